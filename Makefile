@@ -1,0 +1,46 @@
+# whirl: `make run` and `make test` each install what is missing, then do their job.
+SHELL := /bin/bash
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+STUDY ?= studies/thesis_ch3/hardening_case2.yaml
+OUT ?= out
+
+.PHONY: setup system-deps test test-fast lint run generate clean
+
+setup: system-deps $(VENV)/.installed
+
+# Debian packages AUTO-07p needs at run time: the AUTO runtime and gfortran to compile equations.
+system-deps:
+	@if ! command -v gfortran >/dev/null || [ ! -d /usr/lib/auto-07p/lib ]; then \
+	  echo "installing auto-07p and gfortran (Debian packages)"; \
+	  $(SUDO) apt-get install -y -q auto-07p gfortran || \
+	  { $(SUDO) apt-get update -q && $(SUDO) apt-get install -y -q auto-07p gfortran; }; \
+	fi
+
+$(VENV)/.installed: pyproject.toml
+	@[ -x $(BIN)/python ] || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install -q --upgrade pip
+	$(BIN)/python -m pip install -q -e '.[dev]'
+	@touch $@
+
+test: setup
+	$(BIN)/python -m pytest -q
+
+test-fast: setup
+	$(BIN)/python -m pytest -q -m "not auto"
+
+lint: setup
+	$(BIN)/ruff check whirl_cli tests benchmarks
+
+run: setup
+	@mkdir -p $(OUT)
+	$(BIN)/whirl run $(STUDY) -o $(OUT)/$(basename $(notdir $(STUDY))).h5 --overwrite
+
+generate: setup
+	$(BIN)/whirl generate
+
+clean:
+	rm -rf $(OUT) .pytest_cache build *.egg-info
+	find . -name __pycache__ -type d -prune -exec rm -rf {} +

@@ -1,0 +1,78 @@
+"""Code generation: deterministic Fortran, AUTO's constants limits, the committed files."""
+
+from __future__ import annotations
+
+import shutil
+
+import pytest
+from click.testing import CliRunner
+
+from whirl_cli import codegen
+from whirl_cli.cli import cli
+from whirl_cli.errors import CodegenError
+from whirl_cli.models import get_model
+
+from ..conftest import ROOT
+
+
+@pytest.fixture(scope="module")
+def model():
+    return get_model("classical")
+
+
+def test_fortran_is_deterministic_and_complete(model):
+    first, second = codegen.fortran_source(model), codegen.fortran_source(model)
+    assert first == second
+    for routine in ("FUNC", "STPNT", "BCND", "ICND", "FOPT", "PVLS"):
+        assert f"SUBROUTINE {routine}" in first and f"END SUBROUTINE {routine}" in first
+    assert "DFDU(3,1)" in first and "DFDP(4,5)" in first  # analytic Jacobians
+    assert "GETP('MAX', 1, U)" in first
+    assert codegen.model_hash(model) in first
+
+
+def test_par_layout_avoids_auto_reserved_slots(model):
+    layout = codegen.par_layout(model)
+    used = [*layout.parameters.values(), *layout.state_max.values(), *layout.state_min.values()]
+    assert len(set(used)) == len(used)
+    assert not set(used) & set(range(10, 37))  # PAR(11) period, HomCont 10..36
+    assert layout.parameters["K1"] == 1 and layout.npar == max(used)
+
+
+@pytest.mark.parametrize("value", [0.4, 1e-16, 2.0 * 3.141592653589793, 4.0, -10.0, 1.78e-4])
+def test_fortran_number_round_trips(value):
+    text = codegen.fortran_number(value)
+    assert "d" in text and float(text.replace("d", "e")) == value
+
+
+def test_constants_text_format_and_limits(model):
+    text = codegen.constants_text({"NDIM": 4, "DS": -0.01, "ICP": ["K1", "PERIOD"],
+                                   "UZSTOP": {"K1": [-0.3, 0.5]}, "e": "x"})
+    assert text == ("NDIM = 4\nDS = -0.01\nICP = ['K1', 'PERIOD']\n"
+                    "UZSTOP = {'K1': [-0.3, 0.5]}\ne = 'x'\n")
+    with pytest.raises(CodegenError, match="<= 13 characters"):
+        codegen.constants_text({"parnames": {1: "a_name_longer_than_13"}})
+    with pytest.raises(CodegenError, match="cannot hold"):
+        codegen.constants_text({"e": "x'; rm"})
+    with pytest.raises(CodegenError, match="2048"):
+        codegen.constants_text({"UZR": {"K1": [0.1] * 400}})
+
+
+def test_committed_files_match_the_models():
+    """`whirl generate --check` on the repository's auto_equations/ (exit 0)."""
+    result = CliRunner().invoke(cli, ["generate", "--check", "--dir",
+                                      str(ROOT / "auto_equations")])
+    assert result.exit_code == 0, result.output
+    assert "up to date" in result.output
+
+
+def test_generate_check_detects_drift(tmp_path):
+    copy = tmp_path / "auto_equations"
+    shutil.copytree(ROOT / "auto_equations", copy)
+    target = copy / "classical_poly_theta" / "classical_poly_theta.f90"
+    target.write_text(target.read_text().replace("F(1) =", "F(1) = 2*"))
+    result = CliRunner().invoke(cli, ["generate", "--check", "--dir", str(copy)])
+    assert result.exit_code == 1
+    assert "classical_poly_theta/classical_poly_theta.f90" in result.output
+    repaired = CliRunner().invoke(cli, ["generate", "--dir", str(copy)])
+    assert repaired.exit_code == 0 and "wrote" in repaired.output
+    assert CliRunner().invoke(cli, ["generate", "--check", "--dir", str(copy)]).exit_code == 0

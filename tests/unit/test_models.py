@@ -1,0 +1,86 @@
+"""The classical model against the values recovered in ../shared/models.md (sections 2-4)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from whirl_cli.models import all_variants, get_model
+from whirl_cli.models.classical import aerodynamic_coefficients
+
+
+@pytest.fixture(scope="module")
+def model():
+    return get_model("classical")
+
+
+def test_aerodynamic_coefficients_at_datum(model):
+    """models.md 2.3: k_d = 0.04657, k_c = 0.05179 N m/rad, c_a = 0.000883 N m s/rad."""
+    symbols = {p.name: sp.Symbol(p.name, real=True) for p in model.parameters}
+    values = {symbols[k]: v for k, v in model.defaults().items()}
+    k_d, k_c, c_a = (float(e.subs(values)) for e in aerodynamic_coefficients(symbols))
+    assert k_d == pytest.approx(0.046567, abs=2e-6)
+    assert k_c == pytest.approx(0.051795, abs=2e-6)
+    assert c_a == pytest.approx(0.0008826, abs=2e-7)
+
+
+def test_datum_modes(model):
+    """models.md 3: BW 34.38 rad/s with zeta 0.0230, FW 57.53 rad/s with zeta 0.1677."""
+    eigenvalues = np.linalg.eigvals(model.jacobian_numpy(np.zeros(4), model.parameter_vector()))
+    upper = sorted(eigenvalues[eigenvalues.imag > 0], key=lambda z: z.imag)
+    assert [z.imag for z in upper] == pytest.approx([34.38, 57.53], abs=0.01)
+    assert [-z.real / abs(z) for z in upper] == pytest.approx([0.0230, 0.1677], abs=1e-4)
+
+
+def test_jacobian_matches_finite_differences(model):
+    rng = np.random.default_rng(1)
+    params = model.parameter_vector({"K2": -10.0, "K3": 350.0, "K_psi": 0.3})
+    y = rng.standard_normal(4) * [0.2, 0.2, 5.0, 5.0]
+    jac = model.jacobian_numpy(y, params)
+    step = 1e-6
+    numeric = np.column_stack([
+        (model.rhs_numpy(y + step * e, params) - model.rhs_numpy(y - step * e, params))
+        / (2 * step) for e in np.eye(4)])
+    np.testing.assert_allclose(jac, numeric, rtol=1e-6, atol=1e-6)
+
+
+def test_odd_symmetry(model):
+    """The model is invariant under y -> -y (equilibria come in +/- pairs)."""
+    params = model.parameter_vector({"K2": 10.0, "K3": 350.0})
+    y = np.array([0.1, -0.05, 3.0, 1.0])
+    np.testing.assert_allclose(model.rhs_numpy(-y, params), -model.rhs_numpy(y, params))
+
+
+def test_pitch_yaw_exchange_symmetry(model):
+    """models.md 2.4: swapping K_theta and K_psi leaves the eigenvalues unchanged."""
+    a = model.parameter_vector({"K_theta": 0.13, "K_psi": 0.31})
+    b = model.parameter_vector({"K_theta": 0.31, "K_psi": 0.13})
+    eig_a = np.sort_complex(np.linalg.eigvals(model.jacobian_numpy(np.zeros(4), a)))
+    eig_b = np.sort_complex(np.linalg.eigvals(model.jacobian_numpy(np.zeros(4), b)))
+    np.testing.assert_allclose(eig_a, eig_b, rtol=1e-10)
+
+
+def test_auto_rhs_is_the_scaled_physical_rhs(model):
+    """AUTO integrates dy*/dtau = f(S y*)/(S w) with tau = w t (models/base.py)."""
+    params = model.parameter_vector({"K2": 10.0})
+    scale = np.array(model.state_scale)
+    y_star = np.array([0.1, 0.05, -0.2, 0.3])
+    auto_rhs = sp.lambdify((model.state_symbols, model.parameter_symbols), list(model.auto_rhs))
+    expected = model.rhs_numpy(scale * y_star, params) / (scale * model.time_scale)
+    np.testing.assert_allclose(np.array(auto_rhs(y_star, params), dtype=float), expected,
+                               rtol=1e-12)
+
+
+def test_zero_airspeed_is_finite(model):
+    params = model.parameter_vector({"V": 0.0})
+    assert np.all(np.isfinite(model.jacobian_numpy(np.zeros(4), params)))
+
+
+def test_aliases_and_variants(model):
+    assert model.canonical("K_theta") == "K1"
+    assert [v.name for v in all_variants()] == ["classical_poly_theta", "classical_poly_psi"]
+    yaw = get_model("classical", "polynomial", "psi")
+    assert yaw.canonical("K_psi") == "K1" and "K_theta" in yaw.parameter_names
+    with pytest.raises(KeyError):
+        model.canonical("K_phi")

@@ -1,0 +1,301 @@
+"""Unit tests of whirl_cli.plots: stability splitting, plotted data and styles, PNG output."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from matplotlib.colors import same_color, to_hex
+
+from whirl_cli import plots
+from whirl_cli.errors import WhirlError
+from whirl_cli.results import (
+    Branch,
+    BranchKind,
+    ContinuationResult,
+    LinearSweep,
+    PointType,
+    SpecialPoint,
+    StudyResult,
+)
+
+STATES = ("theta", "psi", "dtheta", "dpsi")
+UNITS = ("rad", "rad", "rad/s", "rad/s")
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def make_branch(name: str, kind: str, k1, theta_max, stable, theta_min=None,
+                point_type=None) -> Branch:
+    """A branch on K1 [N m/rad] whose theta max/min are given (rad); other states 0.1 * theta."""
+    k1 = np.asarray(k1, dtype=float)
+    n = len(k1)
+    theta_max = np.asarray(theta_max, dtype=float)
+    theta_min = theta_max if theta_min is None else np.asarray(theta_min, dtype=float)
+    state_max = np.column_stack([theta_max] + [0.1 * theta_max] * 3)
+    state_min = np.column_stack([theta_min] + [0.1 * theta_min] * 3)
+    periodic = kind == BranchKind.PERIODIC
+    return Branch(
+        name=name, kind=kind, origin="test",
+        parameter_names=("K1", "V"), parameter_units=("N m/rad", "m/s"),
+        state_names=STATES, state_units=UNITS,
+        parameters=np.column_stack([k1, np.full(n, 6.7)]),
+        state_max=state_max, state_min=state_min,
+        l2_norm=np.abs(theta_max), period=np.full(n, 0.2 if periodic else np.nan),
+        stable=np.asarray(stable, dtype=bool),
+        point_type=np.zeros(n, int) if point_type is None else np.asarray(point_type),
+        label=np.zeros(n, int), eigenvalues=np.full((n, 4), np.nan, complex),
+    )
+
+
+def make_point(branch: str, point_type: PointType, k1: float, theta: float) -> SpecialPoint:
+    return SpecialPoint(branch=branch, index=0, point_type=int(point_type),
+                        parameter_names=("K1", "V"), parameters=np.array([k1, 6.7]),
+                        state=np.array([theta, 0.0, 0.0, 0.0]), period=np.nan, stable=False)
+
+
+@pytest.fixture
+def continuation() -> ContinuationResult:
+    """Equilibrium losing stability at a Hopf (K1 = 0.3) feeding a periodic branch with a fold."""
+    equilibrium = make_branch("main_down", BranchKind.EQUILIBRIUM,
+                              [0.5, 0.4, 0.3, 0.2, 0.1], [0.0] * 5, [1, 1, 0, 0, 0])
+    periodic = make_branch("periodic_1", BranchKind.PERIODIC,
+                           [0.3, 0.35, 0.4, 0.35, 0.3], [0.0, 0.1, 0.2, 0.3, 0.4],
+                           [0, 0, 0, 1, 1], theta_min=[0.0, -0.1, -0.2, -0.3, -0.4])
+    points = (make_point("main_down", PointType.HB, 0.3, 0.0),
+              make_point("main_down", PointType.BP, 0.2, 0.0),
+              make_point("periodic_1", PointType.LPC, 0.4, 0.2),
+              make_point("periodic_1", PointType.EP, 0.3, 0.4))
+    return ContinuationResult("hopf_K1", "one-parameter", (equilibrium, periodic), points)
+
+
+def line_style(line) -> tuple[str, str]:
+    """(colour name, linestyle) of a line; colours normalised so "g" or "#008000" match "green"."""
+    names = {to_hex(name): name for name in ("green", "magenta", "blue", "red", "black")}
+    return names.get(to_hex(line.get_color()), line.get_color()), line.get_linestyle()
+
+
+def branch_lines(ax):
+    return [line for line in ax.lines if line.get_linestyle() not in ("None", "none", "")]
+
+
+def marker_lines(ax):
+    return [line for line in ax.lines if line.get_marker() not in ("None", "none", "", None)]
+
+
+# -- stability_segments ---------------------------------------------------------------------------
+
+def test_segments_split_with_shared_switching_points():
+    x = np.arange(6.0)
+    y = 10 * x
+    segments = plots.stability_segments(x, y, np.array([1, 1, 0, 0, 0, 1], bool))
+    assert [s for _, _, s in segments] == [True, False, True]
+    np.testing.assert_array_equal(segments[0][0], [0, 1, 2])
+    np.testing.assert_array_equal(segments[1][0], [2, 3, 4, 5])
+    np.testing.assert_array_equal(segments[2][0], [5])
+    np.testing.assert_array_equal(segments[1][1], [20, 30, 40, 50])
+    for (xa, _, _), (xb, _, _) in zip(segments, segments[1:], strict=False):
+        assert xa[-1] == xb[0]  # no gaps
+    assert sum(len(xs) for xs, _, _ in segments) == len(x) + len(segments) - 1
+
+
+@pytest.mark.parametrize("flag", [True, False])
+def test_segments_uniform_stability_is_one_piece(flag):
+    x, y = np.linspace(0, 1, 4), np.linspace(2, 3, 4)
+    (segment,) = plots.stability_segments(x, y, np.full(4, flag))
+    np.testing.assert_array_equal(segment[0], x)
+    np.testing.assert_array_equal(segment[1], y)
+    assert segment[2] is flag
+
+
+def test_segments_single_point_and_empty():
+    ((xs, ys, stable),) = plots.stability_segments(np.array([1.0]), np.array([2.0]),
+                                                   np.array([False]))
+    assert xs.tolist() == [1.0] and ys.tolist() == [2.0] and stable is False
+    assert plots.stability_segments(np.array([]), np.array([]), np.array([], bool)) == []
+
+
+def test_segments_alternating_every_point():
+    segments = plots.stability_segments(np.arange(3.0), np.arange(3.0), [True, False, True])
+    assert [xs.tolist() for xs, _, _ in segments] == [[0, 1], [1, 2], [2]]
+
+
+def test_segments_reject_mismatched_lengths():
+    with pytest.raises(ValueError):
+        plots.stability_segments(np.arange(3.0), np.arange(2.0), np.ones(3, bool))
+
+
+# -- bifurcation_diagram -------------------------------------------------------------------------
+
+def test_branch_styles_follow_kind_and_stability(continuation):
+    ax = plots.bifurcation_diagram(continuation).axes[0]
+    styles = [line_style(line) for line in branch_lines(ax)]
+    expected = {("green", "-"), ("magenta", "--"), ("blue", "-"), ("red", ":")}
+    assert set(styles) == expected
+    # equilibrium: stable [0.5..0.3], unstable [0.3..0.1]; periodic max: unstable, then stable
+    lines = branch_lines(ax)
+    assert len(lines) == 4
+    by_style = {line_style(line): line for line in lines}
+    np.testing.assert_allclose(by_style["green", "-"].get_xdata(), [0.5, 0.4, 0.3])
+    np.testing.assert_allclose(by_style["magenta", "--"].get_xdata(), [0.3, 0.2, 0.1])
+    np.testing.assert_allclose(by_style["red", ":"].get_xdata(), [0.3, 0.35, 0.4, 0.35])
+    np.testing.assert_allclose(by_style["blue", "-"].get_xdata(), [0.35, 0.3])
+
+
+def test_y_data_are_degrees(continuation):
+    ax = plots.bifurcation_diagram(continuation).axes[0]
+    periodic = [line for line in branch_lines(ax) if line_style(line)[0] in ("red", "blue")]
+    ys = np.concatenate([line.get_ydata() for line in periodic])
+    np.testing.assert_allclose(np.sort(np.unique(ys)), np.degrees([0.0, 0.1, 0.2, 0.3, 0.4]))
+    assert ax.get_ylabel() == "theta (max) [deg]"
+    assert ax.get_xlabel() == "K1 [N m/rad]"
+    assert ax.get_title() == "hopf_K1"
+
+
+def test_radians_when_degrees_false(continuation):
+    ax = plots.bifurcation_diagram(continuation, degrees=False).axes[0]
+    ys = np.concatenate([line.get_ydata() for line in branch_lines(ax)])
+    assert np.max(ys) == pytest.approx(0.4)
+    assert ax.get_ylabel() == "theta (max) [rad]"
+
+
+def test_rate_state_in_deg_per_second(continuation):
+    ax = plots.bifurcation_diagram(continuation, state="dtheta").axes[0]
+    ys = np.concatenate([line.get_ydata() for line in branch_lines(ax)])
+    assert np.max(ys) == pytest.approx(np.degrees(0.04))
+    assert ax.get_ylabel() == "dtheta (max) [deg/s]"
+
+
+def test_min_drawn_for_periodic_only(continuation):
+    ax = plots.bifurcation_diagram(continuation, which=("max", "min")).axes[0]
+    periodic = [line for line in branch_lines(ax) if line_style(line)[0] in ("red", "blue")]
+    equilibrium = [line for line in branch_lines(ax) if line_style(line)[0] in ("green", "magenta")]
+    assert len(periodic) == 4 and len(equilibrium) == 2
+    ys = np.concatenate([line.get_ydata() for line in periodic])
+    assert np.min(ys) == pytest.approx(np.degrees(-0.4))
+    assert ax.get_ylabel() == "theta (max, min) [deg]"
+
+
+def test_special_point_markers(continuation):
+    ax = plots.bifurcation_diagram(continuation).axes[0]
+    markers = {line.get_marker(): line for line in marker_lines(ax)}
+    assert set(markers) == {"s", "*", "o"}  # HB, BP, LPC; no marker for EP
+    hopf, branch_point, fold = markers["s"], markers["*"], markers["o"]
+    assert hopf.get_markerfacecolor() == "none"
+    assert same_color(hopf.get_markeredgecolor(), "black")
+    assert same_color(branch_point.get_markerfacecolor(), "black")
+    assert same_color(fold.get_markerfacecolor(), "black")
+    np.testing.assert_allclose(np.c_[hopf.get_xdata(), hopf.get_ydata()], [[0.3, 0.0]])
+    np.testing.assert_allclose(np.c_[branch_point.get_xdata(), branch_point.get_ydata()],
+                               [[0.2, 0.0]])
+    np.testing.assert_allclose(np.c_[fold.get_xdata(), fold.get_ydata()],
+                               [[0.4, np.degrees(0.2)]])
+    for line in markers.values():
+        assert line.get_linestyle() == "None"
+
+
+def test_legend_lists_only_present_styles(continuation):
+    ax = plots.bifurcation_diagram(continuation).axes[0]
+    labels = [text.get_text() for text in ax.get_legend().get_texts()]
+    assert labels == ["stable equilibrium", "unstable equilibrium", "stable periodic",
+                      "unstable periodic", "Hopf (HB)", "branch point (BP, BPC)",
+                      "fold (LP, LPC)"]
+
+
+def test_legend_without_periodic_or_points():
+    equilibrium = make_branch("main", BranchKind.EQUILIBRIUM, [0.1, 0.2], [0.0, 0.0], [1, 1])
+    result = ContinuationResult("eq", "one-parameter", (equilibrium,), ())
+    ax = plots.bifurcation_diagram(result).axes[0]
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["stable equilibrium"]
+    assert ax.get_ylabel() == "theta [deg]"
+
+
+def test_all_markers_of_the_key():
+    equilibrium = make_branch("main", BranchKind.EQUILIBRIUM, [0.1, 0.2], [0.0, 0.0], [0, 0])
+    types = [PointType.HB, PointType.BP, PointType.BPC, PointType.LP, PointType.LPC,
+             PointType.HOMOCLINIC, PointType.HETEROCLINIC, PointType.TR, PointType.PD,
+             PointType.REGULAR, PointType.RG, PointType.UZ, PointType.EP, PointType.MX]
+    points = tuple(make_point("main", t, 0.1 + 0.01 * i, 0.0) for i, t in enumerate(types))
+    ax = plots.bifurcation_diagram(ContinuationResult("all", "one-parameter", (equilibrium,),
+                                                      points)).axes[0]
+    found = {(line.get_marker(), line.get_markerfacecolor() == "none"): len(line.get_xdata())
+             for line in marker_lines(ax)}
+    assert found == {("s", True): 1, ("*", False): 2, ("o", False): 2, ("^", False): 1,
+                     ("^", True): 1, ("o", True): 1, ("D", False): 1}
+
+
+def test_draws_on_given_axes(continuation):
+    figure = plots._new_figure()
+    ax = figure.add_subplot()
+    assert plots.bifurcation_diagram(continuation, ax=ax) is figure
+    assert len(figure.axes) == 1 and ax.lines
+
+
+def test_loci_are_skipped(continuation):
+    locus = make_branch("hopf_locus", BranchKind.HOPF_LOCUS, [0.1, 0.2], [0.0, 0.0], [0, 0])
+    extended = ContinuationResult(continuation.name, continuation.kind,
+                                  continuation.branches + (locus,), continuation.special_points)
+    plain = plots.bifurcation_diagram(continuation).axes[0]
+    with_locus = plots.bifurcation_diagram(extended).axes[0]
+    assert len(with_locus.lines) == len(plain.lines)
+
+
+@pytest.mark.parametrize("kwargs", [{"state": "phi"}, {"which": ("mean",)}, {"which": ()}])
+def test_bad_arguments_raise(continuation, kwargs):
+    with pytest.raises(WhirlError):
+        plots.bifurcation_diagram(continuation, **kwargs)
+
+
+# -- linear_sweep_plot ---------------------------------------------------------------------------
+
+def make_sweep() -> LinearSweep:
+    values = np.linspace(0.1, 0.5, 5)
+    bw = -0.1 + 0.05 * np.arange(5) + 1j * (10 - np.arange(5))
+    fw = -0.2 + 1j * (20 + np.arange(5))
+    eigenvalues = np.column_stack([bw, bw.conj(), fw, fw.conj()])
+    modulus = np.abs(eigenvalues)
+    whirl = np.array([["BW", "BW", "FW", "FW"]] * 5)
+    return LinearSweep("K1", "N m/rad", values, eigenvalues, -eigenvalues.real / modulus,
+                       np.abs(eigenvalues.imag), whirl)
+
+
+def test_linear_sweep_plot_modes():
+    sweep = make_sweep()
+    figure = plots.linear_sweep_plot(sweep)
+    ax_freq, ax_damp = figure.axes
+    labels = [line.get_label() for line in ax_freq.lines]
+    assert labels == ["BW", "FW"]
+    np.testing.assert_allclose(ax_freq.lines[0].get_ydata(), 10 - np.arange(5))
+    np.testing.assert_allclose(ax_damp.lines[1].get_ydata(), sweep.damping_ratio[:, 2])
+    zero = [line for line in ax_damp.lines if np.all(np.asarray(line.get_ydata()) == 0)]
+    assert zero, "zero line in the damping panel"
+    assert ax_freq.get_ylabel() == "frequency [rad/s]"
+    assert ax_damp.get_ylabel() == "damping ratio [-]"
+    assert ax_damp.get_xlabel() == "K1 [N m/rad]"
+
+
+# -- save_study_plots ----------------------------------------------------------------------------
+
+def test_save_study_plots_writes_pngs_only(tmp_path, continuation):
+    two_parameter = ContinuationResult("hopf_locus", "two-parameter", (), ())
+    result = StudyResult("study", "classical", (continuation, two_parameter), (make_sweep(),), ())
+    paths = plots.save_study_plots(result, ("bifurcation", "linear"), tmp_path, "run")
+    assert paths == sorted([tmp_path / "run_hopf_K1_bifurcation.png",
+                            tmp_path / "run_linear_K1.png"])
+    assert sorted(tmp_path.iterdir()) == paths  # no temporary files left behind
+    for path in paths:
+        assert path.read_bytes()[:8] == PNG_MAGIC
+
+
+def test_save_study_plots_selected_kind_and_overwrite(tmp_path, continuation):
+    result = StudyResult("study", "classical", (continuation,), (make_sweep(),), ())
+    (tmp_path / "run_linear_K1.png").write_bytes(b"old")
+    paths = plots.save_study_plots(result, ("linear",), tmp_path, "run")
+    assert paths == [tmp_path / "run_linear_K1.png"]
+    assert paths[0].read_bytes()[:8] == PNG_MAGIC
+    assert [p.name for p in tmp_path.iterdir()] == ["run_linear_K1.png"]
+
+
+def test_save_study_plots_rejects_unknown_kind(tmp_path, continuation):
+    result = StudyResult("study", "classical", (continuation,), (), ())
+    with pytest.raises(WhirlError):
+        plots.save_study_plots(result, ("phase",), tmp_path, "run")
+    assert list(tmp_path.iterdir()) == []

@@ -1,0 +1,267 @@
+"""Running AUTO-07p: compile once, run each job in its own directory, classify the outcome.
+
+* Equation files are compiled and linked against Debian's AUTO runtime objects
+  (``/usr/lib/auto-07p/lib/*.o``) once per source text: executables are cached under
+  ``$WHIRL_CACHE_DIR`` (default ``~/.cache/whirl``) keyed by a hash of the source, the compiler,
+  the flags and the runtime objects. The cache entry appears atomically (a directory rename), so
+  concurrent processes never see a half-written executable.
+* Every run gets a fresh working directory, its constants written as ``fort.2`` (and as
+  ``c.<name>`` for inspection), ``OMP_NUM_THREADS=1`` and a wall-clock timeout. The process is
+  started from an argument list (never a shell string) with an explicit environment.
+* AUTO exits 0 on most errors, so success is: exit status 0, none of AUTO's error texts on
+  stdout, at least one solution point in ``b.<name>``, and no MX (no convergence) ending.
+  Anything else becomes a :class:`RunOutcome` with a status and a message, never an exception.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+import shutil
+import signal
+import subprocess
+import tempfile
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from functools import cache
+from pathlib import Path
+
+from .codegen import constants_text
+from .errors import ToolchainError
+
+AUTO_DIR = Path(os.environ.get("WHIRL_AUTO_DIR", "/usr/lib/auto-07p"))
+#: The flags of Debian's ``cmds/cmds.make`` (minus the build-path mapping).
+FFLAGS = ("-g", "-O2", "-fstack-protector-strong", "-fPIC", "-std=legacy", "-fopenmp")
+INSTALL_HINT = "install them with: sudo apt-get install auto-07p gfortran   (or: make setup)"
+
+#: stdout texts meaning AUTO did not do what was asked, although it exits 0 -> message shown.
+FATAL_PATTERNS = (
+    (r"Restart label \S+ not found", "restart label not found"),
+    (r"could not be found", "the restart solution file could not be found"),
+    (r"Unknown AUTO constant \S+", "unknown AUTO constant"),
+    (r"bad value on line \d+", "malformed constants file"),
+    (r"Name '[^']*' not found", "unknown parameter name"),
+    (r"Insufficient number of parameters", "too few continuation parameters (ICP)"),
+    (r"Invalid parameter index", "invalid parameter index"),
+    (r"Initialization Error", "initialisation error"),
+    (r"On entry to \w+ parameter number\s+\d+ had an illegal value",
+     "NaN or Inf in the equations (LAPACK rejected the Jacobian)"),
+)
+_LABEL_LINE = re.compile(r"^\s*-?\d+\s+-?\d+\s+([A-Z][A-Z0-9]{1,2})\s+(\d+)\s")
+
+
+# ------------------------------------------------------------------------------ toolchain
+def cache_dir() -> Path:
+    root = os.environ.get("WHIRL_CACHE_DIR")
+    if root:
+        return Path(root)
+    xdg = os.environ.get("XDG_CACHE_HOME")
+    return (Path(xdg) if xdg else Path.home() / ".cache") / "whirl"
+
+
+def runtime_objects() -> list[Path]:
+    objects = sorted((AUTO_DIR / "lib").glob("*.o"))
+    if not objects:
+        raise ToolchainError(f"AUTO-07p runtime objects not found in {AUTO_DIR / 'lib'}; "
+                             + INSTALL_HINT)
+    return objects
+
+
+def gfortran() -> str:
+    path = shutil.which("gfortran")
+    if not path:
+        raise ToolchainError("gfortran (needed to compile AUTO equation files) is not installed; "
+                             + INSTALL_HINT)
+    return path
+
+
+@cache
+def _compiler_identity(compiler: str) -> str:
+    out = subprocess.run([compiler, "--version"], capture_output=True, text=True, check=False)
+    return out.stdout.splitlines()[0] if out.stdout else compiler
+
+
+@cache
+def auto_version() -> str:
+    """The installed AUTO-07p package version (Debian), or 'unknown'."""
+    try:
+        out = subprocess.run(["dpkg-query", "-W", "-f=${Version}", "auto-07p"],
+                             capture_output=True, text=True, check=False, timeout=10)
+    except (OSError, subprocess.TimeoutExpired):
+        return "unknown"
+    return out.stdout.strip() or "unknown"
+
+
+@dataclass(frozen=True)
+class Executable:
+    """A compiled AUTO program for one equation source."""
+
+    path: Path
+    source_hash: str
+    compiled: bool  # True if this call compiled it, False if it came from the cache
+
+
+def compile_equations(source: str | Callable[[], str], name: str,
+                      source_key: str | None = None) -> Executable:
+    """Compile and link a free-form .f90 source once; later calls reuse the cached program.
+
+    ``source`` may be a function producing the text, called only on a cache miss; then
+    ``source_key`` must identify the text it would produce.
+    """
+    compiler = gfortran()
+    objects = runtime_objects()
+    if source_key is None:
+        assert isinstance(source, str)
+        source_key = hashlib.sha256(source.encode()).hexdigest()
+    key = hashlib.sha256()
+    for part in (source_key, _compiler_identity(compiler), " ".join(FFLAGS),
+                 *(f"{o.name}:{o.stat().st_size}:{o.stat().st_mtime_ns}" for o in objects)):
+        key.update(part.encode())
+        key.update(b"\0")
+    digest = key.hexdigest()[:24]
+    final = cache_dir() / "exe" / f"{name}-{digest}"
+    exe = final / f"{name}.exe"
+    if exe.exists():
+        return Executable(exe, digest, compiled=False)
+    final.parent.mkdir(parents=True, exist_ok=True)
+    build = Path(tempfile.mkdtemp(prefix=f".{name}-", dir=final.parent))
+    try:
+        (build / f"{name}.f90").write_text(source if isinstance(source, str) else source())
+        for command in (
+            [compiler, *FFLAGS, "-c", f"{name}.f90", "-o", f"{name}.o"],
+            [compiler, *FFLAGS, f"{name}.o", "-o", f"{name}.exe", *map(str, objects)],
+        ):
+            done = subprocess.run(command, cwd=build, capture_output=True, text=True, check=False)
+            if done.returncode != 0:
+                raise ToolchainError(f"compiling {name}.f90 failed ({command[0]} exit "
+                                     f"{done.returncode}):\n{done.stderr.strip()[-2000:]}")
+        try:
+            build.rename(final)  # atomic: another process may have won the race
+        except OSError:
+            if not exe.exists():
+                raise
+        return Executable(exe, digest, compiled=True)
+    finally:
+        shutil.rmtree(build, ignore_errors=True)
+
+
+# ------------------------------------------------------------------------------ running
+@dataclass(frozen=True)
+class RunOutcome:
+    """What one AUTO run did. ``status``: ok | mx | error | timeout | crashed."""
+
+    name: str
+    status: str
+    message: str
+    workdir: Path
+    constants: str
+    returncode: int | None
+    wall_seconds: float
+    n_points: int
+    labels: tuple[tuple[str, int], ...] = field(default=())  # (type, label) from stdout
+
+    @property
+    def success(self) -> bool:
+        return self.status == "ok"
+
+    @property
+    def has_output(self) -> bool:
+        """True if AUTO wrote solution points that can be parsed (also after MX)."""
+        return self.n_points > 0 and self.status in ("ok", "mx", "timeout")
+
+    def file(self, kind: str) -> Path:
+        """Path of AUTO's ``b``, ``s`` or ``d`` output file of this run."""
+        return self.workdir / f"{kind}.{self.name}"
+
+
+def _auto_env() -> dict[str, str]:
+    return {
+        "PATH": os.environ.get("PATH", "/usr/bin:/bin"),
+        "OMP_NUM_THREADS": "1",
+        "OMP_WAIT_POLICY": "PASSIVE",
+        "LC_ALL": "C",
+    }
+
+
+def _count_points(path: Path) -> int:
+    if not path.exists():
+        return 0
+    with path.open(errors="replace") as handle:
+        return sum(1 for line in handle if line.split()[:1] not in ([], ["0"]))
+
+
+def _describe_signal(returncode: int) -> str:
+    number = -returncode if returncode < 0 else returncode - 128
+    try:
+        return f"{signal.Signals(number).name} (exit {returncode})"
+    except ValueError:
+        return f"exit {returncode}"
+
+
+def run(executable: Path, constants: dict, workdir: Path, name: str,
+        restart: Path | None = None, timeout: float = 120.0) -> RunOutcome:
+    """Run AUTO once in the fresh directory ``workdir``.
+
+    ``constants`` are complete (whirl never relies on AUTO defaults it did not choose); ``sv`` is
+    set to ``name`` here. ``restart`` is the ``s.`` file to restart from; it is copied into
+    ``workdir`` and named through the ``s`` constant.
+    """
+    workdir.mkdir(parents=True, exist_ok=False)
+    constants = dict(constants, sv=name)
+    if restart is not None:
+        restart_name = "restart"
+        shutil.copyfile(restart, workdir / f"s.{restart_name}")
+        constants["s"] = restart_name
+    text = constants_text(constants)
+    (workdir / f"c.{name}").write_text(text)
+    (workdir / "fort.2").write_text(text)
+
+    start = time.perf_counter()
+    returncode: int | None
+    with (workdir / "stdout.txt").open("wb") as out, (workdir / "stderr.txt").open("wb") as err:
+        process = subprocess.Popen([str(executable)], cwd=workdir, env=_auto_env(),
+                                   stdin=subprocess.DEVNULL, stdout=out, stderr=err,
+                                   start_new_session=True)
+        try:
+            returncode = process.wait(timeout=timeout)
+            timed_out = False
+        except subprocess.TimeoutExpired:
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
+            returncode, timed_out = None, True
+        except BaseException:  # KeyboardInterrupt: never leave AUTO running
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
+            raise
+    wall = time.perf_counter() - start
+    (workdir / "fort.2").unlink(missing_ok=True)
+
+    stdout = (workdir / "stdout.txt").read_text(errors="replace")
+    labels = tuple((m.group(1), int(m.group(2)))
+                   for m in map(_LABEL_LINE.match, stdout.splitlines()) if m)
+    n_points = _count_points(workdir / f"b.{name}")
+    status, message = _classify(returncode, timed_out, stdout, n_points, labels, timeout)
+    return RunOutcome(name, status, message, workdir, text, returncode, wall, n_points, labels)
+
+
+def _classify(returncode: int | None, timed_out: bool, stdout: str, n_points: int,
+              labels: tuple[tuple[str, int], ...], timeout: float) -> tuple[str, str]:
+    if timed_out:
+        return "timeout", f"AUTO did not finish within {timeout:g} s ({n_points} points kept)"
+    assert returncode is not None
+    if returncode < 0 or returncode > 128:
+        return "crashed", f"AUTO crashed with {_describe_signal(returncode)}"
+    if returncode != 0:
+        return "error", f"AUTO exited with status {returncode}"
+    for pattern, meaning in FATAL_PATTERNS:
+        found = re.search(pattern, stdout)
+        if found:
+            return "error", f"{meaning}: AUTO said '{found.group(0).strip()}'"
+    if n_points == 0:
+        return "error", "AUTO wrote no solution points"
+    if any(kind == "MX" for kind, _ in labels):
+        return "mx", ("no convergence with the minimum step size (MX): the branch ends early; "
+                      "try a smaller step.min or more mesh intervals")
+    return "ok", "ok"

@@ -1,0 +1,213 @@
+"""The ``whirl`` command line: a thin click layer over the library.
+
+Exit status: 0 success; 1 bad input, a missing tool, or an AUTO run that did not succeed (the
+results are still written, with each run's status); 2 usage errors (click).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+import click
+
+from . import __version__
+from .errors import OutputError, WhirlError
+
+
+def _console():
+    from rich.console import Console
+
+    return Console(stderr=True, highlight=False)
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="whirl")
+def cli() -> None:
+    """Nonlinear whirl-flutter continuation studies with AUTO-07p: YAML in, HDF5 and plots out."""
+
+
+# ------------------------------------------------------------------------------------ run
+@cli.command()
+@click.argument("study_file", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
+              help="HDF5 result file [default: <study name>.h5 in the current directory].")
+@click.option("-j", "--jobs", type=click.IntRange(1, 64), default=1, show_default=True,
+              help="AUTO runs in parallel.")
+@click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
+@click.option("--plots/--no-plots", default=True, show_default=True,
+              help="Write the study's plots (PNG) next to the output file.")
+@click.option("--keep-runs", type=click.Path(file_okay=False, path_type=Path),
+              help="Keep AUTO's working directories (constants, b./s./d. files) here.")
+def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots: bool,
+        keep_runs: Path | None) -> None:
+    """Run every continuation and linear analysis of STUDY_FILE."""
+    from . import store
+    from .pipeline import run_study
+    from .study import load_study
+
+    study = load_study(study_file)
+    output = output or Path(f"{study.name}.h5")
+    if output.exists() and not overwrite:
+        raise OutputError(f"{output}: output exists; pass --overwrite to replace it")
+    output.parent.mkdir(parents=True, exist_ok=True)
+    console = _console()
+
+    def report(outcome) -> None:
+        mark = "ok" if outcome.success else outcome.status.upper()
+        console.print(f"  {outcome.name:<32} {mark:<8} {outcome.n_points:>6} points "
+                      f"{outcome.wall_seconds:7.3f} s"
+                      + ("" if outcome.success else f"  {outcome.message}"))
+
+    console.print(f"whirl {__version__}: {study.path} -> {output}")
+    if keep_runs:
+        keep_runs.mkdir(parents=True, exist_ok=True)
+        workroot = Path(tempfile.mkdtemp(prefix=f"{study.name}-", dir=keep_runs))
+    else:
+        workroot = Path(tempfile.mkdtemp(prefix="whirl-"))
+    try:
+        result = run_study(study, workroot, jobs=jobs, on_run=report)
+        store.write(result, output, overwrite=overwrite)
+    finally:
+        if not keep_runs:
+            shutil.rmtree(workroot, ignore_errors=True)
+    console.print(f"wrote {output}")
+    if plots and study.plots:
+        from .plots import save_study_plots
+
+        for path in save_study_plots(result, tuple(study.plots), output.parent, output.stem):
+            console.print(f"wrote {path}")
+    failed = [r for r in result.runs if r.status != "ok"]
+    if failed:
+        raise WhirlError(f"{len(failed)} of {len(result.runs)} AUTO runs did not succeed "
+                         "(their status is stored in the output): "
+                         + "; ".join(f"{r.name}: {r.message}" for r in failed))
+
+
+# ------------------------------------------------------------------------------------ validate
+@cli.command()
+@click.argument("study_file", type=click.Path(dir_okay=False, path_type=Path))
+def validate(study_file: Path) -> None:
+    """Check STUDY_FILE against the schema and the model; exit 0 if valid, 1 if not."""
+    from .study import load_study
+
+    study = load_study(study_file)
+    click.echo(f"{study_file}: ok (model {study.variant().name}, "
+               f"{len(study.continuations)} continuation(s))")
+
+
+# ------------------------------------------------------------------------------------ generate
+@cli.command()
+@click.option("--check", is_flag=True, help="Only check; exit 1 if the files drifted.")
+@click.option("--dir", "directory", type=click.Path(file_okay=False, path_type=Path),
+              default=Path("auto_equations"), show_default=True,
+              help="Where the generated AUTO files live.")
+def generate(check: bool, directory: Path) -> None:
+    """(Re)write the AUTO-07p equation and constants files of every model variant."""
+    from .codegen import drifted, write_generated
+
+    if check:
+        stale = drifted(directory)
+        if stale:
+            raise WhirlError("generated files differ from the symbolic models "
+                             "(run `whirl generate`): " + ", ".join(stale))
+        click.echo(f"{directory}: up to date")
+        return
+    for path in write_generated(directory):
+        click.echo(f"wrote {path}")
+    click.echo(f"{directory}: up to date")
+
+
+# ------------------------------------------------------------------------------------ models
+@cli.command()
+def models() -> None:
+    """List the model variants with their states and parameters (units, defaults)."""
+    from .models import all_variants
+
+    click.echo("\n\n".join(model.describe() for model in all_variants()))
+
+
+# ------------------------------------------------------------------------------------ plot
+@cli.command()
+@click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--kind", "kinds", multiple=True, type=click.Choice(["bifurcation", "linear"]),
+              help="Plot kind (repeatable) [default: all available].")
+@click.option("-o", "--output-dir", type=click.Path(file_okay=False, path_type=Path),
+              help="Directory for the PNG files [default: next to RESULT_FILE].")
+def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None) -> None:
+    """Draw the plots of a whirl result file."""
+    from . import store
+    from .plots import save_study_plots
+
+    result = store.read(result_file)
+    output_dir = output_dir or result_file.parent
+    output_dir.mkdir(parents=True, exist_ok=True)
+    for path in save_study_plots(result, kinds or ("bifurcation", "linear"), output_dir,
+                                 result_file.stem):
+        click.echo(f"wrote {path}")
+
+
+# ------------------------------------------------------------------------------------ doctor
+@cli.command()
+def doctor() -> None:
+    """Check gfortran and AUTO-07p: find them, compile a model, run AUTO once."""
+    from . import auto
+    from .codegen import fortran_source
+    from .models import get_model
+    from .recipes import Numerics, equilibrium_constants
+
+    problems = []
+    click.echo(f"whirl {__version__}, Python {sys.version.split()[0]}")
+    try:
+        click.echo(f"gfortran: {auto.gfortran()}")
+    except WhirlError as error:
+        problems.append(error.message)
+    try:
+        click.echo(f"AUTO-07p: {auto.AUTO_DIR} ({len(auto.runtime_objects())} runtime objects, "
+                   f"package {auto.auto_version()})")
+    except WhirlError as error:
+        problems.append(error.message)
+    if not problems:
+        model = get_model("classical")
+        try:
+            executable = auto.compile_equations(fortran_source(model), model.name)
+            click.echo(f"compile: ok ({executable.path})")
+            constants = equilibrium_constants(model, Numerics(), model.parameters[0].name,
+                                              (0.0, 0.5), -1)
+            with tempfile.TemporaryDirectory(prefix="whirl-doctor-") as scratch:
+                outcome = auto.run(executable.path, constants, Path(scratch) / "run", "doctor",
+                                   timeout=60)
+            if outcome.success:
+                click.echo(f"AUTO run: ok ({outcome.n_points} points, "
+                           f"{outcome.wall_seconds:.3f} s)")
+            else:
+                problems.append(f"AUTO run failed: {outcome.message}")
+        except WhirlError as error:
+            problems.append(error.message)
+    if problems:
+        raise WhirlError("\n".join(problems))
+    click.echo("everything needed is installed")
+
+
+def main() -> None:
+    """Console entry point: whirl errors as one message, unexpected errors without traceback."""
+    try:
+        cli.main(standalone_mode=False)
+    except click.exceptions.Abort:
+        click.echo("interrupted", err=True)
+        sys.exit(130)
+    except click.ClickException as error:
+        error.show()
+        sys.exit(error.exit_code)
+    except KeyboardInterrupt:
+        click.echo("interrupted", err=True)
+        sys.exit(130)
+    except Exception as error:  # a bug: say so plainly, traceback only on request
+        if os.environ.get("WHIRL_DEBUG"):
+            raise
+        click.echo(f"whirl: internal error: {type(error).__name__}: {error} "
+                   "(set WHIRL_DEBUG=1 for the traceback and please report it)", err=True)
+        sys.exit(1)

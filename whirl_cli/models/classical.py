@@ -1,0 +1,137 @@
+"""Classical whirl flutter: the Reed/Bielawa 2-DOF pitch-yaw rotor-nacelle (thesis ch. 3).
+
+Sources (see ``../shared/models.md``): Mair, Rezgui & Titurus, Nonlinear Dyn. 94 (2018) for the
+model; C. Riso's public MATLAB implementation ``cristinariso/propeller-nacelle``
+(``utilities/model/compute_A.m``), which states it follows Mair 2018 with no modifications, for
+the equations; an independent quasi-steady strip-theory derivation for every coefficient.
+Datum parameters: Reed's 1965 tabletop model (thesis Table 3.1), with C_l_alpha = 2 pi (the
+table's "2" gives an onset of 14.9 m/s instead of 7.8) and rho = 1.225 kg/m^3 (not printed).
+
+Equations (thesis/Riso sign convention), state y = [theta, psi, theta_dot, psi_dot]::
+
+    I_y theta'' = -M_theta(theta) + k_d theta - k_c psi - (C_theta + c_a) theta' + I_x Omega psi'
+    I_y psi''   =  k_c theta - M_psi(psi) + k_d psi - I_x Omega theta' - (C_psi + c_a) psi'
+
+    M_theta = K_theta theta, M_psi = K_psi psi unless a stiffness law replaces one of them;
+    k_d = Q a A'_1 (direct aerodynamic stiffness), k_c = Q A'_2 (cross aerodynamic stiffness),
+    c_a = Q (A_3 + a^2 A_1) / Omega (aerodynamic damping), Q = N rho C_l_alpha R^5 Omega^2 / 4,
+    mu = V / (Omega R) and, with c/R constant,
+    A_1 = (c/R) mu^2 asinh(1/mu),  A_2 = (c/R) (mu/2) [sqrt(1+mu^2) - mu^2 asinh(1/mu)],
+    A_3 = (c/R) [(2 - 3 mu^2) sqrt(1+mu^2) + 3 mu^4 asinh(1/mu)] / 8,  A'_1 = mu A_1, A'_2 = mu A_2.
+
+Sign conventions: the rotor spins about +x (forward along the shaft); theta is pitch about +y.
+Relative to the strip-theory derivation frame, psi is measured about -z (psi -> -psi), which
+leaves every eigenvalue unchanged and gives deflected equilibria with theta and psi of the same
+sign, as the thesis reports. The hub offset is (y, z) = (-a R psi, -a R theta); backward whirl
+(BW, against the spin) has theta in phase with psi_dot.
+
+Regularisation: mu enters as sqrt(mu^2 + 1e-16) so that V = 0 (mu -> 0, where A_1 = A_2 = 0) is
+finite; the relative change is below 1e-12 for V > 1e-2 m/s.
+"""
+
+from __future__ import annotations
+
+import math
+
+import sympy as sp
+
+from .base import Model, Parameter, State
+from .nonlinearities import StiffnessLaw
+
+#: AUTO's time: tau = TIME_SCALE * t, with the datum rotor speed (the BW mode is ~34 rad/s).
+TIME_SCALE = 40.0
+
+STATES = (
+    State("theta", "rad", "nacelle pitch about the pivot"),
+    State("psi", "rad", "nacelle yaw about the pivot"),
+    State("dtheta", "rad/s", "pitch rate"),
+    State("dpsi", "rad/s", "yaw rate"),
+)
+
+#: Degrees of freedom a stiffness law may act on, and the name of their linear stiffness.
+DOFS = {"theta": "K_theta", "psi": "K_psi"}
+
+_STIFFNESS = {
+    "K_theta": Parameter("K_theta", 0.4, "N m/rad", "pitch spring stiffness"),
+    "K_psi": Parameter("K_psi", 0.4, "N m/rad", "yaw spring stiffness"),
+}
+#: Parameters after the stiffness ones, in PAR order (the first nine PAR slots are 1..9).
+_OTHER = (
+    Parameter("V", 6.7, "m/s", "free-stream airspeed"),
+    Parameter("C_theta", 0.001, "N m s/rad", "pitch viscous damping"),
+    Parameter("C_psi", 0.001, "N m s/rad", "yaw viscous damping"),
+    Parameter("Omega", 40.0, "rad/s", "rotor speed"),
+    Parameter("I_y", 0.000178, "kg m^2", "nacelle + rotor inertia about the pivot (I_y = I_z)"),
+    Parameter("rho", 1.225, "kg/m^3", "air density"),
+    Parameter("a", 0.25, "1", "pivot-to-hub distance / R"),
+    Parameter("I_x", 0.000103, "kg m^2", "rotor polar inertia"),
+    Parameter("R", 0.152, "m", "rotor radius"),
+    Parameter("c", 0.026, "m", "blade chord (constant)"),
+    Parameter("N", 4.0, "1", "number of blades (>= 3)"),
+    Parameter("C_l_alpha", 2.0 * math.pi, "1/rad", "blade section lift slope"),
+)
+
+NOTES = (
+    "Recovered from Mair et al. 2018 via Riso's implementation and a strip-theory derivation "
+    "(../shared/models.md). Onset 7.764 m/s at datum (thesis ~7.8). Angles in rad inside the "
+    "model; hub offset (y, z) = (-a R psi, -a R theta); rotor spin about +x."
+)
+
+
+def aerodynamic_coefficients(sym: dict[str, sp.Symbol]) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
+    """(k_d, k_c, c_a): direct and cross aerodynamic stiffness [N m/rad], damping [N m s/rad]."""
+    V, Omega, R, c = sym["V"], sym["Omega"], sym["R"], sym["c"]
+    mu = sp.sqrt((V / (Omega * R)) ** 2 + sp.Float(1e-16))
+    ash = sp.asinh(1 / mu)
+    root = sp.sqrt(1 + mu**2)
+    a1 = (c / R) * mu**2 * ash
+    a2 = (c / R) * (mu / 2) * (root - mu**2 * ash)
+    a3 = (c / R) * ((2 - 3 * mu**2) * root + 3 * mu**4 * ash) / 8
+    q = sym["N"] * sym["rho"] * sym["C_l_alpha"] * R**5 * Omega**2 / 4
+    k_d = q * sym["a"] * mu * a1
+    k_c = q * mu * a2
+    c_a = q * (a3 + sym["a"] ** 2 * a1) / Omega
+    return k_d, k_c, c_a
+
+
+def build(law: StiffnessLaw, dof: str) -> Model:
+    """The classical model with ``law`` replacing the linear spring of ``dof``."""
+    if dof not in DOFS:
+        raise ValueError(f"classical model has no degree of freedom {dof!r}")
+    replaced = _STIFFNESS[DOFS[dof]]
+    state = {s.name: sp.Symbol(s.name, real=True) for s in STATES}
+    moment, law_params = law.build(state[dof], replaced)
+    kept = tuple(p for name, p in _STIFFNESS.items() if name != replaced.name)
+    parameters = law_params + kept + _OTHER
+    sym = {p.name: sp.Symbol(p.name, real=True) for p in parameters}
+
+    moments = {
+        d: moment if d == dof else sym[DOFS[d]] * state[d] for d in DOFS
+    }
+    k_d, k_c, c_a = aerodynamic_coefficients(sym)
+    theta, psi, dtheta, dpsi = (state[s.name] for s in STATES)
+    gyro = sym["I_x"] * sym["Omega"]
+    rhs = sp.Matrix(
+        [
+            dtheta,
+            dpsi,
+            (-moments["theta"] + k_d * theta - k_c * psi - (sym["C_theta"] + c_a) * dtheta
+             + gyro * dpsi) / sym["I_y"],
+            (k_c * theta - moments["psi"] + k_d * psi - gyro * dtheta
+             - (sym["C_psi"] + c_a) * dpsi) / sym["I_y"],
+        ]
+    )
+    return Model(
+        name=f"classical_{law.name[:4]}_{dof}",
+        family="classical",
+        law=law.name,
+        dof=dof,
+        description=f"Reed/Bielawa pitch-yaw rotor-nacelle, {law.name} stiffness on {dof}",
+        states=STATES,
+        parameters=parameters,
+        rhs=rhs,
+        time_scale=TIME_SCALE,
+        state_scale=(1.0, 1.0, TIME_SCALE, TIME_SCALE),
+        notes=NOTES,
+        hub_plane=((1, -1.0), (0, -1.0)),  # (y, z) = (-a R psi, -a R theta)
+    )

@@ -1,0 +1,363 @@
+"""Figures of study results: bifurcation diagrams and linear sweeps (matplotlib, Agg).
+
+The only module that imports matplotlib, and only inside functions (the CLI starts without it).
+Figures are built with the object-oriented API on an Agg canvas, never through pyplot, so they
+need no display, are not kept alive by pyplot's figure registry and are freed once unreferenced.
+
+Units: data arrive in SI (angles in rad, rates in rad/s, eigenvalues in 1/s). Bifurcation
+diagrams show angle states in degrees by default ("rad" -> "deg", "rad/s" -> "deg/s");
+parameters are always shown in their own (SI) units. Linear sweeps show frequency in rad/s and
+the damping ratio (dimensionless).
+
+Plot key (thesis Table 2.1) is :data:`PLOT_KEY`: one entry per semantic style, with the
+matplotlib ``Line2D`` keyword arguments that draw it and its legend label.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import re
+import tempfile
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .errors import OutputError, WhirlError
+from .results import Branch, BranchKind, ContinuationResult, LinearSweep, PointType, StudyResult
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+_BLACK = "black"
+_MARKER_SIZE = 8.0
+
+PLOT_KEY: dict[str, dict[str, object]] = {
+    # branches
+    "stable_equilibrium": {"color": "green", "linestyle": "-", "label": "stable equilibrium"},
+    "unstable_equilibrium": {"color": "magenta", "linestyle": "--",
+                             "label": "unstable equilibrium"},
+    "stable_periodic": {"color": "blue", "linestyle": "-", "label": "stable periodic"},
+    "unstable_periodic": {"color": "red", "linestyle": ":", "label": "unstable periodic"},
+    # special points
+    "hopf": {"marker": "s", "markerfacecolor": "none", "markeredgecolor": _BLACK,
+             "label": "Hopf (HB)"},
+    "branch_point": {"marker": "*", "markerfacecolor": _BLACK, "markeredgecolor": _BLACK,
+                     "label": "branch point (BP, BPC)"},
+    "fold": {"marker": "o", "markerfacecolor": _BLACK, "markeredgecolor": _BLACK,
+             "label": "fold (LP, LPC)"},
+    "homoclinic": {"marker": "^", "markerfacecolor": _BLACK, "markeredgecolor": _BLACK,
+                   "label": "homoclinic"},
+    "heteroclinic": {"marker": "^", "markerfacecolor": "none", "markeredgecolor": _BLACK,
+                     "label": "heteroclinic"},
+    "torus": {"marker": "o", "markerfacecolor": "none", "markeredgecolor": _BLACK,
+              "label": "torus (TR)"},
+    "period_doubling": {"marker": "D", "markerfacecolor": _BLACK, "markeredgecolor": _BLACK,
+                        "label": "period doubling (PD)"},
+}
+"""Semantic style -> Line2D keyword arguments (including ``label``). Do not mutate."""
+
+MARKER_STYLE: dict[PointType, str] = {
+    PointType.HB: "hopf",
+    PointType.BP: "branch_point",
+    PointType.BPC: "branch_point",
+    PointType.LP: "fold",
+    PointType.LPC: "fold",
+    PointType.HOMOCLINIC: "homoclinic",
+    PointType.HETEROCLINIC: "heteroclinic",
+    PointType.TR: "torus",
+    PointType.PD: "period_doubling",
+}
+"""Point type -> key of :data:`PLOT_KEY`; types not listed (REGULAR, RG, UZ, EP, MX, ...) get
+no marker."""
+
+_PLOTTED_KINDS = (BranchKind.EQUILIBRIUM, BranchKind.PERIODIC)
+PLOT_KINDS = ("bifurcation", "linear")
+
+
+def branch_style(kind: str, stable: bool) -> str:
+    """Key of :data:`PLOT_KEY` for a branch piece of ``kind`` (a :class:`BranchKind`)."""
+    family = "periodic" if kind == BranchKind.PERIODIC else "equilibrium"
+    return f"{'stable' if stable else 'unstable'}_{family}"
+
+
+def stability_segments(x: np.ndarray, y: np.ndarray, stable: np.ndarray
+                       ) -> list[tuple[np.ndarray, np.ndarray, bool]]:
+    """Split a curve into runs of equal stability, ``[(x_i, y_i, stable_i), ...]`` in order.
+
+    The first point of each new run (the switching point) also ends the previous run, so drawn
+    pieces join without gaps. Units are those of ``x`` and ``y``; empty input gives ``[]``.
+    """
+    x = np.asarray(x)
+    y = np.asarray(y)
+    stable = np.asarray(stable, dtype=bool)
+    if not (x.shape == y.shape == stable.shape) or x.ndim != 1:
+        raise ValueError(f"x, y and stable must be 1-D of equal length, got shapes "
+                         f"{x.shape}, {y.shape}, {stable.shape}")
+    if len(x) == 0:
+        return []
+    starts = np.concatenate(([0], np.flatnonzero(stable[1:] != stable[:-1]) + 1))
+    ends = np.append(starts[1:] + 1, len(x))  # inclusive of the next run's first point
+    return [(x[a:b], y[a:b], bool(stable[a])) for a, b in zip(starts, ends, strict=True)]
+
+
+def display_unit(unit: str, degrees: bool = True) -> tuple[float, str]:
+    """(factor, unit) to show an SI quantity: rad -> deg (and rad/s -> deg/s) if ``degrees``."""
+    if degrees and re.fullmatch(r"rad(/.*)?", unit):
+        return float(np.degrees(1.0)), "deg" + unit[3:]
+    return 1.0, unit
+
+
+def axis_label(name: str, unit: str) -> str:
+    """``"name [unit]"``, with ``[-]`` for dimensionless quantities (unit "" or "1")."""
+    return f"{name} [{unit if unit not in ('', '1') else '-'}]"
+
+
+def bifurcation_diagram(continuation: ContinuationResult, state: str = "theta",
+                        which: Sequence[str] = ("max",), ax: Axes | None = None,
+                        degrees: bool = True) -> Figure:
+    """One-parameter bifurcation diagram: ``state`` against each branch's principal parameter.
+
+    Equilibrium and periodic branches are drawn (other kinds, e.g. loci, are skipped) with
+    y = max of ``state`` over the orbit (the state itself for equilibria), and for periodic
+    branches also the min when "min" is in ``which``; line styles follow :data:`PLOT_KEY` by kind
+    and stability. Special points get markers at (principal parameter, ``state`` value). Angle
+    states are shown in degrees (rad -> deg, rad/s -> deg/s) unless ``degrees`` is False; the
+    parameter keeps its SI unit. Draws on ``ax`` if given, else on a new figure; returns the
+    figure. The legend lists only styles present; the title is the continuation's name.
+    """
+    which = tuple(which)
+    if not which or not set(which) <= {"max", "min"}:
+        raise WhirlError(f"which must be a non-empty subset of ('max', 'min'), got {which}")
+    branches = [b for b in continuation.branches if b.kind in _PLOTTED_KINDS]
+    for branch in branches:
+        if state not in branch.state_names:
+            raise WhirlError(f"state {state!r} not on branch {branch.name!r} "
+                             f"(states: {', '.join(branch.state_names)})")
+    if ax is None:
+        ax = _new_figure().add_subplot()
+    first: dict[str, object] = {}  # style -> first artist drawn with it (legend handle)
+    for branch in branches:
+        _draw_branch(ax, branch, state, which, degrees, first)
+    _draw_special_points(ax, continuation, branches, state, degrees, first)
+    _label_axes(ax, continuation, branches, state, which, degrees)
+    handles = [first[key] for key in PLOT_KEY if key in first]
+    if handles:
+        ax.legend(handles, [PLOT_KEY[key]["label"] for key in PLOT_KEY if key in first],
+                  fontsize="small")
+    ax.set_title(continuation.name)
+    return ax.figure
+
+
+def _new_figure(**kwargs) -> Figure:
+    """A Figure on an Agg canvas, outside pyplot (needs no display, no closing)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    figure = Figure(**kwargs)
+    FigureCanvasAgg(figure)
+    return figure
+
+
+def _plot_styled(ax: Axes, x: np.ndarray, y: np.ndarray, style: str, first: dict) -> None:
+    """Plot with ``PLOT_KEY[style]``; remember the first artist of each style for the legend."""
+    kwargs = dict(PLOT_KEY[style])
+    kwargs["label"] = "_" + str(kwargs["label"])  # legend is assembled from ``first``
+    if "marker" in kwargs:
+        kwargs.update(linestyle="none", markersize=_MARKER_SIZE, zorder=3)
+    (line,) = ax.plot(x, y, **kwargs)
+    first.setdefault(style, line)
+
+
+def _draw_branch(ax: Axes, branch: Branch, state: str, which: tuple[str, ...], degrees: bool,
+                 first: dict) -> None:
+    """Draw one branch's max (and min, periodic only) curves, split by stability."""
+    factor, _ = display_unit(branch.state_units[branch.state_names.index(state)], degrees)
+    x = branch.parameters[:, 0]
+    tables = [w for w in ("max", "min") if w in which] if branch.is_periodic else [which[0]]
+    for table in tables:
+        y = branch.state(state, table) * factor
+        for xs, ys, stable in stability_segments(x, y, branch.stable):
+            _plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)
+
+
+def _draw_special_points(ax: Axes, continuation: ContinuationResult, branches: list[Branch],
+                         state: str, degrees: bool, first: dict) -> None:
+    """Markers for special points, one artist per marker style.
+
+    A point's state is read by the state names of its branch (or of the first plotted branch if
+    its branch is not among them); points not on the x-axis parameter are skipped.
+    """
+    by_name = {b.name: b for b in branches}
+    x_name = branches[0].parameter_names[0] if branches else None
+    points: dict[str, list[tuple[float, float]]] = {}
+    for point in continuation.special_points:
+        style = MARKER_STYLE.get(_point_type(point.point_type))
+        branch = by_name.get(point.branch, branches[0] if branches else None)
+        if style is None or branch is None or point.parameter_names[0] != x_name:
+            continue
+        index = branch.state_names.index(state)
+        factor, _ = display_unit(branch.state_units[index], degrees)
+        xy = (float(point.parameters[0]), float(point.state[index]) * factor)
+        if np.all(np.isfinite(xy)):
+            points.setdefault(style, []).append(xy)
+    for style in PLOT_KEY:
+        if style in points:
+            xs, ys = np.array(points[style]).T
+            _plot_styled(ax, xs, ys, style, first)
+
+
+def _point_type(code: int) -> PointType | None:
+    try:
+        return PointType(int(code))
+    except ValueError:
+        return None
+
+
+def _label_axes(ax: Axes, continuation: ContinuationResult, branches: list[Branch], state: str,
+                which: tuple[str, ...], degrees: bool) -> None:
+    """Axis labels with units from the first plotted branch (nothing if there is none)."""
+    if not branches:
+        return
+    ref = branches[0]
+    ax.set_xlabel(axis_label(ref.parameter_names[0], ref.parameter_units[0]))
+    _, unit = display_unit(ref.state_units[ref.state_names.index(state)], degrees)
+    extent = ", ".join(which) if any(b.is_periodic for b in branches) else ""
+    ax.set_ylabel(axis_label(f"{state} ({extent})" if extent else state, unit))
+
+
+def linear_sweep_plot(sweep: LinearSweep) -> Figure:
+    """Frequency [rad/s] (top) and damping ratio [-] (bottom) of each mode vs the parameter.
+
+    One line per column of ``sweep.eigenvalues``, drawn only where Im(lambda) > 0 so each
+    conjugate pair appears once (real eigenvalues are not drawn). Lines are labelled with their
+    whirl direction ("BW"/"FW", numbered if repeated); the damping panel has a zero line.
+    """
+    figure = _new_figure(figsize=(6.4, 6.4))
+    ax_freq, ax_damp = figure.subplots(2, 1, sharex=True)
+    for (column, label), colour in zip(_mode_labels(sweep), _colours(), strict=False):
+        upper = sweep.eigenvalues[:, column].imag > 0
+        freq = np.where(upper, sweep.frequency[:, column], np.nan)
+        damp = np.where(upper, sweep.damping_ratio[:, column], np.nan)
+        ax_freq.plot(sweep.values, freq, color=colour, label=label)
+        ax_damp.plot(sweep.values, damp, color=colour, label=label)
+    ax_damp.axhline(0.0, color="black", linewidth=0.8, label="_zero")
+    ax_freq.set_ylabel(axis_label("frequency", "rad/s"))
+    ax_damp.set_ylabel(axis_label("damping ratio", ""))
+    ax_damp.set_xlabel(axis_label(sweep.parameter, sweep.unit))
+    if ax_freq.get_lines():
+        ax_freq.legend(fontsize="small")
+    ax_freq.set_title(f"linear analysis vs {sweep.parameter}")
+    return figure
+
+
+def _mode_labels(sweep: LinearSweep) -> list[tuple[int, str]]:
+    """(column, label) of the columns with Im(lambda) > 0 somewhere; label = majority whirl."""
+    modes = []
+    for column in range(sweep.eigenvalues.shape[1]):
+        upper = sweep.eigenvalues[:, column].imag > 0
+        if not upper.any():
+            continue
+        names, counts = np.unique(np.asarray(sweep.whirl)[upper, column].astype(str),
+                                  return_counts=True)
+        modes.append((column, str(names[np.argmax(counts)])))
+    totals = {label: sum(1 for _, other in modes if other == label) for _, label in modes}
+    seen: dict[str, int] = {}
+    labelled = []
+    for column, label in modes:
+        seen[label] = seen.get(label, 0) + 1
+        labelled.append((column, f"{label} {seen[label]}" if totals[label] > 1 else label))
+    return labelled
+
+
+def _colours() -> Iterator[str]:
+    """Endless cycle of the default matplotlib line colours."""
+    from matplotlib import rcParams
+
+    return itertools.cycle(rcParams["axes.prop_cycle"].by_key().get("color", ["C0"]))
+
+
+def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path, stem: str,
+                     state: str = "theta", dpi: int = 150) -> list[Path]:
+    """Write a study's figures as PNG files into ``out_dir``; return the paths, sorted.
+
+    ``kinds``: "bifurcation" -> ``<stem>_<continuation>_bifurcation.png`` per one-parameter
+    continuation (``state`` vs the principal parameter, angles in degrees; the first state if
+    the branches have no ``state``); "linear" -> ``<stem>_linear_<parameter>.png`` per linear
+    sweep. Names are made filesystem-safe; repeats get ``_2``, ``_3``, ... Each file is written
+    under a temporary name in ``out_dir`` and moved into place, so none is ever half-written.
+    """
+    unknown = set(kinds) - set(PLOT_KINDS)
+    if unknown:
+        raise WhirlError(f"unknown plot kind(s) {sorted(unknown)}; choose from {PLOT_KINDS}")
+    out_dir = Path(out_dir)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"cannot create plot directory {out_dir}: {exc}") from exc
+    written: list[Path] = []
+    for name, make in _figure_jobs(result, kinds, stem, state):
+        path = _unique(out_dir / _safe_name(name), written)
+        _write_png(make(), path, dpi)
+        written.append(path)
+    return sorted(written)
+
+
+def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: str):
+    """(file name, figure factory) pairs for the requested kinds, in a stable order."""
+    jobs = []
+    if "bifurcation" in kinds:
+        for continuation in result.continuations:
+            if continuation.kind == "one-parameter":
+                chosen = _state_for(continuation, state)
+                jobs.append((f"{stem}_{continuation.name}_bifurcation.png",
+                             lambda c=continuation, s=chosen: bifurcation_diagram(c, s)))
+    if "linear" in kinds:
+        for sweep in result.linear_sweeps:
+            jobs.append((f"{stem}_linear_{sweep.parameter}.png",
+                         lambda s=sweep: linear_sweep_plot(s)))
+    return jobs
+
+
+def _state_for(continuation: ContinuationResult, state: str) -> str:
+    """``state`` if every plotted branch has it, else the first branch's first state."""
+    branches = [b for b in continuation.branches if b.kind in _PLOTTED_KINDS]
+    if not branches or all(state in b.state_names for b in branches):
+        return state
+    return branches[0].state_names[0]
+
+
+def _safe_name(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9._+-]", "_", name)
+
+
+def _unique(path: Path, taken: list[Path]) -> Path:
+    candidate, n = path, 1
+    while candidate in taken:
+        n += 1
+        candidate = path.with_name(f"{path.stem}_{n}{path.suffix}")
+    return candidate
+
+
+def _write_png(figure: Figure, path: Path, dpi: int) -> None:
+    """Save ``figure`` as PNG to a temporary file beside ``path``, then rename it atomically."""
+    try:
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    except OSError as exc:
+        figure.clear()
+        raise OutputError(f"cannot write plot {path}: {exc}") from exc
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            figure.savefig(handle, format="png", dpi=dpi, bbox_inches="tight")
+        os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        raise OutputError(f"cannot write plot {path}: {exc}") from exc
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    finally:
+        figure.clear()

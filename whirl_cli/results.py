@@ -1,0 +1,232 @@
+"""Result types shared by the pipeline: branches, special points, orbits, linear sweeps.
+
+All are frozen dataclasses holding numpy columns (one array per quantity, one row per point), in
+SI units with physical time: angles in rad, rates in rad/s, periods in s, eigenvalues in 1/s.
+``branches.py`` builds them from AUTO's files, ``store.py`` writes and reads them, ``plots.py``
+draws them; none of those modules change them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import IntEnum
+
+import numpy as np
+
+
+class PointType(IntEnum):
+    """Point types: AUTO's TY codes (mod 10 on loci), plus whirl's own for global bifurcations.
+
+    Equilibria: BP (branch point / pitchfork), LP (fold), HB (Hopf). Periodic orbits: LPC (fold of
+    cycles), BPC (branch point of cycles), PD (period doubling), TR (torus). Both: RG (labelled
+    regular point), UZ (user point or stop), EP (end point), MX (no convergence).
+    Codimension 2 on loci: BT, CP, ZH, GH, R1..R4. HOMOCLINIC/HETEROCLINIC: period blow-up
+    detected by whirl (not an AUTO code).
+    """
+
+    REGULAR = 0
+    BP = 1
+    LP = 2
+    HB = 3
+    RG = 4
+    LPC = 5
+    BPC = 6
+    PD = 7
+    TR = 8
+    EP = 9
+    UZ = -4
+    MX = -9
+    BT = -1
+    CP = -2
+    ZH = -3
+    R1 = -5
+    R2 = -6
+    R3 = -7
+    R4 = -8
+    GH = -32
+    LTR = 23
+    PTR = 77
+    LPD = 28
+    TTR = 88
+    HOMOCLINIC = 101
+    HETEROCLINIC = 102
+
+    @classmethod
+    def from_auto(cls, ty: int) -> PointType:
+        """Normalise an AUTO TY code (e.g. 30 on a Hopf locus is a regular point)."""
+        specials = {-32: cls.GH, 23: cls.LTR, 83: cls.LTR, 77: cls.PTR, 87: cls.PTR,
+                    28: cls.LPD, 78: cls.LPD, 88: cls.TTR}
+        if ty in specials:
+            return specials[ty]
+        rest = abs(ty) % 10
+        return cls(-rest if ty < 0 else rest)
+
+    @property
+    def is_special(self) -> bool:
+        """Bifurcations worth listing (not regular, user, end or no-convergence points)."""
+        return self not in (PointType.REGULAR, PointType.RG, PointType.UZ, PointType.EP,
+                            PointType.MX)
+
+
+class BranchKind:
+    """Values of :attr:`Branch.kind`."""
+
+    EQUILIBRIUM = "equilibrium"
+    PERIODIC = "periodic"
+    HOPF_LOCUS = "hopf_locus"
+    BRANCH_POINT_LOCUS = "branch_point_locus"
+    FOLD_LOCUS = "fold_locus"
+    FOLD_OF_CYCLES_LOCUS = "fold_of_cycles_locus"
+
+
+@dataclass(frozen=True)
+class Orbit:
+    """One stored solution profile (a labelled AUTO solution), states in SI units.
+
+    ``time``: (K,) in s from 0 to the period (a single point for equilibria); ``states``: (K, n).
+    """
+
+    label: int
+    point_type: int
+    index: int  # row of the point on its branch
+    parameters: np.ndarray  # (P,) values of the branch's parameter_names
+    period: float  # s, NaN for equilibria
+    time: np.ndarray
+    states: np.ndarray
+
+
+@dataclass(frozen=True)
+class Branch:
+    """One continuation branch (one AUTO run), N points.
+
+    Attributes
+    ----------
+    name : unique id within its continuation, e.g. "main_down", "secondary_1_up", "periodic_2".
+    kind : one of :class:`BranchKind`.
+    origin : where it started, e.g. "start at K1 = 0.5", "BP 4 of main_down".
+    parameter_names : continuation parameters, principal first; ``parameters``: (N, P) values.
+    state_names, state_units : the model's states and their SI units.
+    state_max, state_min : (N, n) max and min of each state over the orbit (equilibria: equal).
+    l2_norm : (N,) AUTO's L2 norm of its (non-dimensional) solution.
+    period : (N,) s, NaN for equilibria.
+    stable : (N,) bool, from AUTO's stability flag (False on loci, where it is undefined).
+    point_type : (N,) int, :class:`PointType` codes; label : (N,) int AUTO label (0 = none).
+    eigenvalues : (N, n) complex: Jacobian eigenvalues in 1/s for equilibria, Floquet multipliers
+        for periodic orbits (NaN where AUTO printed none).
+    status, message : how the AUTO run ended (ok | mx | error | timeout | crashed).
+    orbits : stored profiles of labelled solutions.
+    """
+
+    name: str
+    kind: str
+    origin: str
+    parameter_names: tuple[str, ...]
+    parameter_units: tuple[str, ...]
+    state_names: tuple[str, ...]
+    state_units: tuple[str, ...]
+    parameters: np.ndarray
+    state_max: np.ndarray
+    state_min: np.ndarray
+    l2_norm: np.ndarray
+    period: np.ndarray
+    stable: np.ndarray
+    point_type: np.ndarray
+    label: np.ndarray
+    eigenvalues: np.ndarray
+    status: str = "ok"
+    message: str = "ok"
+    run: str = ""
+    orbits: tuple[Orbit, ...] = field(default=())
+
+    def __len__(self) -> int:
+        return len(self.point_type)
+
+    def parameter(self, name: str) -> np.ndarray:
+        return self.parameters[:, self.parameter_names.index(name)]
+
+    def state(self, name: str, which: str = "max") -> np.ndarray:
+        table = self.state_max if which == "max" else self.state_min
+        return table[:, self.state_names.index(name)]
+
+    @property
+    def is_periodic(self) -> bool:
+        return self.kind == BranchKind.PERIODIC
+
+
+@dataclass(frozen=True)
+class SpecialPoint:
+    """A bifurcation or notable end on a branch.
+
+    ``status``: "located" (AUTO converged on it) or "bracketed" (estimated between points, e.g.
+    a period blow-up). ``criticality``: "supercritical" | "subcritical" | "" (Hopf points).
+    """
+
+    branch: str
+    index: int
+    point_type: int
+    parameter_names: tuple[str, ...]
+    parameters: np.ndarray
+    state: np.ndarray  # (n,) equilibrium state, or max over the orbit for periodic points
+    period: float
+    stable: bool
+    label: int = 0
+    status: str = "located"
+    criticality: str = ""
+    note: str = ""
+
+    @property
+    def type_name(self) -> str:
+        return PointType(self.point_type).name
+
+
+@dataclass(frozen=True)
+class LinearSweep:
+    """Linear analysis along a sweep of one parameter (M points, n states).
+
+    ``eigenvalues``: (M, n) complex [1/s]; ``damping_ratio``: (M, n) [-]; ``frequency``: (M, n)
+    [rad/s]; ``whirl``: (M, n) str, "FW", "BW" or "--" for real eigenvalues. Modes are ordered by
+    frequency per point.
+    """
+
+    parameter: str
+    unit: str
+    values: np.ndarray
+    eigenvalues: np.ndarray
+    damping_ratio: np.ndarray
+    frequency: np.ndarray
+    whirl: np.ndarray
+
+
+@dataclass(frozen=True)
+class RunRecord:
+    """Bookkeeping of one AUTO run, stored under /runs."""
+
+    name: str
+    status: str
+    message: str
+    constants: str
+    returncode: int
+    wall_seconds: float
+    n_points: int
+
+
+@dataclass(frozen=True)
+class ContinuationResult:
+    """Everything one continuation of a study produced."""
+
+    name: str
+    kind: str  # "one-parameter" | "two-parameter"
+    branches: tuple[Branch, ...]
+    special_points: tuple[SpecialPoint, ...]
+
+
+@dataclass(frozen=True)
+class StudyResult:
+    """A whole study's results, as written to one HDF5 file."""
+
+    study_name: str
+    model: str
+    continuations: tuple[ContinuationResult, ...]
+    linear_sweeps: tuple[LinearSweep, ...]
+    runs: tuple[RunRecord, ...]
+    attributes: dict = field(default_factory=dict)  # provenance (versions, study text, hash)
