@@ -40,7 +40,6 @@ continuations:
     periodic: false
     branch_points: true
 """
-SHARED_SMOKE = Path(__file__).resolve().parents[3] / "shared" / "hooks" / "smoke_linear_case2.yaml"
 HEAD = "name: s\nmodel: classical\n"
 MODELS: tuple[type[BaseModel], ...] = (
     Study,
@@ -83,15 +82,6 @@ def test_smoke_study_loads_with_defaults():
     assert study.source == SMOKE
     assert study.sha256 == hashlib.sha256(SMOKE.encode()).hexdigest()
     assert study.path == "smoke.yaml"
-
-
-def test_shared_smoke_file_loads():
-    if not SHARED_SMOKE.is_file():
-        pytest.skip("shared/ is not beside the repository")
-    study = load_study(SHARED_SMOKE)
-    assert study.name == "smoke-linear-case2"
-    assert study.path == str(SHARED_SMOKE)
-    assert study.sha256 == hashlib.sha256(SHARED_SMOKE.read_bytes()).hexdigest()
 
 
 def test_load_study_reads_a_file(tmp_path):
