@@ -80,11 +80,40 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
 
         for path in save_study_plots(result, tuple(study.plots), output.parent, output.stem):
             console.print(f"wrote {path}")
-    failed = [r for r in result.runs if r.status != "ok"]
-    if failed:
-        raise WhirlError(f"{len(failed)} of {len(result.runs)} AUTO runs did not succeed "
-                         "(their status is stored in the output): "
-                         + "; ".join(f"{r.name}: {r.message}" for r in failed))
+    failed = [b for c in result.continuations for b in c.branches if b.status != "ok"]
+    checks = [x for c in result.continuations for x in c.cross_checks]
+    wrong = [x for x in checks if not x.passed]
+    if checks:
+        console.print(f"cross-checks by time simulation: {len(checks) - len(wrong)} of "
+                      f"{len(checks)} passed")
+    problems = [f"{b.name} ({b.run}): {b.message}" for b in failed]
+    problems += [f"cross-check failed on {x.branch} at {x.parameter:.6g}" for x in wrong]
+    if problems:
+        raise WhirlError(f"{len(problems)} problem(s); the results are stored with their "
+                         "status: " + "; ".join(problems))
+
+
+# ------------------------------------------------------------------------------------ check
+@cli.command()
+@click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+def check(result_file: Path) -> None:
+    """Check the stable orbits and equilibria of a result file by time simulation."""
+    from . import simulate, store
+    from .study import validate_text
+
+    result = store.read(result_file)
+    study = validate_text(str(result.attributes.get("study_yaml", "")), result_file.name)
+    model, parameters = study.variant(), study.parameter_values()
+    wrong = 0
+    for continuation in result.continuations:
+        for x in simulate.cross_check(model, parameters, continuation.branches):
+            mark = "ok  " if x.passed else "FAIL"
+            click.echo(f"{mark} {continuation.name}/{x.branch}[{x.index}] {x.kind:<11} "
+                       f"{continuation.branches[0].parameter_names[0]} = {x.parameter:.6g}: "
+                       f"AUTO {x.expected:.6g}, simulation {x.simulated:.6g}")
+            wrong += not x.passed
+    if wrong:
+        raise WhirlError(f"{wrong} cross-check(s) failed")
 
 
 # ------------------------------------------------------------------------------------ validate
@@ -133,7 +162,8 @@ def models() -> None:
 # ------------------------------------------------------------------------------------ plot
 @cli.command()
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.option("--kind", "kinds", multiple=True, type=click.Choice(["bifurcation", "linear"]),
+@click.option("--kind", "kinds", multiple=True,
+              type=click.Choice(["bifurcation", "linear", "projections", "period", "phase"]),
               help="Plot kind (repeatable) [default: all available].")
 @click.option("-o", "--output-dir", type=click.Path(file_okay=False, path_type=Path),
               help="Directory for the PNG files [default: next to RESULT_FILE].")
@@ -145,7 +175,7 @@ def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None) -> 
     result = store.read(result_file)
     output_dir = output_dir or result_file.parent
     output_dir.mkdir(parents=True, exist_ok=True)
-    for path in save_study_plots(result, kinds or ("bifurcation", "linear"), output_dir,
+    for path in save_study_plots(result, kinds or ("bifurcation", "linear", "period"), output_dir,
                                  result_file.stem):
         click.echo(f"wrote {path}")
 

@@ -24,6 +24,9 @@ from .models import Model, all_variants
 #: Free PAR slots for user parameters, in order (AUTO reserves 10..36).
 _USER_SLOTS = tuple(range(1, 10)) + tuple(range(37, 200))
 PERIOD_INDEX = 11
+#: PVLS output: the largest half peak-to-peak value of any (AUTO, non-dimensional) state over
+#: the solution; 0 on equilibria. Used to stop periodic families that shrink back onto a Hopf.
+AMPLITUDE = "amplitude"
 _FCODE = dict(standard=2008, source_format="free", strict=True,
               user_functions={"asinh": "asinh"})
 
@@ -35,21 +38,23 @@ class ParLayout:
     parameters: dict[str, int]
     state_max: dict[str, int]
     state_min: dict[str, int]
+    amplitude: int
 
     @property
     def npar(self) -> int:
-        return max([*self.parameters.values(), *self.state_max.values(),
-                    *self.state_min.values()])
+        return self.amplitude
 
     def parnames(self) -> dict[int, str]:
         names = {i: n for n, i in self.parameters.items()}
         names.update({i: f"max_{n}" for n, i in self.state_max.items()})
         names.update({i: f"min_{n}" for n, i in self.state_min.items()})
+        names[self.amplitude] = AMPLITUDE
         return dict(sorted(names.items()))
 
     def measures(self) -> list[str]:
         """The PVLS output names, in PAR order (listed at the end of every ICP)."""
-        return [f"max_{n}" for n in self.state_max] + [f"min_{n}" for n in self.state_min]
+        return ([f"max_{n}" for n in self.state_max] + [f"min_{n}" for n in self.state_min]
+                + [AMPLITUDE])
 
 
 def par_layout(model: Model) -> ParLayout:
@@ -60,7 +65,7 @@ def par_layout(model: Model) -> ParLayout:
     maxima = [next(slots) for _ in range(n_states)]
     minima = [next(slots) for _ in range(n_states)]
     return ParLayout(parameters, dict(zip(model.state_names, maxima, strict=True)),
-                     dict(zip(model.state_names, minima, strict=True)))
+                     dict(zip(model.state_names, minima, strict=True)), next(slots))
 
 
 def model_hash(model: Model) -> str:
@@ -136,8 +141,10 @@ def fortran_source(model: Model) -> str:
         header.append(f"!   PAR({layout.parameters[p.name]}) = {p.name} [{p.unit}]: "
                       f"{p.description}")
     header.append(f"!   PAR({PERIOD_INDEX}) = period in tau")
-    header.append(f"!   PAR({min(layout.state_max.values())}..{layout.npar}) = max and min of "
-                  "each state over the solution (PVLS)")
+    header.append(f"!   PAR({min(layout.state_max.values())}..{layout.npar - 1}) = max and min "
+                  "of each state over the solution (PVLS)")
+    header.append(f"!   PAR({layout.amplitude}) = {AMPLITUDE}: largest half peak-to-peak value "
+                  "of a state (PVLS)")
     header.append("!" + "-" * 78)
 
     unpack = [f"  {s.name} = U({i + 1})" for i, s in enumerate(model.states)]
@@ -190,11 +197,13 @@ def fortran_source(model: Model) -> str:
         "  DOUBLE PRECISION, EXTERNAL :: GETP",
         "",
     ]
+    body.append(f"  PAR({layout.amplitude}) = 0d0  ! {AMPLITUDE}")
     for i, s in enumerate(model.states):
-        body.append(f"  PAR({layout.state_max[s.name]}) = GETP('MAX', {i + 1}, U)"
-                    f"  ! max_{s.name}")
-        body.append(f"  PAR({layout.state_min[s.name]}) = GETP('MIN', {i + 1}, U)"
-                    f"  ! min_{s.name}")
+        high, low = layout.state_max[s.name], layout.state_min[s.name]
+        body.append(f"  PAR({high}) = GETP('MAX', {i + 1}, U)  ! max_{s.name}")
+        body.append(f"  PAR({low}) = GETP('MIN', {i + 1}, U)  ! min_{s.name}")
+        body.append(f"  PAR({layout.amplitude}) = MAX(PAR({layout.amplitude}), "
+                    f"0.5d0*(PAR({high}) - PAR({low})))")
     body += [
         "END SUBROUTINE PVLS",
         "",

@@ -132,6 +132,11 @@ def critical_points(model: Model, overrides: dict[str, float], parameter: str,
             frequency = 0.0
             if kind == "hopf":
                 eigenvalues = np.linalg.eigvals(jacobians(model, at(value)))[0]
-                frequency = float(np.abs(eigenvalues[np.argmin(np.abs(eigenvalues.real))].imag))
+                critical = eigenvalues[np.argmin(np.abs(eigenvalues.real))]
+                frequency = float(abs(critical.imag))
+                # a real pair colliding into a complex pair off the axis is no Hopf point
+                if abs(critical.real) > 1e-6 * abs(critical) or frequency < 1e-6 * abs(
+                        eigenvalues).max():
+                    continue
             found.append(CriticalPoint(kind, name, float(value), frequency))
     return sorted(found, key=lambda c: c.value)

@@ -8,12 +8,13 @@ from __future__ import annotations
 
 import subprocess
 from collections.abc import Callable
+from dataclasses import replace
 from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
 
-from . import __version__, linear
+from . import __version__, linear, simulate
 from .auto import RunOutcome, auto_version
 from .recipes import Engine, Numerics, one_parameter
 from .results import ContinuationResult, StudyResult
@@ -54,7 +55,12 @@ def run_study(study: Study, workroot: Path, jobs: int = 1,
         assert engine is not None
         continuations.append(one_parameter(
             engine, spec.name, spec.parameter, spec.start, tuple(spec.range), parameters,
-            numerics, branch_points=spec.branch_points))
+            numerics, branch_points=spec.branch_points, periodic=spec.periodic,
+            orbits_at=spec.orbits_at))
+    if study.cross_check:
+        continuations = [replace(c, cross_checks=simulate.cross_check(model, parameters,
+                                                                      c.branches))
+                         for c in continuations]
     sweeps = []
     if study.linear is not None:
         for sweep in study.linear.sweeps:

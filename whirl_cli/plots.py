@@ -1,4 +1,5 @@
-"""Figures of study results: bifurcation diagrams and linear sweeps (matplotlib, Agg).
+"""Figures of study results (matplotlib, Agg): bifurcation diagrams, state projections, period
+plots, phase planes of stored orbits and linear sweeps.
 
 The only module that imports matplotlib, and only inside functions (the CLI starts without it).
 Figures are built with the object-oriented API on an Agg canvas, never through pyplot, so they
@@ -6,8 +7,8 @@ need no display, are not kept alive by pyplot's figure registry and are freed on
 
 Units: data arrive in SI (angles in rad, rates in rad/s, eigenvalues in 1/s). Bifurcation
 diagrams show angle states in degrees by default ("rad" -> "deg", "rad/s" -> "deg/s");
-parameters are always shown in their own (SI) units. Linear sweeps show frequency in rad/s and
-the damping ratio (dimensionless).
+parameters are always shown in their own (SI) units; periods in s. Linear sweeps show frequency
+in rad/s and the damping ratio (dimensionless).
 
 Plot key (thesis Table 2.1) is :data:`PLOT_KEY`: one entry per semantic style, with the
 matplotlib ``Line2D`` keyword arguments that draw it and its legend label.
@@ -75,7 +76,12 @@ MARKER_STYLE: dict[PointType, str] = {
 no marker."""
 
 _PLOTTED_KINDS = (BranchKind.EQUILIBRIUM, BranchKind.PERIODIC)
-PLOT_KINDS = ("bifurcation", "linear")
+PLOT_KINDS = ("bifurcation", "linear", "projections", "period", "phase")
+"""Kinds accepted by :func:`save_study_plots`."""
+_PERIOD_POINTS = (PointType.HB, PointType.LPC, PointType.PD, PointType.TR, PointType.BPC,
+                  PointType.HOMOCLINIC, PointType.HETEROCLINIC)
+_GLOBAL_POINTS = (PointType.HOMOCLINIC, PointType.HETEROCLINIC)
+_LOG_SPAN = 20.0  # period plots switch to a log y-axis above this max/min ratio
 
 
 def branch_style(kind: str, stable: bool) -> str:
@@ -149,6 +155,176 @@ def bifurcation_diagram(continuation: ContinuationResult, state: str = "theta",
         ax.legend(handles, [PLOT_KEY[key]["label"] for key in PLOT_KEY if key in first],
                   fontsize="small")
     ax.set_title(continuation.name)
+    return ax.figure
+
+
+def projections_figure(continuation: ContinuationResult, which: Sequence[str] = ("max",),
+                       degrees: bool = True) -> Figure:
+    """One bifurcation diagram per state on a grid of ceil(n/2) x 2 axes sharing the x-axis.
+
+    The states are those common to every plotted (equilibrium or periodic) branch, in the order
+    of the first; each panel is :func:`bifurcation_diagram` of one state (angles in deg, rates in
+    deg/s unless ``degrees`` is False; ``which`` as there). Only the first panel has a legend and
+    only the bottom panels an x label; the figure title is the continuation's name. Without
+    plotted branches the figure has one empty axes.
+    """
+    states = _common_states(continuation)
+    rows = max(1, -(-len(states) // 2))
+    figure = _new_figure(figsize=(10.0, 3.2 * rows + 0.6), layout="constrained")
+    if not states:
+        figure.add_subplot().set_title(continuation.name)
+        return figure
+    axes = figure.subplots(rows, 2, sharex=True, squeeze=False).ravel()
+    for k, (ax, state) in enumerate(zip(axes, states, strict=False)):
+        bifurcation_diagram(continuation, state=state, which=which, ax=ax, degrees=degrees)
+        ax.set_title("")
+        if k > 0 and ax.get_legend() is not None:
+            ax.get_legend().remove()
+        if k < len(states) - 2:  # another panel below in the same column
+            ax.set_xlabel("")
+    for ax in axes[len(states):]:
+        figure.delaxes(ax)
+    if len(states) % 2 and len(states) > 1:  # lone last panel: label its neighbour's x
+        axes[len(states) - 2].xaxis.set_tick_params(labelbottom=True)
+        axes[len(states) - 2].set_xlabel(axes[len(states) - 1].get_xlabel())
+    figure.suptitle(continuation.name)
+    return figure
+
+
+def _common_states(continuation: ContinuationResult) -> tuple[str, ...]:
+    """States on every plotted branch, in the order of the first (``()`` without branches)."""
+    branches = [b for b in continuation.branches if b.kind in _PLOTTED_KINDS]
+    if not branches:
+        return ()
+    return tuple(s for s in branches[0].state_names if all(s in b.state_names for b in branches))
+
+
+def period_plot(continuation: ContinuationResult) -> Figure:
+    """Period [s] of every periodic branch against its principal parameter (SI unit).
+
+    Lines follow :data:`PLOT_KEY` (stable solid blue, unstable dotted red) split as in
+    :func:`bifurcation_diagram`. Markers: LPC, PD, TR, BPC on periodic branches at their period
+    (the branch's period at the point's row if the point has none), Hopf points with a finite
+    period (where periodic branches are born), and HOMOCLINIC/HETEROCLINIC at (their parameter
+    estimate, the period at the last point of their branch). A "bracketed" global point also
+    gets its bracket drawn as a horizontal error bar at the top of the data. The y-axis is
+    logarithmic if the largest period exceeds 20 times the smallest. Without periodic branches
+    the axes stay empty.
+    """
+    ax = _new_figure().add_subplot()
+    periodic = [b for b in continuation.branches if b.is_periodic]
+    first: dict[str, object] = {}
+    for branch in periodic:
+        x = branch.parameters[:, 0]
+        for xs, ys, stable in stability_segments(x, branch.period, branch.stable):
+            _plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)
+    periods = np.concatenate([b.period for b in periodic]) if periodic else np.array([])
+    periods = periods[np.isfinite(periods) & (periods > 0)]
+    points, brackets = _period_points(continuation, periodic)
+    for style in PLOT_KEY:
+        if style in points:
+            xs, ys = np.array(points[style]).T
+            _plot_styled(ax, xs, ys, style, first)
+    handles = [first[key] for key in PLOT_KEY if key in first]
+    labels = [str(PLOT_KEY[key]["label"]) for key in PLOT_KEY if key in first]
+    if brackets and periods.size:
+        top = float(np.max(periods))
+        for low, high in brackets:
+            bar = ax.errorbar([(low + high) / 2], [top], xerr=[(high - low) / 2], fmt="none",
+                              ecolor=_BLACK, elinewidth=1.2, capsize=4, zorder=4,
+                              label="_bracket")
+        handles.append(bar)
+        labels.append("bracket (global bifurcation)")
+    if periods.size and periods.max() > _LOG_SPAN * periods.min():
+        ax.set_yscale("log")
+    if periodic:
+        ax.set_xlabel(axis_label(periodic[0].parameter_names[0], periodic[0].parameter_units[0]))
+    ax.set_ylabel(axis_label("period", "s"))
+    if handles:
+        ax.legend(handles, labels, fontsize="small")
+    ax.set_title(f"{continuation.name}: period")
+    return ax.figure
+
+
+def _period_points(continuation: ContinuationResult, periodic: list[Branch]
+                   ) -> tuple[dict[str, list[tuple[float, float]]], list[tuple[float, float]]]:
+    """Marker positions by style, and the finite brackets of "bracketed" global points."""
+    by_name = {b.name: b for b in continuation.branches}
+    periodic_names = {b.name for b in periodic}
+    x_name = periodic[0].parameter_names[0] if periodic else None
+    points: dict[str, list[tuple[float, float]]] = {}
+    brackets: list[tuple[float, float]] = []
+    for point in continuation.special_points:
+        kind = _point_type(point.point_type)
+        branch = by_name.get(point.branch)
+        if kind not in _PERIOD_POINTS or branch is None or point.parameter_names[0] != x_name:
+            continue
+        if kind != PointType.HB and point.branch not in periodic_names:
+            continue
+        if kind in _GLOBAL_POINTS:
+            finite = branch.period[np.isfinite(branch.period)]
+            period = float(finite[-1]) if finite.size else np.nan
+            bracket = np.asarray(point.bracket, dtype=float)
+            if point.status == "bracketed" and bracket.shape == (2,) and np.isfinite(
+                    bracket).all():
+                brackets.append((float(bracket.min()), float(bracket.max())))
+        else:
+            period = float(point.period)
+            if not np.isfinite(period) and 0 <= point.index < len(branch):
+                period = float(branch.period[point.index])
+        xy = (float(point.parameters[0]), period)
+        if np.all(np.isfinite(xy)):
+            points.setdefault(MARKER_STYLE[kind], []).append(xy)
+    return points, brackets
+
+
+def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str = "theta",
+                y: str = "psi", degrees: bool = True, ax: Axes | None = None) -> Figure:
+    """Stored orbits of a periodic branch as closed curves of state ``y`` against state ``x``.
+
+    All of ``branch.orbits`` if ``labels`` is None, else those with these AUTO labels (in the
+    order given). Each curve is closed (its first point repeated at the end unless already
+    equal), drawn solid if the branch is stable at the orbit's row and dotted if not, in the
+    default colour cycle, and labelled ``"<parameter> = <value> (stable|unstable)"`` with the
+    principal parameter (4 significant digits). Angles in degrees, rates in deg/s unless
+    ``degrees`` is False; equal aspect when both axes have the same unit. Draws on ``ax`` if
+    given, else on a new figure; returns the figure. The title is the branch's name.
+    """
+    if not branch.is_periodic:
+        raise WhirlError(f"branch {branch.name!r} is {branch.kind}, not periodic: no orbits")
+    for name in (x, y):
+        if name not in branch.state_names:
+            raise WhirlError(f"state {name!r} not on branch {branch.name!r} "
+                             f"(states: {', '.join(branch.state_names)})")
+    orbits = list(branch.orbits)
+    if labels is not None:
+        by_label = {orbit.label: orbit for orbit in orbits}
+        missing = [label for label in labels if label not in by_label]
+        if missing:
+            raise WhirlError(f"no stored orbit with label(s) {missing} on branch "
+                             f"{branch.name!r} (labels: {sorted(by_label)})")
+        orbits = [by_label[label] for label in labels]
+    ix, iy = branch.state_names.index(x), branch.state_names.index(y)
+    fx, unit_x = display_unit(branch.state_units[ix], degrees)
+    fy, unit_y = display_unit(branch.state_units[iy], degrees)
+    if ax is None:
+        ax = _new_figure().add_subplot()
+    for orbit, colour in zip(orbits, _colours(), strict=False):
+        states = np.asarray(orbit.states, dtype=float)
+        if len(states) and not np.array_equal(states[0], states[-1]):
+            states = np.vstack([states, states[:1]])
+        stable = bool(branch.stable[orbit.index]) if 0 <= orbit.index < len(branch) else None
+        status = {True: "stable", False: "unstable", None: "stability unknown"}[stable]
+        ax.plot(states[:, ix] * fx, states[:, iy] * fy, color=colour,
+                linestyle="-" if stable else ":",
+                label=f"{branch.parameter_names[0]} = {orbit.parameters[0]:.4g} ({status})")
+    ax.set_xlabel(axis_label(x, unit_x))
+    ax.set_ylabel(axis_label(y, unit_y))
+    if unit_x == unit_y:
+        ax.set_aspect("equal", adjustable="datalim")
+    if orbits:
+        ax.legend(fontsize="small")
+    ax.set_title(branch.name)
     return ax.figure
 
 
@@ -284,10 +460,20 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
                      state: str = "theta", dpi: int = 150) -> list[Path]:
     """Write a study's figures as PNG files into ``out_dir``; return the paths, sorted.
 
-    ``kinds``: "bifurcation" -> ``<stem>_<continuation>_bifurcation.png`` per one-parameter
-    continuation (``state`` vs the principal parameter, angles in degrees; the first state if
-    the branches have no ``state``); "linear" -> ``<stem>_linear_<parameter>.png`` per linear
-    sweep. Names are made filesystem-safe; repeats get ``_2``, ``_3``, ... Each file is written
+    ``kinds`` (any of :data:`PLOT_KINDS`):
+
+    * "bifurcation" -> ``<stem>_<continuation>_bifurcation.png`` per one-parameter continuation
+      (``state`` vs the principal parameter, angles in degrees; the first state if the branches
+      have no ``state``);
+    * "projections" -> ``<stem>_<continuation>_projections.png`` per one-parameter continuation
+      (:func:`projections_figure`);
+    * "period" -> ``<stem>_<continuation>_period.png`` per continuation with a periodic branch
+      (:func:`period_plot`);
+    * "phase" -> ``<stem>_<continuation>_<branch>_phase.png`` per periodic branch with stored
+      orbits (:func:`phase_plane`, psi vs theta, or the branch's first two states);
+    * "linear" -> ``<stem>_linear_<parameter>.png`` per linear sweep.
+
+    Names are made filesystem-safe; repeats get ``_2``, ``_3``, ... Each file is written
     under a temporary name in ``out_dir`` and moved into place, so none is ever half-written.
     """
     unknown = set(kinds) - set(PLOT_KINDS)
@@ -315,11 +501,35 @@ def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: 
                 chosen = _state_for(continuation, state)
                 jobs.append((f"{stem}_{continuation.name}_bifurcation.png",
                              lambda c=continuation, s=chosen: bifurcation_diagram(c, s)))
+    if "projections" in kinds:
+        for continuation in result.continuations:
+            if continuation.kind == "one-parameter":
+                jobs.append((f"{stem}_{continuation.name}_projections.png",
+                             lambda c=continuation: projections_figure(c)))
+    if "period" in kinds:
+        for continuation in result.continuations:
+            if any(b.is_periodic for b in continuation.branches):
+                jobs.append((f"{stem}_{continuation.name}_period.png",
+                             lambda c=continuation: period_plot(c)))
+    if "phase" in kinds:
+        for continuation in result.continuations:
+            for branch in continuation.branches:
+                if branch.is_periodic and branch.orbits and len(branch.state_names) >= 2:
+                    x, y = _phase_states(branch)
+                    jobs.append((f"{stem}_{continuation.name}_{branch.name}_phase.png",
+                                 lambda b=branch, x=x, y=y: phase_plane(b, x=x, y=y)))
     if "linear" in kinds:
         for sweep in result.linear_sweeps:
             jobs.append((f"{stem}_linear_{sweep.parameter}.png",
                          lambda s=sweep: linear_sweep_plot(s)))
     return jobs
+
+
+def _phase_states(branch: Branch) -> tuple[str, str]:
+    """("theta", "psi") if the branch has both, else its first two states."""
+    if {"theta", "psi"} <= set(branch.state_names):
+        return "theta", "psi"
+    return branch.state_names[0], branch.state_names[1]
 
 
 def _state_for(continuation: ContinuationResult, state: str) -> str:

@@ -115,6 +115,8 @@ class Branch:
         for periodic orbits (NaN where AUTO printed none).
     status, message : how the AUTO run ended (ok | mx | error | timeout | crashed).
     orbits : stored profiles of labelled solutions.
+    end : why the branch ends (range, amplitude bound, return to a Hopf point, period blow-up,
+        step limit, no convergence).
     """
 
     name: str
@@ -137,6 +139,7 @@ class Branch:
     message: str = "ok"
     run: str = ""
     orbits: tuple[Orbit, ...] = field(default=())
+    end: str = ""  # how the branch ends, e.g. "range", "returns to HB at K1 = 0.0807"
 
     def __len__(self) -> int:
         return len(self.point_type)
@@ -158,7 +161,8 @@ class SpecialPoint:
     """A bifurcation or notable end on a branch.
 
     ``status``: "located" (AUTO converged on it) or "bracketed" (estimated between points, e.g.
-    a period blow-up). ``criticality``: "supercritical" | "subcritical" | "" (Hopf points).
+    a period blow-up, with ``bracket`` the interval of the principal parameter and ``residual``
+    the relative fit residual). ``criticality``: "supercritical" | "subcritical" | "" (Hopf).
     """
 
     branch: str
@@ -173,6 +177,8 @@ class SpecialPoint:
     status: str = "located"
     criticality: str = ""
     note: str = ""
+    bracket: np.ndarray = field(default_factory=lambda: np.full(2, np.nan))  # bracketed only
+    residual: float = float("nan")  # relative rms fit residual (bracketed global points)
 
     @property
     def type_name(self) -> str:
@@ -211,6 +217,24 @@ class RunRecord:
 
 
 @dataclass(frozen=True)
+class CrossCheck:
+    """One time-simulation check of a point of a branch (``whirl_cli.simulate``).
+
+    ``kind``: "orbit" (expected/simulated: max over the orbit of the state the stiffness law
+    acts on, SI units) or "equilibrium" (expected: initial perturbation, simulated: final
+    deviation, rad).
+    """
+
+    branch: str
+    index: int
+    kind: str
+    parameter: float
+    expected: float
+    simulated: float
+    passed: bool
+
+
+@dataclass(frozen=True)
 class ContinuationResult:
     """Everything one continuation of a study produced."""
 
@@ -218,6 +242,7 @@ class ContinuationResult:
     kind: str  # "one-parameter" | "two-parameter"
     branches: tuple[Branch, ...]
     special_points: tuple[SpecialPoint, ...]
+    cross_checks: tuple[CrossCheck, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,10 @@ Layout (units in a ``units`` attribute on every physical dataset)::
                                                                 parameters
         special_points/             columns: branch, index, point_type, type_name, label,
                                     parameters (K, P), state (K, n), period, stable, status,
-                                    criticality, note
+                                    criticality, note, bracket (K, 2), residual
+        cross_checks/               (study `cross_check: true`) columns: branch, index, kind
+                                    (orbit | equilibrium), parameter, expected, simulated,
+                                    passed
     /linear/sweeps/<parameter>/     values, eigenvalues [1/s], damping_ratio, frequency [rad/s],
                                     whirl (FW | BW | --)
     /runs/<run>                     attrs: status, message, constants, returncode,
@@ -39,6 +42,7 @@ from .results import (
     Branch,
     BranchKind,
     ContinuationResult,
+    CrossCheck,
     LinearSweep,
     Orbit,
     RunRecord,
@@ -56,7 +60,7 @@ def _strings(values) -> np.ndarray:
 
 def _write_branch(group: h5py.Group, branch: Branch) -> None:
     group.attrs.update(kind=branch.kind, origin=branch.origin, status=branch.status,
-                       message=branch.message, run=branch.run)
+                       message=branch.message, run=branch.run, end=branch.end)
     params = group.create_dataset("parameters", data=branch.parameters.reshape(len(branch), -1))
     params.attrs.update(names=list(branch.parameter_names), units=list(branch.parameter_units))
     for key in ("state_max", "state_min"):
@@ -98,6 +102,27 @@ def _write_special_points(group: h5py.Group, points: tuple[SpecialPoint, ...],
     group.create_dataset("stable", data=np.array([p.stable for p in points], dtype=bool))
     for key in ("status", "criticality", "note"):
         group.create_dataset(key, data=_strings(getattr(p, key) for p in points), dtype=_STR)
+    group.create_dataset("bracket", data=np.array([p.bracket for p in points]).reshape(-1, 2))
+    group.create_dataset("residual", data=np.array([p.residual for p in points], dtype=float))
+
+
+def _write_cross_checks(group: h5py.Group, checks: tuple[CrossCheck, ...]) -> None:
+    group.create_dataset("branch", data=_strings(c.branch for c in checks), dtype=_STR)
+    group.create_dataset("index", data=np.array([c.index for c in checks], dtype=np.int64))
+    group.create_dataset("kind", data=_strings(c.kind for c in checks), dtype=_STR)
+    for key in ("parameter", "expected", "simulated"):
+        group.create_dataset(key, data=np.array([getattr(c, key) for c in checks], dtype=float))
+    group.create_dataset("passed", data=np.array([c.passed for c in checks], dtype=bool))
+
+
+def _read_cross_checks(group: h5py.Group) -> tuple[CrossCheck, ...]:
+    columns = {key: group[key][()] for key in group}
+    return tuple(
+        CrossCheck(_text(columns["branch"][k]), int(columns["index"][k]),
+                   _text(columns["kind"][k]), float(columns["parameter"][k]),
+                   float(columns["expected"][k]), float(columns["simulated"][k]),
+                   bool(columns["passed"][k]))
+        for k in range(len(columns["index"])))
 
 
 def _write_sweep(group: h5py.Group, sweep: LinearSweep) -> None:
@@ -133,6 +158,9 @@ def write(result: StudyResult, path: Path, overwrite: bool = False) -> Path:
                     _write_branch(group.create_group(f"branches/{branch.name}"), branch)
                 _write_special_points(group.create_group("special_points"),
                                       continuation.special_points, n_states)
+                if continuation.cross_checks:
+                    _write_cross_checks(group.create_group("cross_checks"),
+                                        continuation.cross_checks)
             for sweep in result.linear_sweeps:
                 _write_sweep(handle.create_group(f"linear/sweeps/{sweep.parameter}"), sweep)
             runs = handle.create_group("runs")
@@ -183,7 +211,7 @@ def _read_branch(name: str, group: h5py.Group) -> Branch:
         point_type=group["point_type"][()], label=group["label"][()],
         eigenvalues=group[key][()], status=_text(group.attrs["status"]),
         message=_text(group.attrs["message"]), run=_text(group.attrs["run"]),
-        orbits=tuple(orbits))
+        orbits=tuple(orbits), end=_text(group.attrs["end"]))
 
 
 def _read_special_points(group: h5py.Group) -> tuple[SpecialPoint, ...]:
@@ -196,7 +224,8 @@ def _read_special_points(group: h5py.Group) -> tuple[SpecialPoint, ...]:
             parameters=columns["parameters"][k], state=columns["state"][k],
             period=float(columns["period"][k]), stable=bool(columns["stable"][k]),
             label=int(columns["label"][k]), status=_text(columns["status"][k]),
-            criticality=_text(columns["criticality"][k]), note=_text(columns["note"][k]))
+            criticality=_text(columns["criticality"][k]), note=_text(columns["note"][k]),
+            bracket=columns["bracket"][k], residual=float(columns["residual"][k]))
         for k in range(len(columns["index"])))
 
 
@@ -210,9 +239,11 @@ def read(path: Path) -> StudyResult:
         continuations = []
         for name, group in handle.get("continuations", {}).items():
             branches = tuple(_read_branch(b, g) for b, g in group["branches"].items())
+            checks = _read_cross_checks(group["cross_checks"]) if "cross_checks" in group \
+                else ()
             continuations.append(ContinuationResult(
                 name, _text(group.attrs["kind"]), branches,
-                _read_special_points(group["special_points"])))
+                _read_special_points(group["special_points"]), checks))
         sweeps = []
         for parameter, group in handle.get("linear/sweeps", {}).items():
             sweeps.append(LinearSweep(

@@ -319,6 +319,11 @@ class OneParameterContinuation(_Strict):
     branch_points: Boolean = Field(
         True, description="Switch at branch points (pitchforks) to follow secondary equilibria."
     )
+    orbits_at: tuple[Number, ...] = Field(
+        (),
+        description="Parameter values (in its unit) at which every branch stores a labelled "
+        "solution: orbit profiles for phase-plane plots (AUTO UZR).",
+    )
 
     def start_value(self, study: Study) -> float:
         """``start``, or the study value of the parameter when unset (models built by hand)."""
@@ -407,8 +412,13 @@ class Study(_Strict):
     linear: LinearSpec | None = Field(
         None, description="Linear (eigenvalue) analysis without AUTO; unset: none."
     )
-    plots: tuple[Literal["bifurcation", "linear"], ...] = Field(
+    plots: tuple[Literal["bifurcation", "linear", "projections", "period", "phase"], ...] = Field(
         ("bifurcation",), description="Figures drawn after the runs."
+    )
+    cross_check: Boolean = Field(
+        False,
+        description="Check stable periodic orbits and equilibria by time simulation (scipy) and "
+        "store the outcome with the results.",
     )
     auto: AutoSettings = Field(
         default_factory=AutoSettings, description="AUTO-07p numerical settings."

@@ -134,3 +134,29 @@ def test_linear_variant_divergence_is_a_vertical_line(run_thesis):
         np.testing.assert_allclose(branch.parameter("K1"), 0.0359815, atol=1e-6)
         assert abs(branch.state("theta")).max() == pytest.approx(1.5, abs=1e-6)  # amplitude stop
     assert _points(run_thesis("linear_case2"), PointType.LP, "") == []
+
+
+@pytest.mark.parametrize("case", [f"{v}_case{c}" for v in VARIANTS[1:] for c in (2, 3, 5)])
+def test_every_hopf_crossing_along_every_branch_is_found(run_thesis, case):
+    """Along every equilibrium branch, the number of Hopf points AUTO reports equals the number
+    of sign changes of the oscillatory growth rate from numpy eigenvalues at the same points."""
+    model = get_model("classical")
+    result = run_thesis(case)
+    study_params = {"hardening": {"K2": 10.0}, "softening": {"K2": -10.0},
+                    "combined": {"K2": -10.0, "K3": 350.0}}[case.split("_")[0]]
+    k_psi = {"2": 0.3, "3": 0.2, "5": 0.037}[case[-1]]
+    params = model.parameter_vector({**study_params, "K_psi": k_psi})
+    for branch in result.continuations[0].branches:
+        if branch.kind != "equilibrium" or len(branch) < 3:
+            continue
+        p = np.repeat(params[:, None], len(branch), axis=1)
+        p[0] = branch.parameter("K1")
+        eigenvalues = np.linalg.eigvals(model.jacobian_numpy(branch.state_max.T, p))
+        oscillatory = np.abs(eigenvalues.imag) > 1e-6
+        growth = np.where(oscillatory, eigenvalues.real, -np.inf).max(axis=1)
+        # a sign change of a complex pair's real part, not a real pair turning complex
+        count = oscillatory.sum(axis=1)
+        same = (count[1:] == count[:-1]) & np.isfinite(growth[1:]) & np.isfinite(growth[:-1])
+        crossings = int(np.sum(same & (np.sign(growth[1:]) * np.sign(growth[:-1]) < 0)))
+        hopfs = int(np.sum(branch.point_type == PointType.HB))
+        assert hopfs == crossings, (case, branch.name)

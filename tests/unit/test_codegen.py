@@ -32,7 +32,8 @@ def test_fortran_is_deterministic_and_complete(model):
 
 def test_par_layout_avoids_auto_reserved_slots(model):
     layout = codegen.par_layout(model)
-    used = [*layout.parameters.values(), *layout.state_max.values(), *layout.state_min.values()]
+    used = [*layout.parameters.values(), *layout.state_max.values(), *layout.state_min.values(),
+            layout.amplitude]
     assert len(set(used)) == len(used)
     assert not set(used) & set(range(10, 37))  # PAR(11) period, HomCont 10..36
     assert layout.parameters["K1"] == 1 and layout.npar == max(used)

@@ -52,9 +52,13 @@ def test_backward_whirl_has_theta_in_phase_with_psi_dot(model):
 @pytest.mark.parametrize(("k_psi", "expected"), [
     (0.3, [("branch_point", 0.03598), ("hopf", 0.0807), ("hopf", 0.2888)]),
     (0.4, [("branch_point", 0.0390)]),
+    # a real pair turning into an unstable complex pair (K1 ~ 0.030) is not a Hopf point
+    (0.2, [("branch_point", 0.02908), ("hopf", 0.3233)]),
+    (0.037, [("hopf", 0.2852), ("branch_point", 0.3270)]),
 ])
 def test_stiffness_sweep_critical_points(model, k_psi, expected):
-    """models.md 4: K_psi = 0.3 -> BP 0.03598, HB 0.0807, HB 0.2888; K_psi = 0.4 -> 0.0390."""
+    """models.md 4: K_psi = 0.3 -> BP 0.03598, HB 0.0807, HB 0.2888; K_psi = 0.4 -> 0.0390;
+    cases 3 and 5 as AUTO finds them."""
     found = linear.critical_points(model, {"K_psi": k_psi}, "K_theta", -0.3, 0.5)
     assert [c.kind for c in found] == [kind for kind, _ in expected]
     for point, (_, value) in zip(found, expected, strict=True):

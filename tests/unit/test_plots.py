@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from matplotlib.colors import same_color, to_hex
+from matplotlib.container import ErrorbarContainer
 
 from whirl_cli import plots
 from whirl_cli.errors import WhirlError
@@ -13,6 +16,7 @@ from whirl_cli.results import (
     BranchKind,
     ContinuationResult,
     LinearSweep,
+    Orbit,
     PointType,
     SpecialPoint,
     StudyResult,
@@ -297,5 +301,220 @@ def test_save_study_plots_selected_kind_and_overwrite(tmp_path, continuation):
 def test_save_study_plots_rejects_unknown_kind(tmp_path, continuation):
     result = StudyResult("study", "classical", (continuation,), (), ())
     with pytest.raises(WhirlError):
-        plots.save_study_plots(result, ("phase",), tmp_path, "run")
+        plots.save_study_plots(result, ("boundary",), tmp_path, "run")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_plot_kinds():
+    assert plots.PLOT_KINDS == ("bifurcation", "linear", "projections", "period", "phase")
+
+
+# -- projections_figure --------------------------------------------------------------------------
+
+def test_projections_one_axes_per_state(continuation):
+    figure = plots.projections_figure(continuation)
+    axes = figure.axes
+    assert len(axes) == 4
+    assert [ax.get_ylabel() for ax in axes] == ["theta (max) [deg]", "psi (max) [deg]",
+                                                "dtheta (max) [deg/s]", "dpsi (max) [deg/s]"]
+    # theta max reaches 0.4 rad, the other states 0.1 * theta (rad or rad/s)
+    for ax, top in zip(axes, [0.4, 0.04, 0.04, 0.04], strict=True):
+        ys = np.concatenate([line.get_ydata() for line in branch_lines(ax)])
+        assert np.max(ys) == pytest.approx(np.degrees(top))
+        assert len(branch_lines(ax)) == 4 and len(marker_lines(ax)) == 3
+    assert all(axes[0].get_shared_x_axes().joined(axes[0], ax) for ax in axes)
+    assert [ax.get_legend() is not None for ax in axes] == [True, False, False, False]
+    assert [ax.get_xlabel() for ax in axes] == ["", "", "K1 [N m/rad]", "K1 [N m/rad]"]
+    assert figure.get_suptitle() == "hopf_K1"
+
+
+def test_projections_odd_state_count_in_radians(continuation):
+    def three(branch):
+        return replace(branch, state_names=STATES[:3], state_units=UNITS[:3],
+                       state_max=branch.state_max[:, :3], state_min=branch.state_min[:, :3],
+                       eigenvalues=branch.eigenvalues[:, :3])
+
+    cut = replace(continuation, branches=tuple(three(b) for b in continuation.branches),
+                  special_points=tuple(replace(p, state=p.state[:3])
+                                       for p in continuation.special_points))
+    axes = plots.projections_figure(cut, which=("max", "min"), degrees=False).axes
+    assert [ax.get_ylabel() for ax in axes] == ["theta (max, min) [rad]", "psi (max, min) [rad]",
+                                                "dtheta (max, min) [rad/s]"]
+    assert [ax.get_xlabel() for ax in axes] == ["", "K1 [N m/rad]", "K1 [N m/rad]"]
+    ys = np.concatenate([line.get_ydata() for line in branch_lines(axes[0])])
+    assert np.min(ys) == pytest.approx(-0.4) and np.max(ys) == pytest.approx(0.4)
+
+
+def test_projections_without_branches():
+    figure = plots.projections_figure(ContinuationResult("empty", "one-parameter", (), ()))
+    assert len(figure.axes) == 1 and not figure.axes[0].lines
+
+
+# -- period_plot ---------------------------------------------------------------------------------
+
+def with_period(branch: Branch, period) -> Branch:
+    return replace(branch, period=np.asarray(period, dtype=float))
+
+
+def period_continuation(period, points=()) -> ContinuationResult:
+    equilibrium = make_branch("main_down", BranchKind.EQUILIBRIUM,
+                              [0.5, 0.4, 0.3, 0.2, 0.1], [0.0] * 5, [1, 1, 0, 0, 0])
+    periodic = make_branch("periodic_1", BranchKind.PERIODIC, [0.3, 0.35, 0.4, 0.35, 0.3],
+                           [0.0, 0.1, 0.2, 0.3, 0.4], [0, 0, 0, 1, 1])
+    return ContinuationResult("hopf_K1", "one-parameter",
+                              (equilibrium, with_period(periodic, period)), tuple(points))
+
+
+def test_period_plot_segments_styles_and_markers():
+    hopf = replace(make_point("main_down", PointType.HB, 0.3, 0.0), index=2, period=0.2)
+    fold = replace(make_point("periodic_1", PointType.LPC, 0.4, 0.2), index=2)  # period NaN
+    end = make_point("periodic_1", PointType.EP, 0.3, 0.4)
+    bp_on_equilibrium = make_point("main_down", PointType.BP, 0.2, 0.0)
+    result = period_continuation([0.2, 0.25, 0.3, 0.35, 0.4],
+                                 [hopf, fold, end, bp_on_equilibrium])
+    ax = plots.period_plot(result).axes[0]
+    lines = branch_lines(ax)
+    assert sorted(line_style(line) for line in lines) == [("blue", "-"), ("red", ":")]
+    by_style = {line_style(line): line for line in lines}
+    np.testing.assert_allclose(by_style["red", ":"].get_xdata(), [0.3, 0.35, 0.4, 0.35])
+    np.testing.assert_allclose(by_style["red", ":"].get_ydata(), [0.2, 0.25, 0.3, 0.35])
+    np.testing.assert_allclose(by_style["blue", "-"].get_xdata(), [0.35, 0.3])
+    np.testing.assert_allclose(by_style["blue", "-"].get_ydata(), [0.35, 0.4])
+    markers = {line.get_marker(): line for line in marker_lines(ax)}
+    assert set(markers) == {"s", "o"}  # Hopf and LPC; no EP, no BP of the equilibrium
+    np.testing.assert_allclose(np.c_[markers["s"].get_xdata(), markers["s"].get_ydata()],
+                               [[0.3, 0.2]])
+    np.testing.assert_allclose(np.c_[markers["o"].get_xdata(), markers["o"].get_ydata()],
+                               [[0.4, 0.3]])  # the branch's period at the LPC's row
+    assert ax.get_yscale() == "linear"
+    assert ax.get_xlabel() == "K1 [N m/rad]" and ax.get_ylabel() == "period [s]"
+    assert not ax.containers
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == [
+        "stable periodic", "unstable periodic", "Hopf (HB)", "fold (LP, LPC)"]
+
+
+@pytest.mark.parametrize(("last", "scale"), [(3.9, "linear"), (4.0, "linear"), (4.2, "log")])
+def test_period_plot_log_scale_only_above_factor_20(last, scale):
+    ax = plots.period_plot(period_continuation([0.2, 0.5, 1.0, 2.0, last])).axes[0]
+    assert ax.get_yscale() == scale
+
+
+def test_period_plot_brackets_bracketed_homoclinic():
+    homoclinic = SpecialPoint(
+        branch="periodic_1", index=4, point_type=int(PointType.HOMOCLINIC),
+        parameter_names=("K1", "V"), parameters=np.array([0.29]),
+        state=np.zeros(4), period=9.0, stable=False, status="bracketed",
+        bracket=np.array([0.3, 0.28]), residual=0.01)
+    heteroclinic = replace(homoclinic, point_type=int(PointType.HETEROCLINIC),
+                           parameters=np.array([0.295]), status="located",
+                           bracket=np.full(2, np.nan))
+    result = period_continuation([0.2, 0.5, 1.0, 12.0, 8.0], [homoclinic, heteroclinic])
+    ax = plots.period_plot(result).axes[0]
+    found = {(line.get_marker(), line.get_markerfacecolor() == "none"): line
+             for line in marker_lines(ax) if line.get_marker() == "^"}
+    # both at the period of the branch's last point, x = their parameter estimate
+    np.testing.assert_allclose(np.c_[found["^", False].get_xdata(),
+                                     found["^", False].get_ydata()], [[0.29, 8.0]])
+    np.testing.assert_allclose(np.c_[found["^", True].get_xdata(),
+                                     found["^", True].get_ydata()], [[0.295, 8.0]])
+    (container,) = ax.containers  # only the bracketed point gets a bracket
+    assert isinstance(container, ErrorbarContainer)
+    (bar,) = container.lines[2]
+    np.testing.assert_allclose(bar.get_segments()[0], [[0.28, 12.0], [0.3, 12.0]])
+    assert ax.get_yscale() == "log"  # 12 / 0.2 > 20
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert labels[-3:] == ["homoclinic", "heteroclinic", "bracket (global bifurcation)"]
+
+
+def test_period_plot_without_periodic_branch():
+    equilibrium = make_branch("main", BranchKind.EQUILIBRIUM, [0.1, 0.2], [0.0, 0.0], [1, 1])
+    points = (make_point("main", PointType.HB, 0.1, 0.0),)  # no period: no marker
+    ax = plots.period_plot(ContinuationResult("eq", "one-parameter", (equilibrium,),
+                                              points)).axes[0]
+    assert not ax.lines and ax.get_legend() is None
+
+
+# -- phase_plane ---------------------------------------------------------------------------------
+
+def make_orbit(label: int, index: int, k1: float, radius: float, closed: bool) -> Orbit:
+    """A circle of ``radius`` rad in (theta, psi), 20 samples, endpoint repeated if ``closed``."""
+    period = 0.2
+    time = np.linspace(0.0, period, 21 if closed else 20, endpoint=closed)
+    phase = 2 * np.pi * time / period
+    theta, psi = radius * np.cos(phase), radius * np.sin(phase)
+    states = np.column_stack([theta, psi, -theta * 31.4, psi * 31.4])
+    if closed:
+        states[-1] = states[0]
+    return Orbit(label=label, point_type=0, index=index, parameters=np.array([k1, 6.7]),
+                 period=period, time=time, states=states)
+
+
+@pytest.fixture
+def orbit_branch() -> Branch:
+    branch = make_branch("periodic_1", BranchKind.PERIODIC, [0.3, 0.35, 0.4, 0.35, 0.3],
+                         [0.0, 0.1, 0.2, 0.3, 0.4], [0, 0, 0, 1, 1])
+    orbits = (make_orbit(3, 1, 0.35, 0.1, closed=False),
+              make_orbit(5, 4, 0.1234, 0.4, closed=True))
+    return replace(branch, orbits=orbits)
+
+
+def test_phase_plane_closed_curves_in_degrees(orbit_branch):
+    ax = plots.phase_plane(orbit_branch).axes[0]
+    assert len(ax.lines) == 2
+    for line, orbit in zip(ax.lines, orbit_branch.orbits, strict=True):
+        xs, ys = line.get_xdata(), line.get_ydata()
+        assert (xs[0], ys[0]) == (xs[-1], ys[-1])
+        np.testing.assert_allclose(xs[:20], np.degrees(orbit.states[:20, 0]))
+        np.testing.assert_allclose(ys[:20], np.degrees(orbit.states[:20, 1]))
+    assert [len(line.get_xdata()) for line in ax.lines] == [21, 21]  # one closed, one as is
+    assert [line.get_linestyle() for line in ax.lines] == [":", "-"]
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == [
+        "K1 = 0.35 (unstable)", "K1 = 0.1234 (stable)"]
+    assert ax.get_xlabel() == "theta [deg]" and ax.get_ylabel() == "psi [deg]"
+    assert ax.get_aspect() == 1.0
+    assert ax.get_title() == "periodic_1"
+
+
+def test_phase_plane_selected_labels_states_and_radians(orbit_branch):
+    ax = plots.phase_plane(orbit_branch, labels=[5], x="theta", y="dtheta",
+                           degrees=False).axes[0]
+    (line,) = ax.lines
+    assert np.max(line.get_ydata()) == pytest.approx(0.4 * 31.4)
+    assert ax.get_ylabel() == "dtheta [rad/s]"
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["K1 = 0.1234 (stable)"]
+
+
+def test_phase_plane_draws_on_given_axes(orbit_branch):
+    figure = plots._new_figure()
+    ax = figure.add_subplot()
+    assert plots.phase_plane(orbit_branch, ax=ax) is figure and len(ax.lines) == 2
+
+
+@pytest.mark.parametrize("kwargs", [{"labels": [4]}, {"x": "phi"}, {"y": "chi"}])
+def test_phase_plane_bad_arguments_raise(orbit_branch, kwargs):
+    with pytest.raises(WhirlError):
+        plots.phase_plane(orbit_branch, **kwargs)
+
+
+def test_phase_plane_rejects_equilibrium_branch():
+    equilibrium = make_branch("main", BranchKind.EQUILIBRIUM, [0.1, 0.2], [0.0, 0.0], [1, 1])
+    with pytest.raises(WhirlError):
+        plots.phase_plane(equilibrium)
+
+
+# -- save_study_plots: new kinds -----------------------------------------------------------------
+
+def test_save_study_plots_new_kinds(tmp_path, continuation, orbit_branch):
+    without_orbits = replace(orbit_branch, name="periodic_2", orbits=())
+    rich = replace(continuation, name="hopf K1",  # space made file-safe
+                   branches=(continuation.branches[0], orbit_branch, without_orbits))
+    equilibria = ContinuationResult("eq", "one-parameter", (continuation.branches[0],), ())
+    locus = ContinuationResult("hopf_locus", "two-parameter", (), ())
+    result = StudyResult("study", "classical", (rich, equilibria, locus), (make_sweep(),), ())
+    paths = plots.save_study_plots(result, ("projections", "period", "phase"), tmp_path, "run")
+    assert [p.name for p in paths] == sorted([
+        "run_hopf_K1_projections.png", "run_eq_projections.png", "run_hopf_K1_period.png",
+        "run_hopf_K1_periodic_1_phase.png"])
+    assert sorted(tmp_path.iterdir()) == paths  # no temporary files left behind
+    for path in paths:
+        assert path.read_bytes()[:8] == PNG_MAGIC

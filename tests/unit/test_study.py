@@ -244,7 +244,8 @@ def test_model_validate_fills_the_same_defaults():
         ),
         (
             "plots: [bifurcation, boundary]\n",
-            "s.yaml:3: plots[1]: expected one of bifurcation, linear, got 'boundary'",
+            "s.yaml:3: plots[1]: expected one of bifurcation, linear, projections, period, phase, "
+            "got 'boundary'",
         ),
         (
             "nonlinearity: {type: linear, dof: phi}\n",
@@ -262,7 +263,7 @@ def test_model_validate_fills_the_same_defaults():
         (
             "grid: {x: 1}\n",
             "s.yaml:3: grid: unknown key (allowed: name, description, model, parameters, "
-            "nonlinearity, continuations, linear, plots, auto)",
+            "nonlinearity, continuations, linear, plots, cross_check, auto)",
         ),
         ("linear: {grid: 1}\n", "s.yaml:3: linear.grid: unknown key (allowed: sweeps)"),
         (
@@ -374,7 +375,7 @@ RUN = "continuations:\n  - name: k1\n    type: one-parameter\n    parameter: K1\
         (
             "    range: [0, 1]\n    loci: [hopf]\n",
             "s.yaml:8: continuations[0].loci: unknown key (allowed: name, type, parameter, "
-            "start, range, periodic, branch_points)",
+            "start, range, periodic, branch_points, orbits_at)",
         ),
         ("", "s.yaml:4: continuations[0].range: required key is missing"),
     ],
@@ -623,7 +624,7 @@ def test_schema_reference_lists_every_key_with_a_description():
     assert lines[0] == "| Key | Type | Default | Description |"
     rows = {line.split("|")[1].strip().strip("`"): line for line in lines[2:]}
     expected = {"name", "description", "model", "parameters", "nonlinearity", "continuations",
-                "linear", "plots", "auto", "nonlinearity.type", "nonlinearity.dof",
+                "linear", "plots", "cross_check", "auto", "nonlinearity.type", "nonlinearity.dof",
                 "nonlinearity.K2", "nonlinearity.K3", "linear.sweeps",
                 "linear.sweeps[].parameter", "linear.sweeps[].range", "linear.sweeps[].points"}
     expected |= {f"continuations[].{k}" for k in OneParameterContinuation.model_fields}

@@ -185,6 +185,18 @@ class Model:
             (self.state_symbols, self.parameter_symbols), list(jac), modules="numpy", cse=True
         )
 
+    def field_at(self, params: np.ndarray):
+        """(f, J): dy/dt (SI) and its Jacobian as fast functions of the state alone, for fixed
+        parameter values (substituted symbolically once; for time integration)."""
+        values = {sym: sp.Float(float(v)) for sym, v in zip(self.parameter_symbols, params,
+                                                            strict=True)}
+        rhs = self.rhs.xreplace(values)
+        function = sp.lambdify((self.state_symbols,), list(rhs), modules="numpy", cse=True)
+        jacobian = sp.lambdify((self.state_symbols,), rhs.jacobian(self.state_symbols),
+                               modules="numpy", cse=True)
+        return (lambda y: np.array(function(y), dtype=float),
+                lambda y: np.array(jacobian(y), dtype=float))
+
     def rhs_numpy(self, y: np.ndarray, params: np.ndarray) -> np.ndarray:
         """dy/dt in SI units. ``y``: (n,) or (n, M); ``params``: (P,) or (P, M)."""
         values = self._numpy_rhs(tuple(y), tuple(params))

@@ -1,0 +1,188 @@
+"""Periodic branches from every Hopf point (real AUTO-07p), checked independently: closed forms
+of the equilibria they hang off, eigenvalue-based Hopf criticality, and time simulation."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from whirl_cli import simulate
+from whirl_cli.models import get_model
+from whirl_cli.pipeline import run_study
+from whirl_cli.results import BranchKind, PointType
+from whirl_cli.study import validate_text
+
+from ..conftest import STUDIES
+
+NONLINEAR = [f"{v}_case{c}" for v in ("hardening", "softening", "combined") for c in range(1, 6)]
+
+
+def _periodic(result):
+    return [b for b in result.continuations[0].branches if b.kind == BranchKind.PERIODIC]
+
+
+def _points(result, kind):
+    return [p for p in result.continuations[0].special_points if p.point_type == kind]
+
+
+def _hopf(result, value, branch="main_down"):
+    (point,) = [p for p in _points(result, PointType.HB)
+                if p.branch == branch and abs(p.parameters[0] - value) < 2e-3]
+    return point
+
+
+def test_hardening_case2_flutter_branch_joins_the_two_hopf_points(run_thesis):
+    result = run_thesis("hardening_case2")
+    main = [b for b in _periodic(result) if b.origin.endswith("on main_down")]
+    assert len(main) == 1  # reached from both Hopf points, stored once
+    (flutter,) = main
+    assert flutter.parameter("K1")[0] == pytest.approx(0.2888, abs=1e-3)
+    assert flutter.end.startswith("returns to HB at K1 = 0.08068")
+    assert flutter.parameter("K1")[-1] == pytest.approx(0.0807, abs=1e-3)
+    # a fold of cycles left of the left Hopf point, and an unstable part there
+    folds = [p for p in _points(result, PointType.LPC) if p.branch == flutter.name]
+    assert any(p.parameters[0] < 0.0807 - 0.01 for p in folds)
+    k1, stable = flutter.parameter("K1"), flutter.stable
+    assert not stable[k1 < 0.075].all()
+    # the rest (well right of the left Hopf) is stable
+    assert stable[(k1 > 0.09) & (np.arange(len(k1)) > 0)].all()
+    assert _hopf(result, 0.2888).criticality == "supercritical"
+    assert _hopf(result, 0.0807).criticality == "subcritical"
+
+
+def test_hardening_case2_secondary_flutter(run_thesis):
+    """Each stable secondary equilibrium branch has its own Hopf pair and secondary-flutter
+    branch joining them."""
+    result = run_thesis("hardening_case2")
+    for side in ("secondary_1a", "secondary_1b"):
+        hopfs = sorted(p.parameters[0] for p in _points(result, PointType.HB)
+                       if p.branch == side)
+        assert len(hopfs) == 2
+        (family,) = [b for b in _periodic(result) if b.origin.endswith(f"on {side}")]
+        assert family.end.startswith("returns to HB") and family.end.endswith(side)
+        ends = sorted([family.parameter("K1")[0], family.parameter("K1")[-1]])
+        np.testing.assert_allclose(ends, hopfs, atol=2e-3)
+        assert family.stable[1:-1].mean() > 0.9
+
+
+@pytest.mark.parametrize("case", ["hardening_case2", "softening_case2", "combined_case2"])
+def test_all_flutter_is_backward_whirl(run_thesis, case):
+    orbits = [(b, o) for b in _periodic(run_thesis(case)) for o in b.orbits
+              if np.ptp(o.states[:, 0]) > 1e-3]
+    assert len(orbits) >= 5
+    model = get_model("classical")
+    assert {simulate.whirl_sense(model, o.states) for _, o in orbits} == {"BW"}
+
+
+@pytest.fixture(scope="module")
+def softening_at_04(tmp_path_factory):
+    """Softening case 2 with the orbits at K1 = 0.4 stored."""
+    text = (STUDIES / "softening_case2.yaml").read_text().replace(
+        "    branch_points: true", "    branch_points: true\n    orbits_at: [0.4]")
+    study = validate_text(text, "softening_case2.yaml")
+    return study, run_study(study, tmp_path_factory.mktemp("soft"), jobs=2)
+
+
+def test_softening_case2_overhang(softening_at_04):
+    """The flutter branch leaves the right Hopf unstable and turns stable at a fold of cycles
+    to the right of that Hopf point (thesis reads ~0.42 off its figure)."""
+    _, result = softening_at_04
+    (flutter,) = [b for b in _periodic(result) if b.origin.endswith("main_down")
+                  and "0.288" in b.origin]
+    assert not flutter.stable[1:6].any()
+    (fold,) = [p for p in _points(result, PointType.LPC) if p.branch == flutter.name]
+    assert 0.2888 < fold.parameters[0] < 0.5
+    row = fold.index
+    assert not flutter.stable[row - 2] and flutter.stable[row + 2]
+    assert _hopf(result, 0.2888).criticality == "subcritical"
+
+
+def test_softening_case2_coexisting_limit_cycle_by_simulation(softening_at_04, capsys):
+    """At K1 = 0.4 the origin is stable and a stable LCO coexists. A 2 degree pitch
+    perturbation decays; a start on AUTO's stable orbit stays on it; a start just outside
+    AUTO's unstable orbit (the separatrix) ends on the stable one, just inside it decays."""
+    study, result = softening_at_04
+    model = get_model("classical")
+    params = model.parameter_vector({**study.parameter_values(), "K1": 0.4})
+    (flutter,) = [b for b in _periodic(result) if "0.288" in b.origin]
+    at = [o for o in flutter.orbits if abs(o.parameters[0] - 0.4) < 1e-6]
+    stable = [o for o in at if flutter.stable[o.index]]
+    unstable = [o for o in at if not flutter.stable[o.index]]
+    assert len(stable) == 1 and len(unstable) == 1
+    (outer,), (inner,) = stable, unstable
+    big, small = (np.degrees(flutter.state_max[o.index, 0]) for o in (outer, inner))
+    assert big > small > 2.0
+
+    _, decay = simulate.integrate(model, params, np.radians([2.0, 0, 0, 0]), 20.0, 400)
+    assert np.abs(decay[-1, :2]).max() < np.radians(0.02)
+    assert simulate.check_orbit(model, study.parameter_values(), flutter, outer).passed
+
+    start = inner.states[np.argmax(inner.states[:, 0])]
+    _, out = simulate.integrate(model, params, 1.05 * start, 60.0, 6000)
+    assert np.degrees(out[-600:, 0].max()) == pytest.approx(big, rel=0.01)
+    _, inside = simulate.integrate(model, params, 0.95 * start, 60.0, 600)
+    assert np.abs(inside[-1, :2]).max() < np.radians(0.05)
+    with capsys.disabled():
+        print(f"\nsoftening case 2 at K1 = 0.4: stable LCO max pitch {big:.2f} deg, unstable "
+              f"LCO (separatrix) {small:.2f} deg; thesis: 2 deg decays, 3 deg reaches the LCO")
+
+
+@pytest.mark.parametrize("case", NONLINEAR)
+def test_cross_checks_pass_on_every_stable_periodic_branch(run_thesis, case):
+    """The time-simulation cross-check of every stable periodic branch of the 15 chapter-3
+    cases (the studies ask for it with cross_check: true)."""
+    result = run_thesis(case)
+    (continuation,) = result.continuations
+    checks = continuation.cross_checks
+    assert all(c.passed for c in checks), [c for c in checks if not c.passed]
+    for branch in _periodic(result):
+        checkable = [o for o in branch.orbits if 0 < o.index < len(branch) - 1
+                     and branch.stable[o.index - 1: o.index + 2].all()
+                     and o.period < 3 * branch.period[0]]  # outside any period blow-up
+        if checkable:
+            assert any(c.branch == branch.name and c.kind == "orbit" for c in checks), branch.name
+    assert all(b.status == "ok" for b in continuation.branches), [
+        (b.name, b.message) for b in continuation.branches if b.status != "ok"]
+
+
+def test_cross_check_fails_for_a_wrong_orbit(run_thesis):
+    from dataclasses import replace
+
+    result = run_thesis("hardening_case2")
+    model = get_model("classical")
+    parameters = {"K_psi": 0.3, "K2": 10.0, "K3": 0.0}
+    (flutter,) = [b for b in _periodic(result) if "0.288" in b.origin]
+    orbit = next(o for o in flutter.orbits if 0 < o.index and flutter.stable[o.index])
+    assert simulate.check_orbit(model, parameters, flutter, orbit).passed
+    wrong = replace(orbit, states=orbit.states * 1.3)
+    assert not simulate.check_orbit(model, parameters, flutter, wrong).passed
+
+
+def test_period_blow_up_is_bracketed(run_thesis):
+    """Hardening case 3 ends in a homoclinic approach and combined case 3 in a heteroclinic
+    one (thesis figures 3.24, 3.26): a bracketed global special point on the main family."""
+    for case, kind in (("hardening_case3", PointType.HOMOCLINIC),
+                       ("combined_case3", PointType.HETEROCLINIC)):
+        result = run_thesis(case)
+        (main,) = [b for b in _periodic(result) if b.origin.endswith("main_down")]
+        assert main.end.startswith("period blow-up")
+        found = [p for p in result.continuations[0].special_points
+                 if p.branch == main.name and p.point_type in (PointType.HOMOCLINIC,
+                                                               PointType.HETEROCLINIC)]
+        assert [p.point_type for p in found] == [kind]
+        (point,) = found
+        assert point.status == "bracketed"
+        assert point.bracket[0] <= point.parameters[0] <= point.bracket[1]
+        assert main.period.max() > 3 * main.period[0]
+        assert "saddle" in point.note
+
+
+def test_airspeed_continuation_overhang(run_thesis):
+    """Combined variant at datum in airspeed (thesis fig. 3.30): the flutter branch from the
+    linear onset bends back to lower airspeed (a fold of cycles below 7.76 m/s)."""
+    result = run_thesis("combined_airspeed")
+    hopf = _hopf(result, 7.764, branch="main_up")
+    assert hopf.criticality == "subcritical"
+    (fold,) = _points(result, PointType.LPC)
+    assert 6.7 < fold.parameters[0] < 7.764
+    assert all(c.passed for c in result.continuations[0].cross_checks)

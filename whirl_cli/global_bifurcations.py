@@ -1,0 +1,185 @@
+"""Period blow-up at the end of a periodic family: homoclinic or heteroclinic approach.
+
+When the period of a family grows without bound while the parameter converges to p*, the orbit
+spends longer and longer near one or more saddle equilibria. From the family's last points and
+its last stored orbit profile this module
+
+* names the equilibria the orbit lingers near: one saddle -> homoclinic, a +/- pair of saddles
+  (symmetric model) -> heteroclinic;
+* estimates p* with the saddle scaling law T = C - ln|p - p*| / lambda_u (lambda_u: the saddle's
+  unstable eigenvalue, 1/s) and with the simpler fit T = A / |p* - p| + B, each by a scan of p*
+  (the other coefficients are linear) over the last points with T > 2 T_Hopf;
+* returns a special point of type HOMOCLINIC or HETEROCLINIC with status "bracketed": the
+  estimate, the bracket [last computed value, estimate] and the relative rms fit residual.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .models import Model
+from .results import Branch, BranchKind, PointType, SpecialPoint
+
+#: A family is in blow-up when its period exceeds this multiple of the Hopf period.
+BLOWUP_FACTOR = 3.0
+#: An orbit lingers near an equilibrium it passes within this fraction of its own size.
+LINGER_FRACTION = 0.05
+
+
+@dataclass(frozen=True)
+class BlowupFit:
+    """Estimates of the parameter p* where the period becomes infinite."""
+
+    log_estimate: float  # from T = C - ln|p - p*| / lambda_u
+    hyperbolic_estimate: float  # from T = A / |p* - p| + B
+    residual: float  # relative rms residual of the log fit (NaN for a snaking approach)
+    n_points: int
+    bracket: tuple[float, float]  # interval holding p*
+
+
+def in_blowup(family: Branch, hopf_period: float) -> bool:
+    """True if the family's period has grown beyond BLOWUP_FACTOR times the Hopf period."""
+    periods = family.period[np.isfinite(family.period)]
+    return bool(len(periods)) and periods.max() > BLOWUP_FACTOR * hopf_period
+
+
+def _tail(period: np.ndarray, hopf_period: float) -> slice:
+    """The last stretch of at most 15 points with the period above twice the Hopf period."""
+    above = np.isfinite(period) & (period > 2 * hopf_period)
+    if not above.any():
+        return slice(0, 0)
+    end = int(np.flatnonzero(above)[-1]) + 1
+    start = end
+    while start > 0 and above[start - 1]:
+        start -= 1
+    return slice(max(start, end - 15), end)
+
+
+def _best_distance(p: np.ndarray, t: np.ndarray, basis, side: float, reach: float
+                   ) -> tuple[float, float]:
+    """(p*, relative rms residual) for T = a * basis(|p* - p|) + b, scanning p* beyond the
+    points on ``side``; a and b are solved linearly for every candidate."""
+    edge = p.max() if side > 0 else p.min()
+    best = (float("nan"), float("inf"))
+    for distance in np.geomspace(1e-14, reach, 600):
+        star = edge + side * distance
+        design = np.column_stack([basis(np.abs(star - p)), np.ones_like(p)])
+        coefficients, *_ = np.linalg.lstsq(design / t[:, None], np.ones_like(t), rcond=None)
+        residual = float(np.sqrt(np.mean((design @ coefficients / t - 1) ** 2)))
+        if residual < best[1] and coefficients[0] > 0:
+            best = (float(star), residual)
+    return best
+
+
+def fit_blowup(parameter: np.ndarray, period: np.ndarray, unstable_rate: float | None,
+               hopf_period: float, width: float) -> BlowupFit | None:
+    """Fit the period growth at the end of a family (periods in s, ``unstable_rate`` in 1/s).
+
+    p* is searched within ``0.1 * width`` beyond the fitted points, on either side.
+    """
+    tail = _tail(period, hopf_period)
+    p, t = parameter[tail], period[tail]
+    if len(p) < 4:
+        return None
+    steps = np.diff(p)
+    if np.any(steps[1:] * steps[:-1] < 0):  # the parameter oscillates: a snaking approach
+        turns = p[1:-1][steps[1:] * steps[:-1] < 0][-2:]
+        if len(turns) == 1:
+            turns = np.array([turns[0], p[-1]])
+        return BlowupFit(float(turns.mean()), float(turns.mean()), float("nan"), len(p),
+                         (float(turns.min()), float(turns.max())))
+    reach = max(2 * np.ptp(p), 1e-9 * width)
+    rate = unstable_rate if unstable_rate and unstable_rate > 0 else 1.0
+
+    def logarithmic(d):
+        return -np.log(d) / rate
+
+    def hyperbolic(d):
+        return 1.0 / d
+
+    side = 1.0 if p[-1] > p[0] else -1.0  # the parameter heads towards p*
+    log_star, residual = _best_distance(p, t, logarithmic, side, reach)
+    hyper_star, _ = _best_distance(p, t, hyperbolic, side, reach)
+    return BlowupFit(log_star, hyper_star, residual, len(p),
+                     tuple(sorted((float(p[-1]), log_star))))
+
+
+def equilibria_at(value: float, equilibria: list[Branch]) -> list[np.ndarray]:
+    """States (SI) of every computed equilibrium at parameter ``value``, by interpolation."""
+    found = []
+    for branch in equilibria:
+        if branch.kind != BranchKind.EQUILIBRIUM or len(branch) < 2:
+            continue
+        p = branch.parameters[:, 0]
+        for k in np.flatnonzero((p[:-1] - value) * (p[1:] - value) <= 0):
+            if p[k + 1] == p[k]:
+                continue
+            w = (value - p[k]) / (p[k + 1] - p[k])
+            state = (1 - w) * branch.state_max[k] + w * branch.state_max[k + 1]
+            if not any(np.allclose(state, s, atol=1e-6) for s in found):
+                found.append(state)
+    return found
+
+
+def lingering(model: Model, orbit_states: np.ndarray, candidates: list[np.ndarray]
+              ) -> list[np.ndarray]:
+    """The candidate equilibria the orbit passes within LINGER_FRACTION of its size."""
+    scale = np.asarray(model.state_scale)
+    points = orbit_states / scale
+    size = np.ptp(points, axis=0).max()
+    near = []
+    for state in candidates:
+        distance = np.linalg.norm(points - state / scale, axis=1).min()
+        if distance < LINGER_FRACTION * size:
+            near.append(state)
+    return near
+
+
+def unstable_rate(model: Model, params: np.ndarray, state: np.ndarray) -> float:
+    """Largest real positive eigenvalue of the equilibrium (0 if none), 1/s."""
+    eigenvalues = np.linalg.eigvals(model.jacobian_numpy(state, params))
+    real = eigenvalues[np.abs(eigenvalues.imag) < 1e-9 * np.maximum(1, np.abs(eigenvalues))]
+    return float(max(real.real.max(initial=0.0), 0.0))
+
+
+def analyse(family: Branch, model: Model, parameters: dict[str, float],
+            equilibria: list[Branch], hopf_period: float, width: float
+            ) -> SpecialPoint | None:
+    """The global bifurcation a blowing-up family approaches, as a bracketed special point."""
+    if not in_blowup(family, hopf_period):
+        return None
+    name = family.parameter_names[0]
+    last = int(np.nanargmax(family.period))
+    value = float(family.parameters[last, 0])
+    params = model.parameter_vector({**parameters, name: value})
+    orbit = max(family.orbits, key=lambda o: o.period) if family.orbits else None
+    near = lingering(model, orbit.states, equilibria_at(value, equilibria)) if orbit else []
+    saddles = [(s, unstable_rate(model, params, s)) for s in near]
+    saddles = [(s, rate) for s, rate in saddles if rate > 0]
+    if len(saddles) >= 2:
+        kind, what = PointType.HETEROCLINIC, "heteroclinic"
+    else:
+        kind, what = PointType.HOMOCLINIC, "homoclinic"
+    rate = max((r for _, r in saddles), default=None)
+    fit = fit_blowup(family.parameters[:, 0], family.period, rate, hopf_period, width)
+    estimate = fit.log_estimate if fit else value
+    bracket = np.array(fit.bracket if fit else (value, value))
+    described = ", ".join("(" + ", ".join(f"{x:.4g}" for x in s[:2]) + ")" for s, _ in saddles)
+    note = (f"period blow-up ({what} approach): orbit lingers near saddle(s) {described or 'none'}"
+            f"; lambda_u = {rate or float('nan'):.4g} 1/s")
+    if fit and np.isnan(fit.residual):
+        note += (f"; the parameter oscillates (snaking, saddle-focus): p* ~ {estimate:.8g} "
+                 f"between the last folds {bracket[0]:.8g} and {bracket[1]:.8g}")
+    elif fit:
+        note += (f"; p* = {fit.log_estimate:.8g} (T = C - ln|p - p*|/lambda_u), "
+                 f"{fit.hyperbolic_estimate:.8g} (T = A/|p* - p| + B); "
+                 f"relative rms residual {fit.residual:.2g} over {fit.n_points} points")
+    state = saddles[0][0] if saddles else family.state_max[last]
+    return SpecialPoint(
+        branch=family.name, index=last, point_type=int(kind),
+        parameter_names=family.parameter_names, parameters=np.array([estimate]),
+        state=np.asarray(state, dtype=float), period=float(family.period[last]),
+        stable=False, status="bracketed", note=note, bracket=bracket,
+        residual=fit.residual if fit else float("nan"))

@@ -1,0 +1,140 @@
+"""Time simulation with scipy ``solve_ivp`` on the numpy right-hand side of the symbolic model:
+the independent check of what continuation claims.
+
+* A stable periodic orbit: started on AUTO's orbit, the simulation must stay on it (the maximum
+  of the law's degree of freedom over the last periods within ``tolerance`` of AUTO's).
+* A stable equilibrium: a small perturbation must decay.
+
+Time in seconds, states in SI units (rad, rad/s), as everywhere outside AUTO.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .global_bifurcations import BLOWUP_FACTOR
+from .models import Model
+from .results import Branch, BranchKind, CrossCheck, Orbit, PointType
+
+#: Relative tolerance on the amplitude for "the simulation stays on the orbit".
+ORBIT_TOLERANCE = 0.01
+
+
+def integrate(model: Model, params: np.ndarray, y0: np.ndarray, duration: float,
+              samples: int = 4000, rtol: float = 1e-8) -> tuple[np.ndarray, np.ndarray]:
+    """(t (K,), y (K, n)): the trajectory from ``y0`` over ``duration`` seconds (LSODA with the
+    analytic Jacobian, so stiff points of strongly hardening springs cost no more than others)."""
+    from scipy.integrate import solve_ivp
+
+    field, jacobian = model.field_at(params)
+    times = np.linspace(0.0, duration, samples)
+    solution = solve_ivp(lambda _t, y: field(y), (0.0, duration), np.asarray(y0, dtype=float),
+                         method="LSODA", jac=lambda _t, y: jacobian(y), t_eval=times,
+                         rtol=rtol, atol=rtol * 1e-3)
+    if not solution.success:
+        raise RuntimeError(f"time integration failed: {solution.message}")
+    return solution.t, solution.y.T
+
+
+def _parameters(model: Model, overrides: dict[str, float], names: tuple[str, ...],
+                values: np.ndarray) -> np.ndarray:
+    return model.parameter_vector({**overrides, **dict(zip(names, map(float, values),
+                                                           strict=True))})
+
+
+def check_orbit(model: Model, overrides: dict[str, float], branch: Branch, orbit: Orbit,
+                periods: int = 10, tolerance: float = ORBIT_TOLERANCE) -> CrossCheck:
+    """Start on ``orbit`` and simulate ``periods`` periods; the max of the law's degree of
+    freedom over the last two periods must match AUTO's within ``tolerance``."""
+    dof = model.state_names.index(model.dof)
+    params = _parameters(model, overrides, branch.parameter_names, orbit.parameters)
+    time, states = integrate(model, params, orbit.states[0], periods * orbit.period,
+                             samples=periods * 400)
+    last = time >= (periods - 2) * orbit.period
+    simulated = float(states[last, dof].max())
+    expected = float(branch.state_max[orbit.index, dof])
+    error = abs(simulated - expected) / max(np.ptp(orbit.states[:, dof]) / 2, 1e-12)
+    return CrossCheck(branch.name, orbit.index, "orbit", float(orbit.parameters[0]), expected,
+                      simulated, bool(error <= tolerance))
+
+
+def check_equilibrium(model: Model, overrides: dict[str, float], branch: Branch, index: int,
+                      perturbation: float = 1e-3) -> CrossCheck:
+    """Perturb the angles of a stable equilibrium by ``perturbation`` rad (at most 0.1 % of its
+    deflection); after ten slowest decay times the deviation must have fallen below a tenth."""
+    state = branch.state_max[index]
+    params = _parameters(model, overrides, branch.parameter_names, branch.parameters[index])
+    eigenvalues = np.linalg.eigvals(model.jacobian_numpy(state, params))
+    slowest = float(-eigenvalues.real.max())
+    angles = np.array([s.unit == "rad" for s in model.states])
+    deflection = np.abs(state[angles]).max()
+    if deflection > 0:  # stay within the basin (tiny next to a pitchfork) of the equilibrium
+        perturbation = min(perturbation, 1e-3 * deflection)
+    start = state + perturbation * angles
+    duration = min(10.0 / max(slowest, 1e-3), 60.0)
+    _, states = integrate(model, params, start, duration, samples=200)
+    final = float(np.abs(states[-1] - state)[angles].max())
+    return CrossCheck(branch.name, index, "equilibrium", float(branch.parameters[index, 0]),
+                      perturbation, final, bool(slowest > 0 and final < 0.1 * perturbation))
+
+
+def _interior_stable(branch: Branch, index: int) -> bool:
+    """Stable, and so are both neighbours (away from bifurcations)."""
+    lo, hi = max(index - 1, 0), min(index + 2, len(branch))
+    special = branch.point_type[lo:hi]
+    return bool(branch.stable[lo:hi].all()) and not np.isin(
+        special, [PointType.LPC, PointType.BPC, PointType.PD, PointType.TR, PointType.HB,
+                  PointType.BP, PointType.LP]).any()
+
+
+def cross_check(model: Model, overrides: dict[str, float], branches: tuple[Branch, ...],
+                per_branch: int = 2) -> tuple[CrossCheck, ...]:
+    """Checks of up to ``per_branch`` stable points of every branch (orbits for periodic
+    branches, perturbations for equilibria), spread along each branch. Not checked: points next
+    to bifurcations, orbits in a period blow-up (T > 3 T_Hopf) and equilibria too weakly damped
+    or too stiff to simulate in bounded time."""
+    checks: list[CrossCheck] = []
+    for branch in branches:
+        if branch.kind == BranchKind.PERIODIC:
+            # orbits in a period blow-up (near a homoclinic/heteroclinic orbit) are too
+            # sensitive for simulation to follow for 20 periods; they are not checked
+            hopf_period = branch.period[0]
+            candidates = [o for o in branch.orbits if 0 < o.index < len(branch) - 1
+                          and _interior_stable(branch, o.index) and o.states.shape[0] > 1
+                          and o.period < BLOWUP_FACTOR * hopf_period]
+            for orbit in _spread(candidates, per_branch):
+                checks.append(check_orbit(model, overrides, branch, orbit))
+        elif branch.kind == BranchKind.EQUILIBRIUM:
+            rows = [k for k in range(1, len(branch) - 1)
+                    if _interior_stable(branch, k) and _checkable(branch.eigenvalues[k])]
+            for row in _spread(rows, per_branch):
+                checks.append(check_equilibrium(model, overrides, branch, row))
+    return tuple(checks)
+
+
+def _checkable(eigenvalues: np.ndarray, max_cycles: float = 300.0) -> bool:
+    """True if a perturbation decays tenfold within a minute and within ``max_cycles`` periods
+    of the fastest mode (stiff, fast-oscillating points cost too much to simulate)."""
+    if not np.all(np.isfinite(eigenvalues)):
+        return False
+    decay = -float(eigenvalues.real.max())
+    if decay <= 0.1:
+        return False
+    duration = min(10.0 / decay, 60.0)
+    return duration * float(np.abs(eigenvalues).max()) / (2 * np.pi) <= max_cycles
+
+
+def _spread(items: list, count: int) -> list:
+    if len(items) <= count:
+        return list(items)
+    picks = np.linspace(0, len(items) - 1, count).round().astype(int)
+    return [items[k] for k in picks]
+
+
+def whirl_sense(model: Model, states: np.ndarray) -> str:
+    """"FW" or "BW": the sense in which the hub path of an orbit turns relative to the spin
+    (+x), from the signed area enclosed in the hub plane (``model.hub_plane``)."""
+    (iy, fy), (iz, fz) = model.hub_plane
+    hub_y, hub_z = fy * states[:, iy], fz * states[:, iz]
+    area = 0.5 * np.sum(hub_y * np.roll(hub_z, -1) - np.roll(hub_y, -1) * hub_z)
+    return "FW" if area > 0 else "BW"
