@@ -41,6 +41,27 @@ run: setup
 generate: setup
 	$(BIN)/whirl generate
 
+# Every study under studies/ (resumable: up-to-date outputs are skipped) -> results/<name>.h5
+SWEEP_JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+.PHONY: sweep references bench
+sweep: setup
+	$(BIN)/whirl sweep studies -o results --jobs $(SWEEP_JOBS)
+
+# Regenerate the committed HDF5 references of tests/regression (a deliberate act: review the
+# `whirl compare` output against the old files before committing the new ones).
+REFERENCES ?= hardening_case2 linear_datum_airspeed
+references: setup
+	@mkdir -p tests/regression/references
+	@for name in $(REFERENCES); do \
+	  $(BIN)/whirl run studies/thesis_ch3/$$name.yaml -o tests/regression/references/$$name.h5 \
+	    --no-plots --overwrite || exit 1; \
+	done
+	@ls -l tests/regression/references
+
+# Performance figures (ratios and timings, printed; never asserted in tests)
+bench: setup
+	$(BIN)/python benchmarks/bench.py
+
 clean:
 	rm -rf $(OUT) .pytest_cache build *.egg-info
 	find . -name __pycache__ -type d -prune -exec rm -rf {} +

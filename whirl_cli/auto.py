@@ -11,25 +11,37 @@
 * AUTO exits 0 on most errors, so success is: exit status 0, none of AUTO's error texts on
   stdout, at least one solution point in ``b.<name>``, and no MX (no convergence) ending.
   Anything else becomes a :class:`RunOutcome` with a status and a message, never an exception.
+* No AUTO process outlives whirl: each gets the parent-death signal SIGKILL (``setpriv
+  --pdeathsig``, util-linux, when available), so even a SIGKILLed whirl leaves none running;
+  inside :func:`interruptible` (what ``run_study`` uses) SIGINT and SIGTERM kill every running
+  AUTO process group at once, refuse new runs and raise :class:`Interrupted`.
+* Testing hook: ``WHIRL_AUTO_EXTRA_CONSTANTS`` = a JSON object ``{"<glob>": {constants}}``;
+  runs whose name (``<continuation>.<branch>``) matches a glob get those constants merged in
+  (mapping values such as ``PAR`` one level deep). It exists to provoke AUTO failures in tests
+  (e.g. ``{"bad.*": {"NDIM": 3}}``); the constants used are stored with every run.
 """
 
 from __future__ import annotations
 
+import fnmatch
 import hashlib
+import json
 import os
 import re
 import shutil
 import signal
 import subprocess
 import tempfile
+import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
 
 from .codegen import constants_text
-from .errors import ToolchainError
+from .errors import ToolchainError, WhirlError
 
 AUTO_DIR = Path(os.environ.get("WHIRL_AUTO_DIR", "/usr/lib/auto-07p"))
 #: The flags of Debian's ``cmds/cmds.make`` (minus the build-path mapping).
@@ -126,6 +138,7 @@ def compile_equations(source: str | Callable[[], str], name: str,
     if exe.exists():
         return Executable(exe, digest, compiled=False)
     final.parent.mkdir(parents=True, exist_ok=True)
+    _remove_stale_builds(final.parent)
     build = Path(tempfile.mkdtemp(prefix=f".{name}-", dir=final.parent))
     try:
         (build / f"{name}.f90").write_text(source if isinstance(source, str) else source())
@@ -147,7 +160,112 @@ def compile_equations(source: str | Callable[[], str], name: str,
         shutil.rmtree(build, ignore_errors=True)
 
 
+def _remove_stale_builds(root: Path, age: float = 3600.0) -> None:
+    """Remove build directories (``.<name>-*``) left by a compile that was killed."""
+    now = time.time()
+    for build in root.glob(".*-*"):
+        try:
+            if build.is_dir() and now - build.stat().st_mtime > age:
+                shutil.rmtree(build, ignore_errors=True)
+        except OSError:
+            pass
+
+
 # ------------------------------------------------------------------------------ running
+class Interrupted(KeyboardInterrupt):
+    """SIGINT or SIGTERM during :func:`interruptible`: every running AUTO process is killed."""
+
+    def __init__(self, signum: int = signal.SIGINT) -> None:
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+#: Running AUTO processes, and whether new runs are refused (after an interrupt).
+_LIVE: set[subprocess.Popen] = set()
+_LIVE_LOCK = threading.RLock()
+_STOPPING = threading.Event()
+
+
+def stop_all() -> None:
+    """Refuse new AUTO runs and kill (SIGKILL, whole process group) every running one."""
+    with _LIVE_LOCK:
+        _STOPPING.set()
+        for process in list(_LIVE):
+            try:
+                os.killpg(process.pid, signal.SIGKILL)
+            except (ProcessLookupError, PermissionError):
+                pass
+
+
+def _on_signal(signum: int, frame: object) -> None:
+    first = not _STOPPING.is_set()
+    stop_all()
+    if first:  # once: later signals must not interrupt the clean-up
+        raise Interrupted(signum)
+
+
+@contextmanager
+def interruptible() -> Iterator[None]:
+    """While inside (main thread only): SIGINT and SIGTERM kill the AUTO runs and raise
+    :class:`Interrupted` (a KeyboardInterrupt) in the main thread."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    _STOPPING.clear()
+    previous = {s: signal.signal(s, _on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+        _STOPPING.clear()
+
+
+@cache
+def _pdeathsig_prefix() -> tuple[str, ...]:
+    """``setpriv --pdeathsig KILL`` if it works here, else nothing."""
+    setpriv, true = shutil.which("setpriv"), shutil.which("true")
+    if not setpriv or not true:
+        return ()
+    prefix = (setpriv, "--pdeathsig", "KILL", "--")
+    try:
+        probe = subprocess.run([*prefix, true], capture_output=True, timeout=10, check=False)
+    except (OSError, subprocess.TimeoutExpired):
+        return ()
+    return prefix if probe.returncode == 0 else ()
+
+
+EXTRA_CONSTANTS = "WHIRL_AUTO_EXTRA_CONSTANTS"
+
+
+def _extra_constants(name: str) -> dict:
+    """The constants the testing hook ``WHIRL_AUTO_EXTRA_CONSTANTS`` adds to run ``name``."""
+    text = os.environ.get(EXTRA_CONSTANTS, "").strip()
+    if not text:
+        return {}
+    try:
+        table = json.loads(text)
+    except ValueError as error:
+        raise WhirlError(f"{EXTRA_CONSTANTS}: not JSON ({error})") from None
+    if not isinstance(table, dict) or not all(isinstance(v, dict) for v in table.values()):
+        raise WhirlError(f'{EXTRA_CONSTANTS}: expected {{"<glob>": {{constants}}}}')
+    extra: dict = {}
+    for pattern, constants in table.items():
+        if fnmatch.fnmatchcase(name, pattern):
+            extra.update(constants)
+    return extra
+
+
+def _merged(constants: dict, extra: dict) -> dict:
+    merged = dict(constants)
+    for key, value in extra.items():
+        if isinstance(value, dict) and isinstance(merged.get(key), dict):
+            merged[key] = {**merged[key], **value}
+        else:
+            merged[key] = value
+    return merged
+
+
 @dataclass(frozen=True)
 class RunOutcome:
     """What one AUTO run did. ``status``: ok | mx | error | timeout | crashed."""
@@ -209,7 +327,7 @@ def run(executable: Path, constants: dict, workdir: Path, name: str,
     ``workdir`` and named through the ``s`` constant.
     """
     workdir.mkdir(parents=True, exist_ok=False)
-    constants = dict(constants, sv=name)
+    constants = dict(_merged(constants, _extra_constants(name)), sv=name)
     if restart is not None:
         restart_name = "restart"
         shutil.copyfile(restart, workdir / f"s.{restart_name}")
@@ -220,10 +338,15 @@ def run(executable: Path, constants: dict, workdir: Path, name: str,
 
     start = time.perf_counter()
     returncode: int | None
+    command = [*_pdeathsig_prefix(), str(executable)]
     with (workdir / "stdout.txt").open("wb") as out, (workdir / "stderr.txt").open("wb") as err:
-        process = subprocess.Popen([str(executable)], cwd=workdir, env=_auto_env(),
-                                   stdin=subprocess.DEVNULL, stdout=out, stderr=err,
-                                   start_new_session=True)
+        with _LIVE_LOCK:
+            if _STOPPING.is_set():
+                raise Interrupted()
+            process = subprocess.Popen(command, cwd=workdir, env=_auto_env(),
+                                       stdin=subprocess.DEVNULL, stdout=out, stderr=err,
+                                       start_new_session=True)
+            _LIVE.add(process)
         try:
             returncode = process.wait(timeout=timeout)
             timed_out = False
@@ -235,6 +358,11 @@ def run(executable: Path, constants: dict, workdir: Path, name: str,
             os.killpg(process.pid, signal.SIGKILL)
             process.wait()
             raise
+        finally:
+            with _LIVE_LOCK:
+                _LIVE.discard(process)
+    if _STOPPING.is_set():  # killed by stop_all: no outcome to report
+        raise Interrupted()
     wall = time.perf_counter() - start
     (workdir / "fort.2").unlink(missing_ok=True)
 

@@ -45,24 +45,29 @@ def cli() -> None:
 def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots: bool,
         keep_runs: Path | None) -> None:
     """Run every continuation and linear analysis of STUDY_FILE."""
-    from . import store
-    from .pipeline import run_study
     from .study import load_study
 
-    study = load_study(study_file)
+    study = load_study(study_file)  # first: a bad study is refused fast, before any import
+    from . import store
+    from .pipeline import run_study
+
     output = output or Path(f"{study.name}.h5")
     if output.exists() and not overwrite:
         raise OutputError(f"{output}: output exists; pass --overwrite to replace it")
-    output.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        output.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise OutputError(f"{output}: cannot create the output directory "
+                          f"({error.strerror or error})") from None
     console = _console()
 
     def report(outcome) -> None:
         mark = "ok" if outcome.success else outcome.status.upper()
         console.print(f"  {outcome.name:<32} {mark:<8} {outcome.n_points:>6} points "
                       f"{outcome.wall_seconds:7.3f} s"
-                      + ("" if outcome.success else f"  {outcome.message}"))
+                      + ("" if outcome.success else f"  {outcome.message}"), soft_wrap=True)
 
-    console.print(f"whirl {__version__}: {study.path} -> {output}")
+    console.print(f"whirl {__version__}: {study.path} -> {output}", soft_wrap=True)
     if keep_runs:
         keep_runs.mkdir(parents=True, exist_ok=True)
         workroot = Path(tempfile.mkdtemp(prefix=f"{study.name}-", dir=keep_runs))
@@ -80,7 +85,15 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
 
         for path in save_study_plots(result, tuple(study.plots), output.parent, output.stem):
             console.print(f"wrote {path}")
-    failed = [b for c in result.continuations for b in c.branches if b.status != "ok"]
+    # a locus ending in MX has mostly reached a degenerate point (a cusp of folds of cycles,
+    # a Bogdanov-Takens point): reported, but not a failure of the study
+    loci_mx = [b for c in result.continuations for b in c.branches
+               if b.status == "mx" and b.kind.endswith("_locus")]
+    for branch in loci_mx:
+        console.print(f"note: locus {branch.name} ends with MX (no convergence) at "
+                      f"{', '.join(f'{v:.5g}' for v in branch.parameters[-1])}")
+    failed = [b for c in result.continuations for b in c.branches
+              if b.status != "ok" and b not in loci_mx]
     checks = [x for c in result.continuations for x in c.cross_checks]
     wrong = [x for x in checks if not x.passed]
     if checks:
@@ -163,7 +176,8 @@ def models() -> None:
 @cli.command()
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--kind", "kinds", multiple=True,
-              type=click.Choice(["bifurcation", "linear", "projections", "period", "phase"]),
+              type=click.Choice(["bifurcation", "linear", "projections", "period", "phase",
+                                 "boundary"]),
               help="Plot kind (repeatable) [default: all available].")
 @click.option("-o", "--output-dir", type=click.Path(file_okay=False, path_type=Path),
               help="Directory for the PNG files [default: next to RESULT_FILE].")
@@ -175,8 +189,8 @@ def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None) -> 
     result = store.read(result_file)
     output_dir = output_dir or result_file.parent
     output_dir.mkdir(parents=True, exist_ok=True)
-    for path in save_study_plots(result, kinds or ("bifurcation", "linear", "period"), output_dir,
-                                 result_file.stem):
+    kinds = kinds or ("bifurcation", "linear", "period", "boundary")
+    for path in save_study_plots(result, kinds, output_dir, result_file.stem):
         click.echo(f"wrote {path}")
 
 
@@ -222,19 +236,80 @@ def doctor() -> None:
     click.echo("everything needed is installed")
 
 
+# ------------------------------------------------------------------------------------ sweep
+@cli.command()
+@click.argument("paths", nargs=-1, required=True,
+                type=click.Path(exists=True, path_type=Path))
+@click.option("-o", "--output-dir", "out_dir", type=click.Path(file_okay=False, path_type=Path),
+              default=Path("results"), show_default=True,
+              help="Directory for <study name>.h5 and the plots.")
+@click.option("-j", "--jobs", type=click.IntRange(1, 256), default=os.cpu_count() or 1,
+              show_default=True, help="Studies run in parallel (local worker processes).")
+@click.option("--dask", "dask_address", metavar="ADDRESS",
+              help="Run the studies on this Dask scheduler instead (needs whirl[dask]).")
+@click.option("--force", is_flag=True, help="Rerun studies whose output is up to date.")
+@click.option("--plots/--no-plots", default=True, show_default=True,
+              help="Write each study's plots next to its HDF5 file.")
+def sweep(paths: tuple[Path, ...], out_dir: Path, jobs: int, dask_address: str | None,
+          force: bool, plots: bool) -> None:
+    """Run every study in PATHS (files, or directories searched for *.yaml), in parallel.
+
+    Resumable: a study whose output has the same study_sha256 and whirl_version is skipped.
+    Exit 1 if any study failed (the others still run), 130 when interrupted.
+    """
+    from .sweep import run_sweep
+
+    try:
+        tally = run_sweep(paths, out_dir, jobs=jobs, dask_address=dask_address, force=force,
+                          plots=plots, console=_console())
+    except KeyboardInterrupt:
+        click.echo("interrupted", err=True)
+        raise SystemExit(130) from None
+    if tally.failures:
+        raise WhirlError(f"{len(tally.failures)} of {tally.total} studies failed")
+
+
+# ------------------------------------------------------------------------------------ compare
+@cli.command()
+@click.argument("file_a", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.argument("file_b", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--rtol", type=click.FloatRange(min=0), default=None,
+              help="Relative tolerance: periods, linear sweeps, special-point parameters "
+                   "(fraction of the continuation's range) [default: 1e-5, 1e-9, 1e-6].")
+@click.option("--atol", type=click.FloatRange(min=0), default=None,
+              help="Absolute tolerance on states (rad, rad/s) of special points and branches "
+                   "[default: 1e-6, 1e-5].")
+@click.option("--limit", type=click.IntRange(1), default=20, show_default=True,
+              help="Differences printed at most.")
+def compare(file_a: Path, file_b: Path, rtol: float | None, atol: float | None,
+            limit: int) -> None:
+    """Compare two result files on physics (special points, branches along the parameter,
+    stability, linear sweeps, boundaries), not point indices. Exit 1 on drift."""
+    from .compare import Tolerances, compare_files
+
+    differences = compare_files(file_a, file_b, Tolerances.from_options(rtol, atol))
+    for difference in differences[:limit]:
+        click.echo(str(difference))
+    if len(differences) > limit:
+        click.echo(f"... and {len(differences) - limit} more")
+    if differences:
+        raise WhirlError(f"{file_a} and {file_b} differ ({len(differences)} difference(s))")
+    click.echo(f"{file_a} and {file_b} agree")
+
+
 def main() -> None:
     """Console entry point: whirl errors as one message, unexpected errors without traceback."""
     try:
         cli.main(standalone_mode=False)
-    except click.exceptions.Abort:
+    except click.exceptions.Abort as error:  # click's wrapper of a KeyboardInterrupt
         click.echo("interrupted", err=True)
-        sys.exit(130)
+        sys.exit(128 + getattr(error.__cause__, "signum", 2))  # SIGINT 130, SIGTERM 143
     except click.ClickException as error:
         error.show()
         sys.exit(error.exit_code)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as error:
         click.echo("interrupted", err=True)
-        sys.exit(130)
+        sys.exit(128 + getattr(error, "signum", 2))
     except Exception as error:  # a bug: say so plainly, traceback only on request
         if os.environ.get("WHIRL_DEBUG"):
             raise

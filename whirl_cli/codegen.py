@@ -13,6 +13,8 @@ the PVLS outputs ``max_<state>`` and ``min_<state>`` follow. All names are AUTO 
 from __future__ import annotations
 
 import hashlib
+import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -84,6 +86,8 @@ def source_key(model: Model) -> str:
 
 def fortran_number(value: float) -> str:
     """A double-precision Fortran literal that round-trips ``value``."""
+    if not math.isfinite(value):
+        raise CodegenError(f"cannot write {value!r} as a Fortran number")
     text = repr(float(value)).replace("e", "d")
     return text if "d" in text else text + "d0"
 
@@ -146,6 +150,9 @@ def fortran_source(model: Model) -> str:
     header.append(f"!   PAR({layout.amplitude}) = {AMPLITUDE}: largest half peak-to-peak value "
                   "of a state (PVLS)")
     header.append("!" + "-" * 78)
+    broken = [line for line in header if "\n" in line or "\r" in line]
+    if broken:  # a line break would end the comment and start a Fortran statement
+        raise CodegenError(f"model {model.name}: a line break in a description: {broken[0]!r}")
 
     unpack = [f"  {s.name} = U({i + 1})" for i, s in enumerate(model.states)]
     unpack += [f"  {p.name} = PAR({layout.parameters[p.name]})" for p in model.parameters]
@@ -243,7 +250,7 @@ def _constant_value(value) -> str:
     if isinstance(value, float):
         return repr(value)
     if isinstance(value, str):
-        if "'" in value or "\n" in value:
+        if any(c in value for c in "'\"\n\r\0"):
             raise CodegenError(f"AUTO constants cannot hold the string {value!r}")
         return f"'{value}'"
     if isinstance(value, list | tuple):
@@ -254,6 +261,11 @@ def _constant_value(value) -> str:
     raise CodegenError(f"cannot write {value!r} ({type(value).__name__}) as an AUTO constant")
 
 
+#: AUTO names (parnames, unames: CHARACTER(13)) and constant keys: ASCII identifiers only.
+_AUTO_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,12}")
+_CONSTANT_KEY = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
+
+
 def constants_text(constants: dict) -> str:
     """AUTO's keyword-style constants file, one ``KEY = value`` per line.
 
@@ -261,8 +273,11 @@ def constants_text(constants: dict) -> str:
     """
     for key in ("parnames", "unames"):
         for name in constants.get(key, {}).values():
-            if len(name) > 13 or not name.replace("_", "").isalnum():
+            if not _AUTO_NAME.fullmatch(name):
                 raise CodegenError(f"AUTO name {name!r} must be <= 13 characters, [A-Za-z0-9_]")
+    for key in constants:
+        if not isinstance(key, str) or not _CONSTANT_KEY.fullmatch(key):
+            raise CodegenError(f"not an AUTO constant name: {key!r}")
     lines = [f"{key} = {_constant_value(value)}" for key, value in constants.items()]
     too_long = [line[:40] for line in lines if len(line) > 2000]
     if too_long:

@@ -11,12 +11,13 @@ the hub path in the plane normal to the spin axis (+x) turns with the spin (FW) 
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 import numpy as np
 
 from .models import Model
-from .results import LinearSweep
+from .results import LinearGrid, LinearSweep
 
 FORWARD, BACKWARD, NON_OSCILLATORY = "FW", "BW", "--"
 
@@ -140,3 +141,68 @@ def critical_points(model: Model, overrides: dict[str, float], parameter: str,
                     continue
             found.append(CriticalPoint(kind, name, float(value), frequency))
     return sorted(found, key=lambda c: c.value)
+
+
+# ------------------------------------------------------------------------------------ grid
+def batched_eigenvalues(matrices: np.ndarray) -> np.ndarray:
+    """``numpy.linalg.eigvals`` of a stack (M, n, n), split over the CPU cores (the batched
+    LAPACK call releases the GIL, so threads run it in parallel)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    workers = min(os.cpu_count() or 1, max(1, len(matrices) // 4096))
+    if workers == 1:
+        return np.linalg.eigvals(matrices)
+    with ThreadPoolExecutor(workers) as pool:
+        parts = list(pool.map(np.linalg.eigvals, np.array_split(matrices, workers)))
+    return np.concatenate(parts)
+
+
+def _critical(model: Model, params: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(max real part, is the critical eigenvalue complex) per column of ``params`` (P, M)."""
+    eigenvalues = batched_eigenvalues(np.ascontiguousarray(jacobians(model, params)))
+    k = np.argmax(eigenvalues.real, axis=1)
+    critical = np.take_along_axis(eigenvalues, k[:, None], axis=1)[:, 0]
+    oscillatory = np.abs(critical.imag) > 1e-6 * np.maximum(np.abs(critical), 1e-12)
+    return critical.real, oscillatory
+
+
+def grid(model: Model, overrides: dict[str, float], x_parameter: str, x_values: np.ndarray,
+         y_parameter: str, y_values: np.ndarray) -> LinearGrid:
+    """Max real part of the eigenvalues of y = 0 over a grid, and its zero contour split into
+    flutter (complex critical eigenvalue) and divergence (real) parts. Vectorised: one batched
+    eigenvalue computation for the whole grid."""
+    import contourpy
+
+    x_name, y_name = model.canonical(x_parameter), model.canonical(y_parameter)
+    x_values, y_values = np.asarray(x_values, float), np.asarray(y_values, float)
+    xx, yy = np.meshgrid(x_values, y_values)
+    params = np.repeat(model.parameter_vector(overrides)[:, None], xx.size, axis=1)
+    params[model.parameter_names.index(x_name)] = xx.ravel()
+    params[model.parameter_names.index(y_name)] = yy.ravel()
+    real, oscillatory = _critical(model, params)
+    max_real = real.reshape(xx.shape)
+    lines = contourpy.contour_generator(x_values, y_values, max_real).lines(0.0)
+    flutter, divergence = _split_by_kind(model, overrides, x_name, y_name, lines)
+    return LinearGrid(x_name, y_name, model.parameter(x_name).unit,
+                      model.parameter(y_name).unit, x_values, y_values, max_real,
+                      oscillatory.reshape(xx.shape), flutter, divergence)
+
+
+def _split_by_kind(model: Model, overrides: dict[str, float], x_name: str, y_name: str,
+                   lines: list[np.ndarray]) -> tuple[tuple[np.ndarray, ...], ...]:
+    """Cut each contour polyline where the critical eigenvalue changes between complex and
+    real; returns (flutter pieces, divergence pieces)."""
+    pieces: dict[bool, list[np.ndarray]] = {True: [], False: []}
+    for line in lines:
+        if len(line) < 2:
+            continue
+        params = np.repeat(model.parameter_vector(overrides)[:, None], len(line), axis=1)
+        params[model.parameter_names.index(x_name)] = line[:, 0]
+        params[model.parameter_names.index(y_name)] = line[:, 1]
+        _, kind = _critical(model, params)
+        cuts = np.flatnonzero(kind[1:] != kind[:-1]) + 1
+        for part, flag in zip(np.split(np.arange(len(line)), cuts),
+                              kind[np.r_[0, cuts]], strict=True):
+            if len(part) >= 2:
+                pieces[bool(flag)].append(line[part])
+    return tuple(pieces[True]), tuple(pieces[False])

@@ -14,10 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__, linear, simulate
-from .auto import RunOutcome, auto_version
-from .recipes import Engine, Numerics, one_parameter
-from .results import ContinuationResult, StudyResult
+from . import __version__, boundaries, linear, simulate
+from .auto import RunOutcome, auto_version, interruptible
+from .recipes import Engine, Numerics, one_parameter, two_parameter
+from .results import Boundary, ContinuationResult, StudyResult
 from .study import Study
 
 
@@ -43,7 +43,17 @@ def provenance(study: Study) -> dict[str, str]:
 
 def run_study(study: Study, workroot: Path, jobs: int = 1,
               on_run: Callable[[RunOutcome], None] | None = None) -> StudyResult:
-    """Run every continuation and linear sweep of ``study``; AUTO works under ``workroot``."""
+    """Run every continuation and linear sweep of ``study``; AUTO works under ``workroot``.
+
+    In the main thread, SIGINT and SIGTERM kill the running AUTO processes at once and raise
+    :class:`whirl_cli.auto.Interrupted` (a KeyboardInterrupt), see :func:`auto.interruptible`.
+    """
+    with interruptible():
+        return _run_study(study, workroot, jobs, on_run)
+
+
+def _run_study(study: Study, workroot: Path, jobs: int,
+               on_run: Callable[[RunOutcome], None] | None) -> StudyResult:
     model = study.variant()
     parameters = study.parameter_values()
     numerics = Numerics.from_settings(study.auto)
@@ -51,8 +61,14 @@ def run_study(study: Study, workroot: Path, jobs: int = 1,
     engine = None
     if study.continuations:
         engine = Engine(model, workroot, jobs=jobs, timeout=numerics.timeout, on_run=on_run)
+    found_boundaries = []
     for spec in study.continuations:
         assert engine is not None
+        if spec.type == "two-parameter":
+            continuation, boundary = _two_parameter(engine, model, spec, parameters, numerics)
+            continuations.append(continuation)
+            found_boundaries.append(boundary)
+            continue
         continuations.append(one_parameter(
             engine, spec.name, spec.parameter, spec.start, tuple(spec.range), parameters,
             numerics, branch_points=spec.branch_points, periodic=spec.periodic,
@@ -66,7 +82,27 @@ def run_study(study: Study, workroot: Path, jobs: int = 1,
         for sweep in study.linear.sweeps:
             values = np.linspace(sweep.range[0], sweep.range[1], sweep.points)
             sweeps.append(linear.sweep(model, parameters, sweep.parameter, values))
+    grid = None
+    if study.linear is not None and study.linear.grid is not None:
+        x, y = study.linear.grid.x, study.linear.grid.y
+        grid = linear.grid(model, parameters, x.parameter, np.linspace(*x.range, x.points),
+                           y.parameter, np.linspace(*y.range, y.points))
     return StudyResult(
         study_name=study.name, model=model.name, continuations=tuple(continuations),
         linear_sweeps=tuple(sweeps), runs=engine.records() if engine else (),
-        attributes=provenance(study))
+        attributes=provenance(study), boundaries=tuple(found_boundaries), linear_grid=grid)
+
+
+def _two_parameter(engine: Engine, model, spec, parameters: dict[str, float],
+                   numerics: Numerics) -> tuple[ContinuationResult, Boundary]:
+    """Loci and the unsafe region of a two-parameter continuation."""
+    pair = tuple(spec.parameters)
+    bounds = spec.bounds(model)
+    continuation, curves = two_parameter(engine, spec.name, pair, bounds, spec.start,
+                                         tuple(spec.slices), tuple(spec.loci), parameters,
+                                         numerics)
+    per_slice = [tuple(b for b in continuation.branches if b.name.startswith(f"slice_{k}."))
+                 for k in range(len(spec.slices))]
+    found = boundaries.boundary(spec.name, model, parameters, pair, bounds, spec.method,
+                                tuple(spec.slices), spec.resolution, curves, per_slice)
+    return continuation, found

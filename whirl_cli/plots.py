@@ -1,5 +1,6 @@
 """Figures of study results (matplotlib, Agg): bifurcation diagrams, state projections, period
-plots, phase planes of stored orbits and linear sweeps.
+plots, phase planes of stored orbits, linear sweeps, two-parameter stability maps with the
+unsafe (overhang) region and the bifurcation diagrams of their slices.
 
 The only module that imports matplotlib, and only inside functions (the CLI starts without it).
 Figures are built with the object-oriented API on an Agg canvas, never through pyplot, so they
@@ -11,7 +12,8 @@ parameters are always shown in their own (SI) units; periods in s. Linear sweeps
 in rad/s and the damping ratio (dimensionless).
 
 Plot key (thesis Table 2.1) is :data:`PLOT_KEY`: one entry per semantic style, with the
-matplotlib ``Line2D`` keyword arguments that draw it and its legend label.
+matplotlib ``Line2D`` keyword arguments that draw it and its legend label. Stability maps
+(thesis figures 3.13, 3.15, 3.28, 3.29) use :data:`BOUNDARY_KEY` in the same way.
 """
 
 from __future__ import annotations
@@ -21,13 +23,23 @@ import os
 import re
 import tempfile
 from collections.abc import Iterator, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .errors import OutputError, WhirlError
-from .results import Branch, BranchKind, ContinuationResult, LinearSweep, PointType, StudyResult
+from .results import (
+    Boundary,
+    Branch,
+    BranchKind,
+    ContinuationResult,
+    LinearGrid,
+    LinearSweep,
+    PointType,
+    StudyResult,
+)
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -75,8 +87,36 @@ MARKER_STYLE: dict[PointType, str] = {
 """Point type -> key of :data:`PLOT_KEY`; types not listed (REGULAR, RG, UZ, EP, MX, ...) get
 no marker."""
 
+_UNSAFE_LABEL = "unsafe (overhang)"
+BOUNDARY_KEY: dict[str, dict[str, object]] = {
+    # linear analysis over a grid
+    "linearly_unstable": {"color": "lightgrey", "label": "linearly unstable"},
+    "linear_flutter": {"color": _BLACK, "linestyle": "-", "linewidth": 0.8,
+                       "label": "linear boundary (flutter)"},
+    "linear_divergence": {"color": _BLACK, "linestyle": "--", "linewidth": 0.8,
+                          "label": "linear boundary (divergence)"},
+    # loci of the two-parameter continuation, by Boundary.loci kind
+    "hopf": {"color": "darkblue", "linestyle": "-", "linewidth": 1.5,
+             "label": "Hopf locus (flutter)"},
+    "branch_point": {"color": _BLACK, "linestyle": "--", "linewidth": 1.5,
+                     "label": "branch point locus (divergence)"},
+    "fold": {"color": "grey", "linestyle": "-.", "linewidth": 1.5, "label": "fold locus (LP)"},
+    "fold_of_cycles": {"color": "orange", "linestyle": "-", "linewidth": 1.5,
+                       "label": "fold of cycles locus (LPC)"},
+    # the unsafe region
+    "unsafe": {"color": "red", "alpha": 0.5, "label": _UNSAFE_LABEL},
+}
+"""Stability-map style -> keyword arguments (``Line2D`` for lines, patch colour/alpha for the
+"linearly_unstable" shading and the "unsafe" polygons), including the legend ``label``. The
+locus entries are keyed by the kinds of :attr:`Boundary.loci`. Do not mutate."""
+_LOCUS_KINDS = ("hopf", "branch_point", "fold", "fold_of_cycles")
+_SLICE_TOLERANCE = 1e-12  # slice values equal within this are the same slice
+_BAND_ALPHA = 0.25  # unsafe bands of overhang diagrams
+_CASE_LABEL_GAP = 0.04  # least distance of case labels, in axes fractions
+_LIMIT_MARGIN = 0.02  # fraction of the data span added around loci-derived axis limits
+
 _PLOTTED_KINDS = (BranchKind.EQUILIBRIUM, BranchKind.PERIODIC)
-PLOT_KINDS = ("bifurcation", "linear", "projections", "period", "phase")
+PLOT_KINDS = ("bifurcation", "linear", "projections", "period", "phase", "boundary")
 """Kinds accepted by :func:`save_study_plots`."""
 _PERIOD_POINTS = (PointType.HB, PointType.LPC, PointType.PD, PointType.TR, PointType.BPC,
                   PointType.HOMOCLINIC, PointType.HETEROCLINIC)
@@ -135,6 +175,19 @@ def bifurcation_diagram(continuation: ContinuationResult, state: str = "theta",
     parameter keeps its SI unit. Draws on ``ax`` if given, else on a new figure; returns the
     figure. The legend lists only styles present; the title is the continuation's name.
     """
+    which, branches = _checked_branches(continuation, state, which)
+    if ax is None:
+        ax = _new_figure().add_subplot()
+    handles, labels = _draw_bifurcation(ax, continuation, branches, state, which, degrees)
+    if handles:
+        ax.legend(handles, labels, fontsize="small")
+    ax.set_title(continuation.name)
+    return ax.figure
+
+
+def _checked_branches(continuation: ContinuationResult, state: str, which: Sequence[str]
+                      ) -> tuple[tuple[str, ...], list[Branch]]:
+    """``which`` as a tuple and the plotted branches; WhirlError if either argument is bad."""
     which = tuple(which)
     if not which or not set(which) <= {"max", "min"}:
         raise WhirlError(f"which must be a non-empty subset of ('max', 'min'), got {which}")
@@ -143,19 +196,20 @@ def bifurcation_diagram(continuation: ContinuationResult, state: str = "theta",
         if state not in branch.state_names:
             raise WhirlError(f"state {state!r} not on branch {branch.name!r} "
                              f"(states: {', '.join(branch.state_names)})")
-    if ax is None:
-        ax = _new_figure().add_subplot()
+    return which, branches
+
+
+def _draw_bifurcation(ax: Axes, continuation: ContinuationResult, branches: list[Branch],
+                      state: str, which: tuple[str, ...], degrees: bool
+                      ) -> tuple[list, list[str]]:
+    """Branches, special points and axis labels of a bifurcation diagram; legend entries."""
     first: dict[str, object] = {}  # style -> first artist drawn with it (legend handle)
     for branch in branches:
         _draw_branch(ax, branch, state, which, degrees, first)
     _draw_special_points(ax, continuation, branches, state, degrees, first)
     _label_axes(ax, continuation, branches, state, which, degrees)
-    handles = [first[key] for key in PLOT_KEY if key in first]
-    if handles:
-        ax.legend(handles, [PLOT_KEY[key]["label"] for key in PLOT_KEY if key in first],
-                  fontsize="small")
-    ax.set_title(continuation.name)
-    return ax.figure
+    return ([first[key] for key in PLOT_KEY if key in first],
+            [str(PLOT_KEY[key]["label"]) for key in PLOT_KEY if key in first])
 
 
 def projections_figure(continuation: ContinuationResult, which: Sequence[str] = ("max",),
@@ -456,6 +510,229 @@ def _colours() -> Iterator[str]:
     return itertools.cycle(rcParams["axes.prop_cycle"].by_key().get("color", ["C0"]))
 
 
+def boundary_plot(boundary: Boundary | None, grid: LinearGrid | None,
+                  cases: Sequence[float] = (), ax: Axes | None = None) -> Figure:
+    """Stability map in two parameters (thesis figures 3.13, 3.15, 3.28, 3.29).
+
+    x is the first parameter of ``boundary`` (or ``grid.x_parameter``), y the second, both in
+    their own (SI) units. Drawn, styled after :data:`BOUNDARY_KEY`:
+
+    * from ``grid``: the linearly unstable region (``max_real`` > 0) shaded light grey and the
+      linear zero contour thin black, solid where the critical eigenvalue is complex (flutter),
+      dashed where it is real (divergence);
+    * from ``boundary``: its loci (Hopf solid dark blue, branch point dashed black, fold
+      dash-dot grey, fold of cycles solid orange; other kinds are not drawn) and the unsafe
+      (overhang) region, its polygons filled red;
+    * a thin dotted horizontal line at each value of ``cases`` (e.g. ``boundary.slices``),
+      labelled "case 1", "case 2", ... just right of the axes (labels only for lines within
+      the y limits, nudged up where they would overlap).
+
+    The legend lists only what is drawn. Axis limits are the grid's extent, else the extent of
+    the loci (or, without loci, of the polygons) plus a 2 % margin, else matplotlib's. A grid
+    over the same two parameters in the other order is transposed; over other parameters it is
+    a :class:`WhirlError`, as is passing neither. Title: ``boundary.name`` (else "linear
+    stability"). Draws on ``ax`` if given, else on a new figure; returns the figure.
+    """
+    if boundary is None and grid is None:
+        raise WhirlError("boundary_plot needs a boundary, a linear grid or both")
+    if boundary is not None and grid is not None:
+        oriented = _oriented_grid(grid, boundary.parameter_names)
+        if oriented is None:
+            raise WhirlError(f"linear grid over ({grid.x_parameter}, {grid.y_parameter}) does "
+                             f"not match boundary {boundary.name!r} over "
+                             f"({', '.join(boundary.parameter_names)})")
+        grid = oriented
+    if ax is None:
+        ax = _new_figure().add_subplot()
+    first: dict[str, object] = {}
+    if grid is not None:
+        _draw_grid(ax, grid, first)
+    if boundary is not None:
+        _draw_loci(ax, boundary, first)
+        for polygon in boundary.polygons:
+            polygon = np.asarray(polygon, dtype=float)
+            if len(polygon) >= 3:
+                style = dict(BOUNDARY_KEY["unsafe"], label="_unsafe")
+                (patch,) = ax.fill(polygon[:, 0], polygon[:, 1], **style, zorder=2)
+                first.setdefault("unsafe", patch)
+    _set_map_limits(ax, boundary, grid)
+    _draw_cases(ax, cases)
+    if boundary is not None:
+        names, units = boundary.parameter_names, boundary.parameter_units
+    else:
+        names, units = (grid.x_parameter, grid.y_parameter), (grid.x_unit, grid.y_unit)
+    ax.set_xlabel(axis_label(names[0], units[0]))
+    ax.set_ylabel(axis_label(names[1], units[1]))
+    if first:
+        ax.legend([first[key] for key in BOUNDARY_KEY if key in first],
+                  [str(BOUNDARY_KEY[key]["label"]) for key in BOUNDARY_KEY if key in first],
+                  fontsize="small")
+    ax.set_title(boundary.name if boundary is not None else "linear stability")
+    return ax.figure
+
+
+def _oriented_grid(grid: LinearGrid, names: Sequence[str]) -> LinearGrid | None:
+    """``grid`` with x = ``names[0]`` and y = ``names[1]`` (transposed if needed), else None."""
+    if (grid.x_parameter, grid.y_parameter) == tuple(names):
+        return grid
+    if (grid.y_parameter, grid.x_parameter) == tuple(names):
+        return LinearGrid(grid.y_parameter, grid.x_parameter, grid.y_unit, grid.x_unit,
+                          grid.y, grid.x, np.asarray(grid.max_real).T,
+                          np.asarray(grid.oscillatory).T,
+                          tuple(np.asarray(line)[:, ::-1] for line in grid.flutter),
+                          tuple(np.asarray(line)[:, ::-1] for line in grid.divergence))
+    return None
+
+
+def _draw_grid(ax: Axes, grid: LinearGrid, first: dict) -> None:
+    """Shade max_real > 0 (contourf, levels [0, inf]); draw the zero contour by kind."""
+    max_real = np.ma.masked_invalid(np.asarray(grid.max_real, dtype=float))
+    if np.ma.any(max_real > 0):
+        style = BOUNDARY_KEY["linearly_unstable"]
+        ax.contourf(grid.x, grid.y, max_real, levels=[0.0, np.inf], colors=[style["color"]],
+                    zorder=0)
+        first["linearly_unstable"] = _patch_proxy(style)
+    for key, lines in (("linear_flutter", grid.flutter), ("linear_divergence", grid.divergence)):
+        for line in lines:
+            _plot_polyline(ax, line, key, first, zorder=1)
+
+
+def _patch_proxy(style: dict[str, object]):
+    """A legend handle for a filled area of ``style``'s colour (and alpha)."""
+    from matplotlib.patches import Patch
+
+    return Patch(facecolor=style["color"], alpha=style.get("alpha"), label=style["label"])
+
+
+def _plot_polyline(ax: Axes, line: np.ndarray, key: str, first: dict, zorder: float) -> None:
+    """Draw a (K, 2) polyline with ``BOUNDARY_KEY[key]`` (nothing if it has < 2 points)."""
+    line = np.asarray(line, dtype=float)
+    if line.ndim != 2 or len(line) < 2:
+        return
+    kwargs = dict(BOUNDARY_KEY[key], label=f"_{key}")
+    (artist,) = ax.plot(line[:, 0], line[:, 1], **kwargs, zorder=zorder)
+    first.setdefault(key, artist)
+
+
+def _draw_loci(ax: Axes, boundary: Boundary, first: dict) -> None:
+    """The boundary's loci, kinds in the order of :data:`BOUNDARY_KEY`."""
+    for kind in _LOCUS_KINDS:
+        for locus_kind, curve in boundary.loci.values():
+            if locus_kind == kind:
+                _plot_polyline(ax, curve, kind, first, zorder=3)
+
+
+def _set_map_limits(ax: Axes, boundary: Boundary | None, grid: LinearGrid | None) -> None:
+    """Grid extent; else loci extent (polygons if no loci) with a margin; else leave as is."""
+    if grid is not None and len(grid.x) and len(grid.y):
+        ax.set_xlim(float(np.min(grid.x)), float(np.max(grid.x)))
+        ax.set_ylim(float(np.min(grid.y)), float(np.max(grid.y)))
+        return
+    if boundary is None:
+        return
+    curves = [np.asarray(c, dtype=float) for kind, c in boundary.loci.values()
+              if kind in _LOCUS_KINDS]
+    if not any(c.ndim == 2 and len(c) >= 2 for c in curves):
+        curves = [np.asarray(p, dtype=float) for p in boundary.polygons]
+    points = [c for c in curves if c.ndim == 2 and c.shape[1] == 2 and len(c)]
+    if not points:
+        return
+    xy = np.concatenate(points)
+    xy = xy[np.isfinite(xy).all(axis=1)]
+    if not len(xy):
+        return
+    for setter, low, high in ((ax.set_xlim, xy[:, 0].min(), xy[:, 0].max()),
+                              (ax.set_ylim, xy[:, 1].min(), xy[:, 1].max())):
+        pad = _LIMIT_MARGIN * (high - low)
+        if pad > 0:
+            setter(float(low - pad), float(high + pad))
+
+
+def _draw_cases(ax: Axes, cases: Sequence[float]) -> None:
+    """Dotted horizontal lines at the case values, labelled "case k" right of the axes."""
+    for k, value in enumerate(cases, 1):
+        ax.axhline(float(value), color=_BLACK, linestyle=":", linewidth=0.8, zorder=1,
+                   label=f"_case {k}")
+    bottom, top = ax.get_ylim()
+    low, high = sorted((bottom, top))
+    shown = sorted(((float(v) - bottom) / (top - bottom) if top != bottom else 0.5, k)
+                   for k, v in enumerate(cases, 1) if low <= float(v) <= high)
+    position = -np.inf
+    for fraction, k in shown:  # in axes fractions, pushed up to keep close labels apart
+        position = max(fraction, position + _CASE_LABEL_GAP)
+        ax.text(1.01, position, f"case {k}", transform=ax.transAxes, ha="left", va="center",
+                fontsize="small")
+
+
+def slice_continuation(continuation: ContinuationResult, index: int) -> ContinuationResult:
+    """The one-parameter continuation of slice ``index`` of a two-parameter continuation.
+
+    Its branches are those named ``slice_<index>.<branch>``, renamed ``<branch>``, and its
+    special points those on them (branch renamed likewise). Named
+    ``<continuation>.slice_<index>``, kind "one-parameter"."""
+    prefix = f"slice_{index}."
+    branches = tuple(replace(b, name=b.name[len(prefix):]) for b in continuation.branches
+                     if b.name.startswith(prefix))
+    points = tuple(replace(p, branch=p.branch[len(prefix):]) for p in continuation.special_points
+                   if p.branch.startswith(prefix))
+    return ContinuationResult(f"{continuation.name}.slice_{index}", "one-parameter", branches,
+                              points)
+
+
+def slice_index(boundary: Boundary, slice_value: float) -> int:
+    """Index of ``slice_value`` in ``boundary.slices`` (equal within 1e-12); WhirlError if
+    absent."""
+    for k, value in enumerate(boundary.slices):
+        if abs(float(value) - float(slice_value)) <= _SLICE_TOLERANCE:
+            return k
+    raise WhirlError(f"{slice_value!r} is not a slice of boundary {boundary.name!r} "
+                     f"(slices: {list(boundary.slices)})")
+
+
+def overhang_diagram(continuation: ContinuationResult, boundary: Boundary | None,
+                     slice_value: float, state: str = "theta", which: Sequence[str] = ("max",),
+                     ax: Axes | None = None, degrees: bool = True) -> Figure:
+    """Bifurcation diagram of one slice with its unsafe (overhang) intervals shaded.
+
+    For a two-parameter ``continuation`` the diagram is :func:`bifurcation_diagram` of
+    :func:`slice_continuation` at the index of ``slice_value`` in ``boundary.slices`` (a
+    ``boundary`` is then required); a one-parameter continuation is drawn as it is. Every
+    interval of ``boundary.intervals`` on this slice (``slice_value`` equal within 1e-12) is a
+    red vertical band (alpha 0.25) from ``lower`` to ``upper``, with one legend entry
+    "unsafe (overhang)". ``state``, ``which``, ``degrees`` and ``ax`` as in
+    :func:`bifurcation_diagram`. Title: ``"<continuation>: <second parameter> = <value>"``
+    (just the continuation's name without a boundary). Returns the figure.
+    """
+    if continuation.kind == "two-parameter":
+        if boundary is None:
+            raise WhirlError(f"continuation {continuation.name!r} is two-parameter: an "
+                             "overhang diagram needs its boundary to find the slice")
+        diagram = slice_continuation(continuation, slice_index(boundary, slice_value))
+    else:
+        diagram = continuation
+    which, branches = _checked_branches(diagram, state, which)
+    if ax is None:
+        ax = _new_figure().add_subplot()
+    handles, labels = _draw_bifurcation(ax, diagram, branches, state, which, degrees)
+    band = None
+    intervals = () if boundary is None else boundary.intervals
+    for interval in intervals:
+        if abs(float(interval.slice_value) - float(slice_value)) <= _SLICE_TOLERANCE:
+            span = ax.axvspan(float(interval.lower), float(interval.upper), color="red",
+                              alpha=_BAND_ALPHA, linewidth=0, zorder=0, label="_unsafe")
+            band = band or span
+    if band is not None:
+        handles.append(band)
+        labels.append(_UNSAFE_LABEL)
+    if handles:
+        ax.legend(handles, labels, fontsize="small")
+    title = continuation.name
+    if boundary is not None:
+        title += f": {boundary.parameter_names[1]} = {float(slice_value):g}"
+    ax.set_title(title)
+    return ax.figure
+
+
 def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path, stem: str,
                      state: str = "theta", dpi: int = 150) -> list[Path]:
     """Write a study's figures as PNG files into ``out_dir``; return the paths, sorted.
@@ -471,7 +748,13 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
       (:func:`period_plot`);
     * "phase" -> ``<stem>_<continuation>_<branch>_phase.png`` per periodic branch with stored
       orbits (:func:`phase_plane`, psi vs theta, or the branch's first two states);
-    * "linear" -> ``<stem>_linear_<parameter>.png`` per linear sweep.
+    * "linear" -> ``<stem>_linear_<parameter>.png`` per linear sweep;
+    * "boundary" -> per boundary of ``result.boundaries``: ``<stem>_<boundary>_boundary.png``
+      (:func:`boundary_plot` with ``result.linear_grid`` if it is over the same parameters, the
+      slices as cases) and ``<stem>_<boundary>_slice_<k>_overhang.png`` per slice k
+      (:func:`overhang_diagram` of the two-parameter continuation named like the boundary, or
+      of no branches if there is none); without boundaries but with a linear grid,
+      ``<stem>_linear_grid.png`` (the grid alone).
 
     Names are made filesystem-safe; repeats get ``_2``, ``_3``, ... Each file is written
     under a temporary name in ``out_dir`` and moved into place, so none is ever half-written.
@@ -522,6 +805,32 @@ def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: 
         for sweep in result.linear_sweeps:
             jobs.append((f"{stem}_linear_{sweep.parameter}.png",
                          lambda s=sweep: linear_sweep_plot(s)))
+    if "boundary" in kinds:
+        jobs += _boundary_jobs(result, stem, state)
+    return jobs
+
+
+def _boundary_jobs(result: StudyResult, stem: str, state: str):
+    """(file name, figure factory) pairs of the "boundary" kind."""
+    grid = result.linear_grid
+    if not result.boundaries:
+        if grid is None:
+            return []
+        return [(f"{stem}_linear_grid.png", lambda: boundary_plot(None, grid))]
+    jobs = []
+    for boundary in result.boundaries:
+        matched = None if grid is None else _oriented_grid(grid, boundary.parameter_names)
+        jobs.append((f"{stem}_{boundary.name}_boundary.png",
+                     lambda b=boundary, g=matched: boundary_plot(b, g, cases=b.slices)))
+        continuation = next((c for c in result.continuations if c.name == boundary.name
+                             and c.kind == "two-parameter"),
+                            ContinuationResult(boundary.name, "one-parameter", (), ()))
+        for k, value in enumerate(boundary.slices):
+            chosen = (_state_for(slice_continuation(continuation, k), state)
+                      if continuation.kind == "two-parameter" else state)
+            jobs.append((f"{stem}_{boundary.name}_slice_{k}_overhang.png",
+                         lambda c=continuation, b=boundary, v=value, s=chosen:
+                         overhang_diagram(c, b, v, state=s)))
     return jobs
 
 

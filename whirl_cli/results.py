@@ -204,6 +204,59 @@ class LinearSweep:
 
 
 @dataclass(frozen=True)
+class LinearGrid:
+    """Linear stability over a grid of two parameters (Nx x Ny points).
+
+    ``max_real``: (Ny, Nx) largest real part of the eigenvalues [1/s] (> 0: unstable);
+    ``oscillatory``: (Ny, Nx) True where that eigenvalue is complex (flutter), False where it
+    is real (divergence). ``flutter`` and ``divergence``: the zero contour of ``max_real`` as
+    polylines (K, 2) in (x, y), split by the kind of the critical eigenvalue along it.
+    """
+
+    x_parameter: str
+    y_parameter: str
+    x_unit: str
+    y_unit: str
+    x: np.ndarray
+    y: np.ndarray
+    max_real: np.ndarray
+    oscillatory: np.ndarray
+    flutter: tuple[np.ndarray, ...]
+    divergence: tuple[np.ndarray, ...]
+
+
+@dataclass(frozen=True)
+class UnsafeInterval:
+    """Where, on one slice (second parameter = ``slice_value``), the first parameter lies in
+    the unsafe region: linearly stable, yet flutter (``cause`` "flutter") or divergence
+    ("divergence") exists for ``lower`` < first < ``upper``."""
+
+    slice_value: float
+    lower: float
+    upper: float
+    cause: str
+
+
+@dataclass(frozen=True)
+class Boundary:
+    """The stability boundary and unsafe region of a two-parameter continuation.
+
+    ``loci``: name -> (kind, curve (K, 2) in (first, second)); kinds hopf, branch_point, fold,
+    fold_of_cycles. ``polygons``: closed (K, 2) outlines of the unsafe region. ``intervals``:
+    the unsafe intervals per slice (``method`` "loci" or "slices" says how they were found).
+    """
+
+    name: str
+    parameter_names: tuple[str, str]
+    parameter_units: tuple[str, str]
+    method: str
+    loci: dict[str, tuple[str, np.ndarray]]
+    intervals: tuple[UnsafeInterval, ...]
+    polygons: tuple[np.ndarray, ...]
+    slices: tuple[float, ...]
+
+
+@dataclass(frozen=True)
 class RunRecord:
     """Bookkeeping of one AUTO run, stored under /runs."""
 
@@ -255,3 +308,5 @@ class StudyResult:
     linear_sweeps: tuple[LinearSweep, ...]
     runs: tuple[RunRecord, ...]
     attributes: dict = field(default_factory=dict)  # provenance (versions, study text, hash)
+    boundaries: tuple[Boundary, ...] = ()
+    linear_grid: LinearGrid | None = None

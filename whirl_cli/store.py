@@ -22,11 +22,18 @@ Layout (units in a ``units`` attribute on every physical dataset)::
                                     passed
     /linear/sweeps/<parameter>/     values, eigenvalues [1/s], damping_ratio, frequency [rad/s],
                                     whirl (FW | BW | --)
+    /linear/grid/                   x, y, max_real (Ny, Nx) [1/s], oscillatory (Ny, Nx),
+                                    flutter/line_<k>, divergence/line_<k> (K, 2): zero contour
+    /boundaries/<name>/             attrs: parameters, units, method (loci | slices), slices
+        loci/<branch>               (K, 2) locus curve in the two parameters; attrs kind
+        unsafe/polygon_<k>          (K, 2) closed outline of the unsafe region
+        unsafe_intervals/           slice_value, lower, upper, cause (flutter | divergence)
     /runs/<run>                     attrs: status, message, constants, returncode,
                                            wall_seconds, n_points
 
-The file is written to a temporary name in the output directory and renamed into place, so an
-output path never holds a partial file.
+The file is built in memory, written to an unnamed file in the output directory (O_TMPFILE)
+and linked into place, so an output path never holds a partial file and an interrupted write
+(even SIGKILL) leaves no temporary file; an existing file is only replaced with ``overwrite``.
 """
 
 from __future__ import annotations
@@ -39,15 +46,18 @@ import numpy as np
 
 from .errors import OutputError
 from .results import (
+    Boundary,
     Branch,
     BranchKind,
     ContinuationResult,
     CrossCheck,
+    LinearGrid,
     LinearSweep,
     Orbit,
     RunRecord,
     SpecialPoint,
     StudyResult,
+    UnsafeInterval,
 )
 
 SCHEMA = 1
@@ -61,7 +71,8 @@ def _strings(values) -> np.ndarray:
 def _write_branch(group: h5py.Group, branch: Branch) -> None:
     group.attrs.update(kind=branch.kind, origin=branch.origin, status=branch.status,
                        message=branch.message, run=branch.run, end=branch.end)
-    params = group.create_dataset("parameters", data=branch.parameters.reshape(len(branch), -1))
+    params = group.create_dataset("parameters", data=np.reshape(
+        branch.parameters, (len(branch), len(branch.parameter_names))))
     params.attrs.update(names=list(branch.parameter_names), units=list(branch.parameter_units))
     for key in ("state_max", "state_min"):
         data = group.create_dataset(key, data=getattr(branch, key))
@@ -125,6 +136,59 @@ def _read_cross_checks(group: h5py.Group) -> tuple[CrossCheck, ...]:
         for k in range(len(columns["index"])))
 
 
+def _write_boundary(group: h5py.Group, boundary: Boundary) -> None:
+    group.attrs.update(parameters=list(boundary.parameter_names),
+                       units=list(boundary.parameter_units), method=boundary.method,
+                       slices=np.array(boundary.slices, dtype=float))
+    for name, (kind, curve) in sorted(boundary.loci.items()):
+        data = group.create_dataset(f"loci/{name}", data=curve.reshape(-1, 2))
+        data.attrs["kind"] = kind
+    for k, polygon in enumerate(boundary.polygons):
+        group.create_dataset(f"unsafe/polygon_{k}", data=polygon)
+    table = group.create_group("unsafe_intervals")
+    rows = boundary.intervals
+    for key in ("slice_value", "lower", "upper"):
+        table.create_dataset(key, data=np.array([getattr(r, key) for r in rows], dtype=float))
+    table.create_dataset("cause", data=_strings(r.cause for r in rows), dtype=_STR)
+
+
+def _read_boundary(name: str, group: h5py.Group) -> Boundary:
+    loci = {key: (_text(data.attrs["kind"]), data[()])
+            for key, data in group.get("loci", {}).items()}
+    polygons = tuple(group["unsafe"][key][()] for key in sorted(
+        group.get("unsafe", {}), key=lambda k: int(k.rsplit("_", 1)[1])))
+    table = group["unsafe_intervals"]
+    intervals = tuple(
+        UnsafeInterval(float(v), float(lo), float(hi), _text(c)) for v, lo, hi, c in zip(
+            table["slice_value"][()], table["lower"][()], table["upper"][()],
+            table["cause"][()], strict=True))
+    return Boundary(name, _texts(group.attrs["parameters"]), _texts(group.attrs["units"]),
+                    _text(group.attrs["method"]), loci, intervals, polygons,
+                    tuple(float(v) for v in group.attrs["slices"]))
+
+
+def _write_grid(group: h5py.Group, grid: LinearGrid) -> None:
+    group.attrs.update(x_parameter=grid.x_parameter, y_parameter=grid.y_parameter)
+    group.create_dataset("x", data=grid.x).attrs["units"] = grid.x_unit
+    group.create_dataset("y", data=grid.y).attrs["units"] = grid.y_unit
+    group.create_dataset("max_real", data=grid.max_real).attrs["units"] = "1/s"
+    group.create_dataset("oscillatory", data=grid.oscillatory)
+    for kind in ("flutter", "divergence"):
+        for k, line in enumerate(getattr(grid, kind)):
+            group.create_dataset(f"{kind}/line_{k}", data=line)
+
+
+def _read_grid(group: h5py.Group) -> LinearGrid:
+    def lines(kind: str) -> tuple[np.ndarray, ...]:
+        found = group.get(kind, {})
+        return tuple(found[k][()] for k in sorted(found, key=lambda k: int(k.split("_")[1])))
+
+    return LinearGrid(_text(group.attrs["x_parameter"]), _text(group.attrs["y_parameter"]),
+                      _text(group["x"].attrs["units"]), _text(group["y"].attrs["units"]),
+                      group["x"][()], group["y"][()], group["max_real"][()],
+                      group["oscillatory"][()], lines("flutter"), lines("divergence"))
+
+
 def _write_sweep(group: h5py.Group, sweep: LinearSweep) -> None:
     group.attrs["parameter"] = sweep.parameter
     group.create_dataset("values", data=sweep.values).attrs["units"] = sweep.unit
@@ -135,47 +199,152 @@ def _write_sweep(group: h5py.Group, sweep: LinearSweep) -> None:
 
 
 def write(result: StudyResult, path: Path, overwrite: bool = False) -> Path:
-    """Write ``result`` to ``path`` atomically; refuses to replace a file unless ``overwrite``."""
+    """Write ``result`` to ``path`` atomically; refuses to replace a file unless ``overwrite``.
+
+    The file is built in memory and appears at ``path`` complete or not at all: it is written to
+    an unnamed file in the output directory (Linux ``O_TMPFILE``) and linked into place, so even
+    SIGKILL leaves no partial file and no temporary file behind. Without ``overwrite`` the link
+    fails if ``path`` exists (also if it appeared meanwhile); with it, the new file is renamed
+    over the old one. Where ``O_TMPFILE`` is unavailable a hidden named temporary is used.
+    """
     path = Path(path)
     if path.exists() and not overwrite:
         raise OutputError(f"{path}: output exists; pass --overwrite to replace it")
     if not path.parent.is_dir():
         raise OutputError(f"{path}: the output directory {path.parent} does not exist")
-    temporary = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    image = _image(result)
     try:
-        with h5py.File(temporary, "w") as handle:
-            handle.attrs["whirl_schema"] = SCHEMA
-            for key, value in sorted(result.attributes.items()):
-                handle.attrs[key] = value
-            handle.attrs["study_name"] = result.study_name
-            handle.attrs["model"] = result.model
-            for continuation in result.continuations:
-                group = handle.create_group(f"continuations/{continuation.name}")
-                group.attrs["kind"] = continuation.kind
-                n_states = len(continuation.branches[0].state_names) if continuation.branches \
-                    else 0
-                for branch in continuation.branches:
-                    _write_branch(group.create_group(f"branches/{branch.name}"), branch)
-                _write_special_points(group.create_group("special_points"),
-                                      continuation.special_points, n_states)
-                if continuation.cross_checks:
-                    _write_cross_checks(group.create_group("cross_checks"),
-                                        continuation.cross_checks)
-            for sweep in result.linear_sweeps:
-                _write_sweep(handle.create_group(f"linear/sweeps/{sweep.parameter}"), sweep)
-            runs = handle.create_group("runs")
-            for record in result.runs:
-                runs.create_group(record.name).attrs.update(
-                    status=record.status, message=record.message, constants=record.constants,
-                    returncode=record.returncode, wall_seconds=record.wall_seconds,
-                    n_points=record.n_points)
-            handle.flush()
-            os.fsync(handle.id.get_vfd_handle())
-        os.replace(temporary, path)
-    except BaseException:
-        temporary.unlink(missing_ok=True)
-        raise
+        _publish(image, path, overwrite)
+    except OSError as error:
+        raise OutputError(f"{path}: cannot write the output ({error.strerror or error})") from None
     return path
+
+
+def publish(data: bytes, path: Path, overwrite: bool = False) -> Path:
+    """Write ``data`` (e.g. a PNG rendered to memory) to ``path`` the way :func:`write` writes
+    result files: complete or not at all, no temporary file left even by SIGKILL."""
+    path = Path(path)
+    try:
+        _publish(data, path, overwrite)
+    except OSError as error:
+        raise OutputError(f"{path}: cannot write ({error.strerror or error})") from None
+    return path
+
+
+def _image(result: StudyResult) -> bytes:
+    """The complete HDF5 file of ``result``, built in memory (never touches the disk)."""
+    with h5py.File(f"whirl-{os.getpid()}-{id(result)}.h5", "w", driver="core",
+                   backing_store=False) as handle:
+        handle.attrs["whirl_schema"] = SCHEMA
+        for key, value in sorted(result.attributes.items()):
+            handle.attrs[key] = value
+        handle.attrs["study_name"] = result.study_name
+        handle.attrs["model"] = result.model
+        for continuation in result.continuations:
+            group = handle.create_group(f"continuations/{continuation.name}")
+            group.attrs["kind"] = continuation.kind
+            n_states = len(continuation.branches[0].state_names) if continuation.branches \
+                else 0
+            for branch in continuation.branches:
+                _write_branch(group.create_group(f"branches/{branch.name}"), branch)
+            _write_special_points(group.create_group("special_points"),
+                                  continuation.special_points, n_states)
+            if continuation.cross_checks:
+                _write_cross_checks(group.create_group("cross_checks"),
+                                    continuation.cross_checks)
+        for sweep in result.linear_sweeps:
+            _write_sweep(handle.create_group(f"linear/sweeps/{sweep.parameter}"), sweep)
+        if result.linear_grid is not None:
+            _write_grid(handle.create_group("linear/grid"), result.linear_grid)
+        for boundary in result.boundaries:
+            _write_boundary(handle.create_group(f"boundaries/{boundary.name}"), boundary)
+        runs = handle.create_group("runs")
+        for record in result.runs:
+            runs.create_group(record.name).attrs.update(
+                status=record.status, message=record.message, constants=record.constants,
+                returncode=record.returncode, wall_seconds=record.wall_seconds,
+                n_points=record.n_points)
+        handle.flush()
+        return handle.id.get_file_image()
+
+
+def _publish(image: bytes, path: Path, overwrite: bool) -> None:
+    """Make ``image`` the file at ``path`` in one step (see :func:`write`)."""
+    directory = os.open(path.parent, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
+    try:
+        fd = None
+        if os.path.isdir("/proc/self/fd"):  # the unnamed file is linked through /proc
+            try:
+                fd = os.open(path.parent, os.O_TMPFILE | os.O_WRONLY | os.O_CLOEXEC, 0o666)
+            except (AttributeError, OSError):  # not Linux, or a file system without O_TMPFILE
+                fd = None
+        if fd is None:
+            _publish_named(image, path, overwrite, directory)
+        else:
+            try:
+                _write_all(fd, image)
+                _link_unnamed(fd, path, overwrite, directory)
+            finally:
+                os.close(fd)
+        try:
+            os.fsync(directory)  # the new name survives a power cut
+        except OSError:  # some file systems cannot sync a directory; the file is in place
+            pass
+    finally:
+        os.close(directory)
+
+
+def _write_all(fd: int, data: bytes) -> None:
+    view = memoryview(data)
+    while view:
+        view = view[os.write(fd, view):]
+    os.fsync(fd)
+
+
+def _exists_error(path: Path) -> OutputError:
+    return OutputError(f"{path}: output exists; pass --overwrite to replace it")
+
+
+def _link_unnamed(fd: int, path: Path, overwrite: bool, directory: int) -> None:
+    """Give the O_TMPFILE file ``fd`` the name ``path`` (through /proc/self/fd)."""
+    source = f"/proc/self/fd/{fd}"
+    if not overwrite:
+        try:
+            os.link(source, path.name, dst_dir_fd=directory, follow_symlinks=True)
+        except FileExistsError:
+            raise _exists_error(path) from None
+        return
+    temporary = f".{path.name}.tmp-{os.getpid()}"
+    os.link(source, temporary, dst_dir_fd=directory, follow_symlinks=True)
+    try:
+        os.replace(temporary, path.name, src_dir_fd=directory, dst_dir_fd=directory)
+    except BaseException:
+        os.unlink(temporary, dir_fd=directory)
+        raise
+
+
+def _publish_named(image: bytes, path: Path, overwrite: bool, directory: int) -> None:
+    """Fallback without O_TMPFILE: a hidden temporary next to ``path``, renamed into place."""
+    temporary = f".{path.name}.tmp-{os.getpid()}"
+    fd = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o666,
+                 dir_fd=directory)
+    try:
+        try:
+            _write_all(fd, image)
+        finally:
+            os.close(fd)
+        if overwrite:
+            os.replace(temporary, path.name, src_dir_fd=directory, dst_dir_fd=directory)
+        else:
+            try:
+                os.link(temporary, path.name, src_dir_fd=directory, dst_dir_fd=directory)
+            except FileExistsError:
+                raise _exists_error(path) from None
+    finally:
+        try:
+            os.unlink(temporary, dir_fd=directory)
+        except FileNotFoundError:
+            pass
 
 
 # ----------------------------------------------------------------------------------- reading
@@ -256,8 +425,12 @@ def read(path: Path) -> StudyResult:
                       _text(g.attrs["constants"]), int(g.attrs["returncode"]),
                       float(g.attrs["wall_seconds"]), int(g.attrs["n_points"]))
             for name, g in handle.get("runs", {}).items())
+        grid = _read_grid(handle["linear/grid"]) if "linear/grid" in handle else None
+        boundaries = tuple(_read_boundary(name, group)
+                           for name, group in handle.get("boundaries", {}).items())
         skip = {"whirl_schema", "study_name", "model"}
         attributes = {k: (_text(v) if isinstance(v, bytes | str) else v)
                       for k, v in handle.attrs.items() if k not in skip}
         return StudyResult(_text(handle.attrs["study_name"]), _text(handle.attrs["model"]),
-                           tuple(continuations), tuple(sweeps), runs, attributes)
+                           tuple(continuations), tuple(sweeps), runs, attributes, boundaries,
+                           grid)

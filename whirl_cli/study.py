@@ -76,6 +76,10 @@ MAX_BYTES = 1 << 20
 #: Deepest nesting of YAML lists and mappings accepted (a study needs 5).
 MAX_DEPTH = 32
 NAME_MAX = 64
+#: Largest integer AUTO-07p reads into its (32-bit) INTEGER constants (NMX, NTST, ITNW).
+FORTRAN_INT_MAX = 2**31 - 1
+#: Most values in ``orbits_at``: AUTO reads at most 2048 characters per constants line (UZR).
+ORBITS_MAX = 64
 _NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
 _NAME_REASON = (
     "expected letters, digits, '_', '.', '-' (starting with a letter or digit), got {got}"
@@ -221,7 +225,17 @@ def _as_range(value: Any) -> tuple[float, float]:
     bounds = [_finite(v) for v in value] if isinstance(value, list | tuple) else []
     if len(bounds) != 2 or None in bounds or not bounds[0] < bounds[1]:
         _fail("expected [lower, upper] with lower < upper, got {value}")
-    return bounds[0], bounds[1]
+    lower, upper = bounds
+    if not (math.isfinite(upper - lower) and math.isfinite(lower - (upper - lower))
+            and math.isfinite(upper + (upper - lower))):  # AUTO's bounds lie 5 % beyond
+        _fail("the range is too wide: its width overflows double precision, got {value}")
+    return lower, upper
+
+
+def _at_most_orbits(values: tuple) -> tuple:
+    if len(values) > ORBITS_MAX:
+        _fail(f"at most {ORBITS_MAX} values, got {len(values)}")
+    return values
 
 
 def _as_model_family(value: str) -> str:
@@ -319,7 +333,7 @@ class OneParameterContinuation(_Strict):
     branch_points: Boolean = Field(
         True, description="Switch at branch points (pitchforks) to follow secondary equilibria."
     )
-    orbits_at: tuple[Number, ...] = Field(
+    orbits_at: Annotated[tuple[Number, ...], AfterValidator(_at_most_orbits)] = Field(
         (),
         description="Parameter values (in its unit) at which every branch stores a labelled "
         "solution: orbit profiles for phase-plane plots (AUTO UZR).",
@@ -334,6 +348,67 @@ class OneParameterContinuation(_Strict):
         return study.parameter_values().get(name, variant.defaults()[name])
 
 
+LocusKind = Literal["hopf", "branch_point", "fold", "fold_of_cycles"]
+
+
+class TwoParameterContinuation(_Strict):
+    """Loci of Hopf points, branch points, folds and folds of cycles in two parameters, the
+    stability boundary they draw and the unsafe (overhang) region.
+
+    After validation ``parameters`` are canonical names and ``start`` and ``slices`` are filled;
+    ``bounds(model)`` gives ``range`` by canonical names.
+    """
+
+    name: Name = Field(
+        description="Run name, unique within the study (same characters as the study name)."
+    )
+    type: Literal["two-parameter"] = Field(
+        description="`two-parameter`: loci of special points in two parameters."
+    )
+    parameters: tuple[Text, Text] = Field(
+        description="[first, second]: the first is continued along each slice of the second; "
+        "both are free on the loci (names or aliases, stored canonical)."
+    )
+    range: dict[str, Range] = Field(
+        description="{first: [lower, upper], second: [lower, upper]}: the region, in the "
+        "parameters' units; loci stop at its edges."
+    )
+    start: Number | None = Field(
+        None,
+        description="Starting value of the first parameter for the one-parameter runs; unset: "
+        "its study value.",
+    )
+    slices: tuple[Number, ...] = Field(
+        (),
+        description="Values of the second parameter at which one-parameter runs find the "
+        "special points the loci start from, and at which unsafe intervals are reported; "
+        "unset: its study value.",
+    )
+    loci: tuple[LocusKind, ...] = Field(
+        ("hopf", "branch_point", "fold", "fold_of_cycles"),
+        description="Which loci to continue: `hopf`, `branch_point` (pitchfork), `fold` (of "
+        "equilibria), `fold_of_cycles` (needs the periodic branches, computed for it).",
+    )
+    method: Literal["loci", "slices"] = Field(
+        "loci",
+        description="How the unsafe region is drawn: `loci` (between the Hopf and fold-of-cycles "
+        "loci, and between the pitchfork and fold loci) or `slices` (the thesis' method: from "
+        "one-parameter runs with periodic branches at every slice).",
+    )
+    resolution: Annotated[Integer, _bound(">=", 3), _bound("<=", 2001)] = Field(
+        101, description="Rows across the second parameter's range for the unsafe polygons."
+    )
+
+    def bounds(self, model: Model) -> dict[str, tuple[float, float]]:
+        """``range`` keyed by canonical parameter names."""
+        return {model.canonical(key): tuple(value) for key, value in self.range.items()}
+
+
+PlotKind = Literal["bifurcation", "linear", "projections", "period", "phase", "boundary"]
+Continuation = Annotated[OneParameterContinuation | TwoParameterContinuation,
+                        Field(discriminator="type")]
+
+
 class LinearSweepSpec(_Strict):
     """Eigenvalues along one parameter, on an even grid."""
 
@@ -346,18 +421,30 @@ class LinearSweepSpec(_Strict):
     )
 
 
+class LinearGridSpec(_Strict):
+    """Linear stability over a grid of two parameters."""
+
+    x: LinearSweepSpec = Field(description="First grid axis: parameter, range, points.")
+    y: LinearSweepSpec = Field(description="Second grid axis: parameter, range, points.")
+
+
 class LinearSpec(_Strict):
     """Linear (eigenvalue) analysis, done with numpy, without AUTO."""
 
     sweeps: tuple[LinearSweepSpec, ...] = Field(
         (), description="Eigenvalue sweeps (damping ratio, frequency, whirl direction)."
     )
+    grid: LinearGridSpec | None = Field(
+        None,
+        description="Max real part of the eigenvalues of y = 0 over a grid, with its zero "
+        "contour split into flutter and divergence parts; unset: none.",
+    )
 
 
 class AutoSettings(_Strict):
     """AUTO-07p settings under readable names; unset ones use whirl's defaults."""
 
-    max_steps: Annotated[Integer, _bound(">=", 1)] | None = Field(
+    max_steps: Annotated[Integer, _bound(">=", 1), _bound("<=", FORTRAN_INT_MAX)] | None = Field(
         None, description="Maximum continuation steps per run (AUTO NMX), >= 1."
     )
     step_initial: Positive | None = Field(
@@ -369,13 +456,15 @@ class AutoSettings(_Strict):
     step_max: Positive | None = Field(
         None, description="Largest step (AUTO DSMAX), fraction of the range width, > 0."
     )
-    mesh_intervals: Annotated[Integer, _bound(">=", 2)] | None = Field(
+    mesh_intervals: Annotated[
+        Integer, _bound(">=", 2), _bound("<=", FORTRAN_INT_MAX)] | None = Field(
         None, description="Mesh intervals for periodic orbits (AUTO NTST), >= 2."
     )
     collocation_points: Annotated[Integer, _bound(">=", 2), _bound("<=", 7)] | None = Field(
         None, description="Collocation points per mesh interval (AUTO NCOL), 2 to 7."
     )
-    newton_max_iterations: Annotated[Integer, _bound(">=", 1)] | None = Field(
+    newton_max_iterations: Annotated[
+        Integer, _bound(">=", 1), _bound("<=", FORTRAN_INT_MAX)] | None = Field(
         None, description="Maximum Newton iterations per step (AUTO ITNW), >= 1."
     )
     tolerance: Positive | None = Field(
@@ -406,13 +495,13 @@ class Study(_Strict):
         discriminator="type",
         description="Structural stiffness law on one degree of freedom.",
     )
-    continuations: tuple[OneParameterContinuation, ...] = Field(
+    continuations: tuple[Continuation, ...] = Field(
         (), description="AUTO-07p continuation runs, in order."
     )
     linear: LinearSpec | None = Field(
         None, description="Linear (eigenvalue) analysis without AUTO; unset: none."
     )
-    plots: tuple[Literal["bifurcation", "linear", "projections", "period", "phase"], ...] = Field(
+    plots: tuple[PlotKind, ...] = Field(
         ("bifurcation",), description="Figures drawn after the runs."
     )
     cross_check: Boolean = Field(
@@ -509,11 +598,35 @@ def _resolved(data: dict) -> dict:
     if isinstance(linear, dict) and isinstance(linear.get("sweeps"), list | tuple):
         sweeps = [_resolved_item(s, variant, None) for s in linear["sweeps"]]
         data["linear"] = {**linear, "sweeps": sweeps}
+    linear = data.get("linear")
+    if isinstance(linear, dict) and isinstance(linear.get("grid"), dict):
+        grid = {k: _resolved_item(v, variant, None) for k, v in linear["grid"].items()}
+        data["linear"] = {**linear, "grid": grid}
     return data
+
+
+def _resolved_pair(item: dict, variant: Model, values: dict[str, float] | None) -> dict:
+    """A two-parameter continuation with canonical parameter names, ``start`` and ``slices``
+    filled; the keys of ``range`` stay as written (see ``TwoParameterContinuation.bounds``)."""
+    pair = item.get("parameters")
+    known = variant.known_parameter_names()
+    if not (isinstance(pair, list | tuple) and len(pair) == 2
+            and all(isinstance(p, str) and p in known for p in pair)):
+        return item
+    first, second = (variant.canonical(p) for p in pair)
+    item = {**item, "parameters": [first, second]}  # range keys stay as written (line numbers)
+    if values is not None:
+        if item.get("start") is None:
+            item["start"] = values[first]
+        if not item.get("slices"):
+            item["slices"] = [values[second]]
+    return item
 
 
 def _resolved_item(item: Any, variant: Model, values: dict[str, float] | None) -> Any:
     """A continuation or sweep with its canonical parameter name (and start, given values)."""
+    if isinstance(item, dict) and item.get("type") == "two-parameter":
+        return _resolved_pair(item, variant, values)
     name = item.get("parameter") if isinstance(item, dict) else None
     if not isinstance(name, str) or name not in variant.known_parameter_names():
         return item
@@ -816,6 +929,12 @@ def _meaning_problems(data: dict) -> list[Problem]:
     for i, sweep in _dict_items(sweeps):
         loc = ("linear", "sweeps", i, "parameter")
         problems += _parameter_problems(loc, sweep.get("parameter"), variant, family)
+    grid = linear.get("grid") if isinstance(linear, dict) else None
+    for axis in ("x", "y"):
+        spec = grid.get(axis) if isinstance(grid, dict) else None
+        if isinstance(spec, dict):
+            loc = ("linear", "grid", axis, "parameter")
+            problems += _parameter_problems(loc, spec.get("parameter"), variant, family)
     return problems
 
 
@@ -855,10 +974,50 @@ def _continuation_problems(
             problems.append((loc + ("name",), f"duplicate continuation name {name!r}"))
         if isinstance(name, str):
             names.add(name)
+        if item.get("type") == "two-parameter":
+            problems += _pair_problems(loc, item, variant, family, values)
+            continue
         found = _parameter_problems(loc + ("parameter",), parameter, variant, family)
         if not found and isinstance(parameter, str):
             found = _start_problems(loc, item, values[variant.canonical(parameter)])
         problems += found
+    return problems
+
+
+def _pair_problems(loc: Loc, item: dict, variant: Model, family: str,
+                   values: dict[str, float]) -> list[Problem]:
+    """Parameters, range keys, start and slices of a two-parameter continuation."""
+    pair = item.get("parameters")
+    if not isinstance(pair, list) or len(pair) != 2:
+        return []
+    problems: list[Problem] = []
+    for k, name in enumerate(pair):
+        problems += _parameter_problems(loc + ("parameters", k), name, variant, family)
+    if problems or not all(isinstance(p, str) for p in pair):
+        return problems
+    first, second = (variant.canonical(p) for p in pair)
+    if first == second:
+        return [(loc + ("parameters",), f"expected two different parameters, got {pair!r}")]
+    bounds = item.get("range")
+    if not isinstance(bounds, dict):
+        return problems
+    canonical = {variant.canonical(k) if k in variant.known_parameter_names() else k: k
+                 for k in bounds if isinstance(k, str)}
+    if set(canonical) != {first, second}:
+        return [(loc + ("range",), f"expected the keys {first}, {second}, got "
+                 f"{', '.join(map(str, bounds)) or 'none'}")]
+    start_item = {"range": bounds[canonical[first]], "start": item.get("start")}
+    problems += _start_problems(loc, start_item, values[first])
+    limits = bounds[canonical[second]]
+    slices = item.get("slices")
+    if isinstance(limits, list) and len(limits) == 2 and isinstance(slices, list):
+        lower, upper = (_finite(b) for b in limits)
+        for k, value in enumerate(slices):
+            number = _finite(value)
+            if None not in (lower, upper, number) and lower < upper and not (
+                    lower <= number <= upper):
+                problems.append((loc + ("slices", k), f"slice {number!r} is outside the range "
+                                 f"[{lower!r}, {upper!r}] of {second}"))
     return problems
 
 

@@ -8,18 +8,23 @@ import numpy as np
 import pytest
 from matplotlib.colors import same_color, to_hex
 from matplotlib.container import ErrorbarContainer
+from matplotlib.contour import QuadContourSet
+from matplotlib.patches import Polygon
 
 from whirl_cli import plots
 from whirl_cli.errors import WhirlError
 from whirl_cli.results import (
+    Boundary,
     Branch,
     BranchKind,
     ContinuationResult,
+    LinearGrid,
     LinearSweep,
     Orbit,
     PointType,
     SpecialPoint,
     StudyResult,
+    UnsafeInterval,
 )
 
 STATES = ("theta", "psi", "dtheta", "dpsi")
@@ -301,12 +306,13 @@ def test_save_study_plots_selected_kind_and_overwrite(tmp_path, continuation):
 def test_save_study_plots_rejects_unknown_kind(tmp_path, continuation):
     result = StudyResult("study", "classical", (continuation,), (), ())
     with pytest.raises(WhirlError):
-        plots.save_study_plots(result, ("boundary",), tmp_path, "run")
+        plots.save_study_plots(result, ("contour",), tmp_path, "run")
     assert list(tmp_path.iterdir()) == []
 
 
 def test_plot_kinds():
-    assert plots.PLOT_KINDS == ("bifurcation", "linear", "projections", "period", "phase")
+    assert plots.PLOT_KINDS == ("bifurcation", "linear", "projections", "period", "phase",
+                                "boundary")
 
 
 # -- projections_figure --------------------------------------------------------------------------
@@ -518,3 +524,301 @@ def test_save_study_plots_new_kinds(tmp_path, continuation, orbit_branch):
     assert sorted(tmp_path.iterdir()) == paths  # no temporary files left behind
     for path in paths:
         assert path.read_bytes()[:8] == PNG_MAGIC
+
+
+# -- boundary_plot -------------------------------------------------------------------------------
+
+PAIR = ("K1", "K_psi")
+PAIR_UNITS = ("N m/rad", "N m/rad")
+CASES = (0.4, 0.3, 0.2, 0.05, 0.037)
+FLUTTER_LINE = np.array([[0.0, 0.3], [0.1, 0.2]])
+DIVERGENCE_LINE = np.array([[0.1, 0.2], [0.3, 0.0]])
+HOPF = np.array([[0.3, 0.0], [0.2, 0.1], [0.0, 0.3]])
+LPC = np.array([[0.45, 0.0], [0.15, 0.3]])
+PITCHFORK = np.array([[0.5, 0.0], [0.6, 0.5]])
+FOLD = np.array([[0.7, 0.0], [0.8, 0.5]])
+POLYGON = np.array([[0.3, 0.0], [0.45, 0.0], [0.15, 0.3], [0.0, 0.3], [0.3, 0.0]])
+
+
+def make_grid(max_real=None) -> LinearGrid:
+    """K1 in [0, 1] x K_psi in [0, 0.5]; unstable (max_real > 0) where K1 + K_psi < 0.3."""
+    x, y = np.linspace(0.0, 1.0, 21), np.linspace(0.0, 0.5, 11)
+    xx, yy = np.meshgrid(x, y)
+    max_real = 0.3 - xx - yy if max_real is None else max_real
+    return LinearGrid("K1", "K_psi", "N m/rad", "N m/rad", x, y, max_real, xx < 0.1,
+                      (FLUTTER_LINE,), (DIVERGENCE_LINE,))
+
+
+def make_boundary(loci=None, polygons=(POLYGON,)) -> Boundary:
+    if loci is None:
+        loci = {"hopf_1": ("hopf", HOPF), "bp_1": ("branch_point", PITCHFORK),
+                "lp_1": ("fold", FOLD), "lpc_1": ("fold_of_cycles", LPC)}
+    intervals = (UnsafeInterval(0.2, 0.1, 0.25, "flutter"),
+                 UnsafeInterval(0.2, 0.32, 0.35, "divergence"),
+                 UnsafeInterval(0.3, 0.0, 0.15, "flutter"),
+                 UnsafeInterval(0.2 + 1e-9, 0.6, 0.7, "flutter"))  # another slice
+    return Boundary("kk", PAIR, PAIR_UNITS, "loci", loci, intervals, polygons, CASES)
+
+
+def legend_labels(ax) -> list[str]:
+    legend = ax.get_legend()
+    return [] if legend is None else [text.get_text() for text in legend.get_texts()]
+
+
+def contour_sets(ax) -> list[QuadContourSet]:
+    return [c for c in ax.collections if isinstance(c, QuadContourSet)]
+
+
+def polyline(ax, points) -> object:
+    """The single line of ``ax`` through exactly ``points`` (K, 2)."""
+    found = [line for line in ax.lines if np.shape(line.get_xydata()) == np.shape(points)
+             and np.allclose(line.get_xydata(), points)]
+    assert len(found) == 1, f"{len(found)} lines through {points.tolist()}"
+    return found[0]
+
+
+def test_boundary_plot_shades_linearly_unstable_region():
+    grid = make_grid()
+    ax = plots.boundary_plot(None, grid).axes[0]
+    (contours,) = contour_sets(ax)
+    np.testing.assert_array_equal(contours.levels, [0.0, np.inf])
+    assert same_color(contours.get_facecolor()[0], "lightgrey")
+    paths = contours.get_paths()
+    xx, yy = np.meshgrid(grid.x, grid.y)
+    inside = np.array([any(path.contains_point(xy) for path in paths)
+                       for xy in np.column_stack([xx.ravel(), yy.ravel()])])
+    interior = ((xx > grid.x[0]) & (xx < grid.x[-1]) & (yy > grid.y[0]) & (yy < grid.y[-1]))
+    clear = (np.abs(grid.max_real) > 0.02).ravel() & interior.ravel()  # off path edges
+    assert (grid.max_real.ravel()[clear] > 0).sum() >= 3
+    np.testing.assert_array_equal(inside[clear], grid.max_real.ravel()[clear] > 0)
+
+
+def test_boundary_plot_without_unstable_points_has_no_shading():
+    ax = plots.boundary_plot(None, make_grid(np.full((11, 21), -1.0))).axes[0]
+    assert contour_sets(ax) == []
+    assert legend_labels(ax) == ["linear boundary (flutter)", "linear boundary (divergence)"]
+
+
+def test_boundary_plot_linear_contour_styles():
+    ax = plots.boundary_plot(None, make_grid()).axes[0]
+    flutter, divergence = polyline(ax, FLUTTER_LINE), polyline(ax, DIVERGENCE_LINE)
+    assert line_style(flutter) == ("black", "-") and flutter.get_linewidth() < 1.0
+    assert line_style(divergence) == ("black", "--") and divergence.get_linewidth() < 1.0
+
+
+def test_boundary_plot_grid_only_labels_limits_and_legend():
+    ax = plots.boundary_plot(None, make_grid()).axes[0]
+    assert ax.get_xlabel() == "K1 [N m/rad]" and ax.get_ylabel() == "K_psi [N m/rad]"
+    assert ax.get_xlim() == (0.0, 1.0) and ax.get_ylim() == (0.0, 0.5)
+    assert legend_labels(ax) == ["linearly unstable", "linear boundary (flutter)",
+                                 "linear boundary (divergence)"]
+    assert len(ax.patches) == 0 and ax.get_title() == "linear stability"
+
+
+def test_boundary_plot_loci_styles_per_kind():
+    ax = plots.boundary_plot(make_boundary(), None).axes[0]
+    assert same_color(polyline(ax, HOPF).get_color(), "darkblue")
+    assert polyline(ax, HOPF).get_linestyle() == "-"
+    assert line_style(polyline(ax, PITCHFORK)) == ("black", "--")
+    assert same_color(polyline(ax, FOLD).get_color(), "grey")
+    assert polyline(ax, FOLD).get_linestyle() == "-."
+    assert same_color(polyline(ax, LPC).get_color(), "orange")
+    assert polyline(ax, LPC).get_linestyle() == "-"
+
+
+def test_boundary_plot_unsafe_polygons():
+    second = POLYGON + [0.0, 0.1]
+    ax = plots.boundary_plot(make_boundary(polygons=(POLYGON, second)), None).axes[0]
+    polygons = [patch for patch in ax.patches if isinstance(patch, Polygon)]
+    assert len(polygons) == 2
+    for patch, expected in zip(polygons, (POLYGON, second), strict=True):
+        np.testing.assert_allclose(patch.get_xy(), expected)
+        assert same_color(patch.get_facecolor()[:3], "red")
+        assert patch.get_alpha() == pytest.approx(0.5)
+
+
+def test_boundary_plot_case_lines_and_labels():
+    ax = plots.boundary_plot(make_boundary(), make_grid(), cases=CASES).axes[0]
+    dotted = [line for line in ax.lines if line.get_linestyle() == ":"]
+    assert [tuple(line.get_ydata()) for line in dotted] == [(v, v) for v in CASES]
+    assert all(line_style(line)[0] == "black" for line in dotted)
+    labels = {text.get_text(): text for text in ax.texts}
+    assert sorted(labels) == [f"case {k}" for k in range(1, 6)]
+    heights = [labels[f"case {k}"].get_position()[1] for k in range(1, 6)]
+    assert heights[:3] == pytest.approx([0.8, 0.6, 0.4])  # axes fractions of 0.4, 0.3, 0.2
+    assert all(x > 1.0 for x, _ in (text.get_position() for text in ax.texts))  # right edge
+    assert heights[0] > heights[1] > heights[2] > heights[3] > heights[4]
+    assert heights[3] - heights[4] >= 0.04 - 1e-12  # close cases pushed apart
+    assert "case" not in " ".join(legend_labels(ax))
+
+
+def test_boundary_plot_cases_outside_limits_are_not_labelled():
+    ax = plots.boundary_plot(None, make_grid(), cases=(0.2, 0.9)).axes[0]
+    assert [text.get_text() for text in ax.texts] == ["case 1"]
+
+
+def test_boundary_plot_both_legend_and_title():
+    ax = plots.boundary_plot(make_boundary(), make_grid(), cases=CASES).axes[0]
+    assert legend_labels(ax) == [
+        "linearly unstable", "linear boundary (flutter)", "linear boundary (divergence)",
+        "Hopf locus (flutter)", "branch point locus (divergence)", "fold locus (LP)",
+        "fold of cycles locus (LPC)", "unsafe (overhang)"]
+    assert ax.get_title() == "kk"
+    assert ax.get_xlim() == (0.0, 1.0) and ax.get_ylim() == (0.0, 0.5)  # the grid's extent
+
+
+def test_boundary_plot_boundary_only_legend_and_limits():
+    loci = {"hopf_1": ("hopf", HOPF), "hopf_2": ("hopf", HOPF + 0.05),
+            "lpc_1": ("fold_of_cycles", LPC), "other": ("torus", np.array([[5.0, 5.0]] * 2))}
+    ax = plots.boundary_plot(make_boundary(loci=loci, polygons=()), None).axes[0]
+    assert legend_labels(ax) == ["Hopf locus (flutter)", "fold of cycles locus (LPC)"]
+    assert len(ax.lines) == 3 and contour_sets(ax) == []
+    # extent of the loci (x 0..0.45, y 0..0.35) with a 2 % margin
+    np.testing.assert_allclose(ax.get_xlim(), [-0.009, 0.459])
+    np.testing.assert_allclose(ax.get_ylim(), [-0.007, 0.357])
+    assert ax.get_xlabel() == "K1 [N m/rad]" and ax.get_ylabel() == "K_psi [N m/rad]"
+
+
+def test_boundary_plot_transposes_a_swapped_grid():
+    grid = make_grid()
+    swapped = LinearGrid("K_psi", "K1", "N m/rad", "N m/rad", grid.y, grid.x,
+                         grid.max_real.T, grid.oscillatory.T, (FLUTTER_LINE[:, ::-1],),
+                         (DIVERGENCE_LINE[:, ::-1],))
+    ax = plots.boundary_plot(make_boundary(), swapped).axes[0]
+    assert ax.get_xlim() == (0.0, 1.0) and ax.get_ylim() == (0.0, 0.5)
+    polyline(ax, FLUTTER_LINE)
+    (contours,) = contour_sets(ax)
+    assert any(path.contains_point((0.05, 0.05)) for path in contours.get_paths())
+
+
+def test_boundary_plot_rejects_bad_input():
+    with pytest.raises(WhirlError):
+        plots.boundary_plot(None, None)
+    other = replace(make_grid(), x_parameter="V")
+    with pytest.raises(WhirlError):
+        plots.boundary_plot(make_boundary(), other)
+
+
+def test_boundary_plot_draws_on_given_axes():
+    figure = plots._new_figure()
+    ax = figure.add_subplot()
+    assert plots.boundary_plot(make_boundary(), None, ax=ax) is figure
+    assert len(figure.axes) == 1 and ax.lines
+
+
+# -- overhang_diagram ----------------------------------------------------------------------------
+
+def two_parameter_continuation(continuation: ContinuationResult) -> ContinuationResult:
+    """Slices 0..4 (CASES) each holding ``continuation``'s branches; points on slice 2 only."""
+    branches = tuple(replace(branch, name=f"slice_{k}.{branch.name}")
+                     for k in range(len(CASES)) for branch in continuation.branches)
+    points = tuple(replace(point, branch=f"slice_2.{point.branch}", parameter_names=PAIR,
+                           parameters=np.array([point.parameters[0], 0.2]))
+                   for point in continuation.special_points)
+    locus = make_branch("hopf_locus_1", BranchKind.HOPF_LOCUS, [0.1, 0.2], [0.0, 0.0], [0, 0])
+    return ContinuationResult("kk", "two-parameter", branches + (locus,), points)
+
+
+def bands(ax) -> list[tuple[float, float]]:
+    return [(patch.get_x(), patch.get_x() + patch.get_width()) for patch in ax.patches]
+
+
+def test_slice_continuation(continuation):
+    sliced = plots.slice_continuation(two_parameter_continuation(continuation), 2)
+    assert sliced.kind == "one-parameter" and sliced.name == "kk.slice_2"
+    assert [b.name for b in sliced.branches] == ["main_down", "periodic_1"]
+    assert [p.branch for p in sliced.special_points] == [
+        "main_down", "main_down", "periodic_1", "periodic_1"]
+    assert plots.slice_continuation(two_parameter_continuation(continuation), 1
+                                    ).special_points == ()
+
+
+def test_overhang_diagram_bands_at_interval_edges(continuation):
+    two = two_parameter_continuation(continuation)
+    ax = plots.overhang_diagram(two, make_boundary(), 0.2).axes[0]
+    assert bands(ax) == [pytest.approx((0.1, 0.25)), pytest.approx((0.32, 0.35))]
+    for patch in ax.patches:
+        assert same_color(patch.get_facecolor()[:3], "red")
+        assert patch.get_alpha() == pytest.approx(0.25)
+    assert legend_labels(ax) == [
+        "stable equilibrium", "unstable equilibrium", "stable periodic", "unstable periodic",
+        "Hopf (HB)", "branch point (BP, BPC)", "fold (LP, LPC)", "unsafe (overhang)"]
+    assert ax.get_title() == "kk: K_psi = 0.2"
+    assert ax.get_xlabel() == "K1 [N m/rad]" and ax.get_ylabel() == "theta (max) [deg]"
+    # the slice's branches only, as in a plain bifurcation diagram
+    plain = plots.bifurcation_diagram(continuation).axes[0]
+    assert len(ax.lines) == len(plain.lines)
+    for mine, theirs in zip(ax.lines, plain.lines, strict=True):
+        np.testing.assert_allclose(mine.get_xydata(), theirs.get_xydata())
+
+
+def test_overhang_diagram_other_slice_and_no_interval(continuation):
+    two = two_parameter_continuation(continuation)
+    ax = plots.overhang_diagram(two, make_boundary(), 0.3).axes[0]
+    assert bands(ax) == [pytest.approx((0.0, 0.15))]
+    assert len(marker_lines(ax)) == 0  # special points are on slice 2 only
+    ax = plots.overhang_diagram(two, make_boundary(), 0.05).axes[0]
+    assert len(ax.patches) == 0 and "unsafe (overhang)" not in legend_labels(ax)
+
+
+def test_overhang_diagram_one_parameter(continuation):
+    ax = plots.overhang_diagram(continuation, make_boundary(), 0.2, which=("max", "min"),
+                                degrees=False).axes[0]
+    assert bands(ax) == [pytest.approx((0.1, 0.25)), pytest.approx((0.32, 0.35))]
+    assert ax.get_ylabel() == "theta (max, min) [rad]"
+    assert legend_labels(ax)[-1] == "unsafe (overhang)"
+    ax = plots.overhang_diagram(continuation, None, 0.2).axes[0]
+    assert len(ax.patches) == 0 and ax.get_title() == "hopf_K1"
+
+
+def test_overhang_diagram_rejects_bad_input(continuation):
+    two = two_parameter_continuation(continuation)
+    with pytest.raises(WhirlError):
+        plots.overhang_diagram(two, None, 0.2)
+    with pytest.raises(WhirlError):
+        plots.overhang_diagram(two, make_boundary(), 0.25)  # not a slice
+    with pytest.raises(WhirlError):
+        plots.overhang_diagram(two, make_boundary(), 0.2, state="phi")
+
+
+# -- save_study_plots: boundary ------------------------------------------------------------------
+
+def test_save_study_plots_boundary(tmp_path, continuation):
+    two = two_parameter_continuation(continuation)
+    other = replace(make_boundary(), name="no continuation", slices=(0.2,))
+    two_slices = replace(make_boundary(), slices=(0.2, 0.3))
+    result = StudyResult("study", "classical", (continuation, two), (), (),
+                         boundaries=(two_slices, other), linear_grid=make_grid())
+    paths = plots.save_study_plots(result, ("boundary",), tmp_path, "run", dpi=40)
+    assert [p.name for p in paths] == sorted([
+        "run_kk_boundary.png", "run_kk_slice_0_overhang.png", "run_kk_slice_1_overhang.png",
+        "run_no_continuation_boundary.png", "run_no_continuation_slice_0_overhang.png"])
+    assert sorted(tmp_path.iterdir()) == paths  # no temporary files left behind
+    for path in paths:
+        assert path.read_bytes()[:8] == PNG_MAGIC
+
+
+def test_save_study_plots_boundary_grid_only_or_nothing(tmp_path, continuation):
+    result = StudyResult("study", "classical", (continuation,), (), (), linear_grid=make_grid())
+    paths = plots.save_study_plots(result, ("boundary", "linear"), tmp_path, "run", dpi=40)
+    assert [p.name for p in paths] == ["run_linear_grid.png"]
+    assert paths[0].read_bytes()[:8] == PNG_MAGIC
+    empty = StudyResult("study", "classical", (continuation,), (), ())
+    assert plots.save_study_plots(empty, ("boundary",), tmp_path / "none", "run") == []
+
+
+def test_save_study_plots_boundary_ignores_grid_of_other_parameters(tmp_path, monkeypatch):
+    seen = []
+
+    def fake(boundary, grid, cases=(), ax=None):
+        seen.append((boundary, grid, tuple(cases)))
+        return plots._new_figure()
+
+    monkeypatch.setattr(plots, "boundary_plot", fake)
+    boundary = replace(make_boundary(), slices=())
+    grid = replace(make_grid(), y_parameter="V")
+    result = StudyResult("study", "classical", (), (), (), boundaries=(boundary,),
+                         linear_grid=grid)
+    paths = plots.save_study_plots(result, ("boundary",), tmp_path, "run", dpi=40)
+    assert [p.name for p in paths] == ["run_kk_boundary.png"]
+    assert seen == [(boundary, None, ())]

@@ -20,6 +20,7 @@ from whirl_cli.study import (
     OneParameterContinuation,
     Polynomial,
     Study,
+    TwoParameterContinuation,
     load_study,
     schema_reference,
     validate_text,
@@ -243,9 +244,9 @@ def test_model_validate_fills_the_same_defaults():
             "s.yaml:3: nonlinearity.type: expected one of linear, polynomial, got 3",
         ),
         (
-            "plots: [bifurcation, boundary]\n",
+            "plots: [bifurcation, bubble]\n",
             "s.yaml:3: plots[1]: expected one of bifurcation, linear, projections, period, phase, "
-            "got 'boundary'",
+            "boundary, got 'bubble'",
         ),
         (
             "nonlinearity: {type: linear, dof: phi}\n",
@@ -265,7 +266,9 @@ def test_model_validate_fills_the_same_defaults():
             "s.yaml:3: grid: unknown key (allowed: name, description, model, parameters, "
             "nonlinearity, continuations, linear, plots, cross_check, auto)",
         ),
-        ("linear: {grid: 1}\n", "s.yaml:3: linear.grid: unknown key (allowed: sweeps)"),
+        ("linear: {grid: 1}\n", "s.yaml:3: linear.grid: expected a mapping, got 1"),
+        ("linear: {table: 1}\n",
+         "s.yaml:3: linear.table: unknown key (allowed: sweeps, grid)"),
         (
             "parameters: {K_phi: 1}\n",
             f"s.yaml:3: parameters.K_phi: unknown parameter 'K_phi' for model classical "
@@ -386,8 +389,15 @@ def test_continuation_reason(body, expected):
 
 def test_continuation_keys():
     item = "continuations:\n  - name: {}\n    type: {}\n    parameter: {}\n    range: [0, 1]\n"
+    assert problems(HEAD + item.format("k", "three-parameter", "K1")) == [
+        "s.yaml:5: continuations[0].type: expected one of one-parameter, two-parameter, "
+        "got 'three-parameter'"
+    ]
     assert problems(HEAD + item.format("k", "two-parameter", "K1")) == [
-        "s.yaml:5: continuations[0].type: expected one of one-parameter, got 'two-parameter'"
+        "s.yaml:4: continuations[0].parameters: required key is missing",
+        "s.yaml:6: continuations[0].parameter: unknown key (allowed: name, type, parameters, "
+        "range, start, slices, loci, method, resolution)",
+        "s.yaml:7: continuations[0].range: expected a mapping, got a list",
     ]
     assert problems(HEAD + item.format("k", "one-parameter", "K_phi")) == [
         "s.yaml:6: continuations[0].parameter: unknown parameter 'K_phi' for model classical "
@@ -626,8 +636,12 @@ def test_schema_reference_lists_every_key_with_a_description():
     expected = {"name", "description", "model", "parameters", "nonlinearity", "continuations",
                 "linear", "plots", "cross_check", "auto", "nonlinearity.type", "nonlinearity.dof",
                 "nonlinearity.K2", "nonlinearity.K3", "linear.sweeps",
-                "linear.sweeps[].parameter", "linear.sweeps[].range", "linear.sweeps[].points"}
+                "linear.sweeps[].parameter", "linear.sweeps[].range", "linear.sweeps[].points",
+                "linear.grid", "linear.grid.x", "linear.grid.y"}
+    expected |= {f"linear.grid.{axis}.{k}" for axis in "xy" for k in ("parameter", "range",
+                                                                      "points")}
     expected |= {f"continuations[].{k}" for k in OneParameterContinuation.model_fields}
+    expected |= {f"continuations[].{k}" for k in TwoParameterContinuation.model_fields}
     expected |= {f"auto.{k}" for k in AutoSettings.model_fields}
     assert set(rows) == expected
     for line in lines[2:]:

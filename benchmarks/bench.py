@@ -1,0 +1,424 @@
+"""whirl performance figures, printed in one run (``make bench``). Nothing here is asserted.
+
+(a) overhead: wall time of a full chapter-3 sweep (every study in studies/thesis_ch3, one
+    worker) against the summed ``wall_seconds`` of the AUTO runs it launched (``/runs`` of
+    the outputs), with and without plots and time-simulation cross-checks, and where the rest
+    goes (start-up and imports, cross-checks, plots, the remaining Python).
+(b) parallel sweep: the same sweep (``--no-plots``) with 1 and 2 worker processes.
+(c) recompilations: a cold compile cache, then a ``--force`` re-run: new cache entries
+    (compiled executables, ``Executable.compiled``) on the re-run.
+(d) linear analysis: ``whirl_cli.linear.sweep`` over 2000 airspeeds at once against a Python
+    loop calling it point by point.
+(e) ``whirl run`` wall time of every chapter-3 case (plots and cross-checks as the studies
+    ask), warm cache.
+(f) a fold of cycles: the LPC of softening case 2 by continuation (``run_study``, and the AUTO
+    runs of its periodic family) against bisection on time simulations.
+
+    Bisection method: the stable limit cycle (LCO) born at the fold exists for K1 below the
+    fold K1_LPC and not above it, where the origin is the only attractor nearby. A test at K1
+    starts on the stable LCO found at the last K1 known to have one (its point of maximum
+    pitch; in max-pitch terms just inside the stable orbit at K1, which grows towards the
+    fold) and integrates with ``whirl_cli.simulate.integrate`` (LSODA, rtol 1e-8) in chunks
+    of 10 periods: "decays" as soon as the pitch amplitude over a chunk falls below half the
+    start's, "ends on an LCO" if it survives ``D`` periods. Near the fold the decay lingers in
+    the ghost of the vanished cycles (150 periods at 1e-4 above it), so ``D`` bounds the
+    accuracy and is a parameter. The only input from continuation is the seed: one point of
+    AUTO's stable orbit at K1 ~ 0.398 (what a user would take from a phase portrait).
+    Because the basin between the unstable and stable cycle is thin near the fold, a bracket
+    is first found by marching up from the seed in steps of 0.005 (short runs, the upper end
+    confirmed with the full ``D``), then bisected to ``--fold-tol``.
+
+Run: ``.venv/bin/python benchmarks/bench.py [--only abcdef] [--exclude GLOB] [--fold-tol 1e-5]
+[--fold-periods 3000]``. With the 22 one-parameter cases it takes about fifteen minutes on two
+cores (two-parameter ``boundary_*`` studies add much more; ``--exclude 'boundary_*.yaml'``
+leaves them out); other load on the machine shows in the numbers (the load average is
+printed).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+CHAPTER3 = ROOT / "studies" / "thesis_ch3"
+WHIRL = [sys.executable, "-m", "whirl_cli"]
+
+
+# ------------------------------------------------------------------------------ helpers
+@dataclass(frozen=True)
+class Timed:
+    """A command and its wall time [s]."""
+
+    command: str
+    seconds: float
+    returncode: int
+
+
+def run(arguments: Sequence[str], env: dict[str, str]) -> Timed:
+    """Run a command (output discarded) and time it."""
+    start = time.perf_counter()
+    done = subprocess.run(list(arguments), cwd=ROOT, env=env, stdout=subprocess.DEVNULL,
+                          stderr=subprocess.PIPE, text=True, check=False)
+    seconds = time.perf_counter() - start
+    if done.returncode not in (0, 1):
+        raise RuntimeError(f"{' '.join(arguments)} failed ({done.returncode}):\n"
+                           f"{done.stderr[-2000:]}")
+    return Timed(" ".join(arguments[2:]), seconds, done.returncode)
+
+
+def auto_seconds(directory: Path) -> tuple[float, int]:
+    """(summed wall_seconds, count) of the AUTO runs recorded in every .h5 of ``directory``."""
+    total, count = 0.0, 0
+    for path in sorted(directory.glob("*.h5")):
+        with h5py.File(path, "r") as handle:
+            for group in handle.get("runs", {}).values():
+                total += float(group.attrs["wall_seconds"])
+                count += 1
+    return total, count
+
+
+def cache_entries(cache: Path) -> int:
+    """Compiled AUTO executables in a whirl cache directory."""
+    return len(list((cache / "exe").glob("*/*.exe"))) if (cache / "exe").is_dir() else 0
+
+
+def load() -> str:
+    return " ".join(f"{x:.2f}" for x in os.getloadavg())
+
+
+def best_of(function: Callable[[], object], repeats: int = 3) -> float:
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        function()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def heading(text: str) -> None:
+    print(f"\n== {text}", flush=True)
+
+
+# ------------------------------------------------------------------------------ (a) (b) (c)
+@dataclass
+class SweepFigures:
+    """Wall times [s] of the chapter-3 sweeps and what they launched."""
+
+    cold_2: Timed | None = None
+    warm_2: Timed | None = None
+    warm_1: Timed | None = None
+    plots_1: Timed | None = None
+    no_checks_1: Timed | None = None
+    auto_total: float = 0.0
+    auto_runs: int = 0
+    auto_no_checks: float = 0.0
+    compiled_cold: int = 0
+    compiled_rerun: int = 0
+    studies: int = 0
+
+
+def selected_studies(target: Path, exclude: Sequence[str]) -> Path:
+    """Copies of the chapter-3 studies whose file names match none of ``exclude`` (globs)."""
+    target.mkdir(parents=True)
+    for path in sorted(CHAPTER3.glob("*.yaml")):
+        if not any(path.match(pattern) for pattern in exclude):
+            shutil.copyfile(path, target / path.name)
+    return target
+
+
+def no_cross_check_copies(source: Path, target: Path) -> Path:
+    """The studies of ``source`` with ``cross_check: false``."""
+    target.mkdir(parents=True)
+    for path in sorted(source.glob("*.yaml")):
+        (target / path.name).write_text(path.read_text().replace("cross_check: true",
+                                                                 "cross_check: false"))
+    return target
+
+
+def sweeps(studies: Path, scratch: Path, env: dict[str, str], cache: Path) -> SweepFigures:
+    """The sweeps of (a), (b) and (c) over ``studies``, cold cache first."""
+    figures = SweepFigures(studies=len(list(studies.glob("*.yaml"))))
+    out = scratch / "sweep"
+    figures.cold_2 = run(WHIRL + ["sweep", str(studies), "-o", str(out), "-j", "2",
+                                  "--no-plots"], env)
+    figures.compiled_cold = cache_entries(cache)
+    print(f"cold cache, 2 workers, no plots: {figures.cold_2.seconds:7.1f} s "
+          f"({figures.compiled_cold} executables compiled)", flush=True)
+    figures.warm_2 = run(WHIRL + ["sweep", str(studies), "-o", str(out), "-j", "2",
+                                  "--no-plots", "--force"], env)
+    figures.compiled_rerun = cache_entries(cache) - figures.compiled_cold
+    print(f"re-run, 2 workers, no plots:     {figures.warm_2.seconds:7.1f} s "
+          f"({figures.compiled_rerun} new executables)", flush=True)
+    figures.warm_1 = run(WHIRL + ["sweep", str(studies), "-o", str(out), "-j", "1",
+                                  "--no-plots", "--force"], env)
+    figures.auto_total, figures.auto_runs = auto_seconds(out)
+    print(f"re-run, 1 worker, no plots:      {figures.warm_1.seconds:7.1f} s", flush=True)
+    figures.plots_1 = run(WHIRL + ["sweep", str(studies), "-o", str(out), "-j", "1",
+                                   "--force"], env)
+    print(f"re-run, 1 worker, with plots:    {figures.plots_1.seconds:7.1f} s", flush=True)
+    unchecked = no_cross_check_copies(studies, scratch / "no-checks")
+    figures.no_checks_1 = run(WHIRL + ["sweep", str(unchecked), "-o",
+                                       str(scratch / "no-checks-out"), "-j", "1",
+                                       "--no-plots"], env)
+    figures.auto_no_checks, _ = auto_seconds(scratch / "no-checks-out")
+    print(f"1 worker, no plots, no checks:   {figures.no_checks_1.seconds:7.1f} s", flush=True)
+    return figures
+
+
+def startup_seconds(env: dict[str, str]) -> tuple[float, float]:
+    """(``whirl --version``, importing what a worker needs) wall times [s], best of 3."""
+    cli = best_of(lambda: run(WHIRL + ["--version"], env))
+    imports = best_of(lambda: run([sys.executable, "-c", "import whirl_cli.pipeline, "
+                                   "whirl_cli.simulate, whirl_cli.store"], env))
+    return cli, imports
+
+
+def report_sweeps(figures: SweepFigures, env: dict[str, str]) -> None:
+    heading(f"(a) whirl wall time vs AUTO wall time: {figures.studies} studies of "
+            "studies/thesis_ch3, 1 worker")
+    auto = figures.auto_total
+    rows = [("with cross-checks and plots (what the studies ask)", figures.plots_1, auto),
+            ("with cross-checks, --no-plots", figures.warm_1, auto),
+            ("without cross-checks, --no-plots", figures.no_checks_1, figures.auto_no_checks)]
+    print(f"AUTO runs launched: {figures.auto_runs}, summed wall_seconds {auto:.1f} s")
+    for label, timed, auto_part in rows:
+        print(f"  {label:<52} {timed.seconds:7.1f} s   ratio {timed.seconds / auto_part:5.2f}"
+              f"   (target <= 1.2)")
+    cli, imports = startup_seconds(env)
+    checks = figures.warm_1.seconds - figures.no_checks_1.seconds
+    plots = figures.plots_1.seconds - figures.warm_1.seconds
+    rest = figures.no_checks_1.seconds - figures.auto_no_checks - imports
+    print("where the time goes (1 worker):")
+    print(f"  AUTO-07p runs                                        {auto:7.1f} s")
+    print(f"  time-simulation cross-checks (with - without)        {checks:7.1f} s")
+    print(f"  plots (with - without)                               {plots:7.1f} s")
+    print(f"  start-up: `whirl --version` {cli:.2f} s; worker imports (sympy, scipy, h5py) "
+          f"{imports:.2f} s")
+    print(f"  rest without checks/plots (model set-up, parsing, HDF5, pool)  {rest:7.1f} s")
+
+    heading("(b) sweep with 1 vs 2 workers (--no-plots, warm cache)")
+    speedup = figures.warm_1.seconds / figures.warm_2.seconds
+    print(f"  1 worker {figures.warm_1.seconds:.1f} s, 2 workers {figures.warm_2.seconds:.1f} s:"
+          f" speed-up {speedup:.2f}x (target >= 1.8x; {os.cpu_count()} CPUs)")
+
+    heading("(c) recompilations on a re-run")
+    print(f"  cold cache: {figures.compiled_cold} executable(s) compiled; --force re-run: "
+          f"{figures.compiled_rerun} new (target 0)")
+
+
+def recompilations_in_process() -> int:
+    """``Executable.compiled`` count of a second in-process run of one study (warm cache)."""
+    from whirl_cli import auto
+    from whirl_cli.pipeline import run_study
+    from whirl_cli.study import load_study
+
+    compiled = []
+    original = auto.compile_equations
+
+    def counting(*args, **kwargs):
+        executable = original(*args, **kwargs)
+        compiled.append(executable.compiled)
+        return executable
+
+    auto.compile_equations = counting
+    try:
+        study = load_study(CHAPTER3 / "linear_case2.yaml")
+        for _ in range(2):
+            with tempfile.TemporaryDirectory() as work:
+                run_study(study, Path(work))
+    finally:
+        auto.compile_equations = original
+    return sum(compiled[1:])
+
+
+# ------------------------------------------------------------------------------ (d)
+def linear_figures(points: int = 2000) -> None:
+    from whirl_cli import linear
+    from whirl_cli.study import load_study
+
+    heading(f"(d) linear analysis over {points} airspeeds: vectorised vs a per-point loop")
+    study = load_study(CHAPTER3 / "linear_datum_airspeed.yaml")
+    model, overrides = study.variant(), study.parameter_values()
+    values = np.linspace(0.0, 10.0, points)
+    vectorised = best_of(lambda: linear.sweep(model, overrides, "V", values))
+    looped = best_of(lambda: [linear.sweep(model, overrides, "V", values[k:k + 1])
+                              for k in range(points)], repeats=1)
+    print(f"  linear.sweep over all points {vectorised * 1e3:8.1f} ms; loop "
+          f"{looped * 1e3:8.1f} ms: {looped / vectorised:.0f}x")
+
+
+# ------------------------------------------------------------------------------ (e)
+def per_case(studies: Path, scratch: Path, env: dict[str, str]) -> None:
+    heading("(e) `whirl run` wall time per chapter-3 case (plots and cross-checks as the "
+            "study asks; warm cache)")
+    rows = []
+    for path in sorted(studies.glob("*.yaml")):
+        timed = run(WHIRL + ["run", str(path), "-o", str(scratch / "cases" / f"{path.stem}.h5"),
+                             "--overwrite"], env)
+        rows.append((path.stem, timed))
+        mark = "" if timed.seconds < 10 else "   over 10 s"
+        print(f"  {path.stem:<26} {timed.seconds:6.2f} s  exit {timed.returncode}{mark}",
+              flush=True)
+    name, slowest = max(rows, key=lambda row: row[1].seconds)
+    over = sum(t.seconds >= 10 for _, t in rows)
+    print(f"  max {slowest.seconds:.2f} s ({name}); {over} of {len(rows)} cases at or over 10 s"
+          f"; median {np.median([t.seconds for _, t in rows]):.2f} s")
+
+
+# ------------------------------------------------------------------------------ (f)
+@dataclass
+class Bisection:
+    """Outcome of the simulation bisection: bracket [N m/rad], cost."""
+
+    lower: float
+    upper: float
+    simulations: int
+    periods: float
+    seconds: float
+
+
+class FoldBySimulation:
+    """Bisection for the fold of cycles on time simulations (see the module docstring)."""
+
+    def __init__(self, model, overrides: dict[str, float], period: float) -> None:
+        self.model, self.overrides, self.period = model, overrides, period
+        self.simulations, self.periods = 0, 0.0
+
+    def ends_on_cycle(self, k1: float, start: np.ndarray, periods: int
+                      ) -> tuple[bool, np.ndarray]:
+        """(True, a state of maximum pitch on the cycle) if the trajectory from ``start`` at
+        ``k1`` survives ``periods`` periods; (False, start) once it decays."""
+        from whirl_cli.simulate import integrate
+
+        params = self.model.parameter_vector({**self.overrides, "K1": k1})
+        amplitude, state, chunk = abs(start[0]), start, 10
+        for _ in range(max(1, periods // chunk)):
+            _, states = integrate(self.model, params, state, chunk * self.period,
+                                  samples=chunk * 40)
+            self.simulations += 1
+            self.periods += chunk
+            half = states[len(states) // 2:]
+            if np.abs(half[:, 0]).max() < 0.5 * amplitude:
+                return False, start
+            state = states[-1]
+        return True, half[int(np.argmax(half[:, 0]))]
+
+    def locate(self, seed_k1: float, seed: np.ndarray, tol: float, periods: int,
+               step: float = 0.005, march_periods: int = 200, upper: float = 0.5
+               ) -> Bisection:
+        start_time = time.perf_counter()
+        found, state = self.ends_on_cycle(seed_k1, seed, periods)
+        assert found, "the seed is not on a stable cycle"
+        lower = seed_k1
+        while True:  # march to a bracket of width ``step``
+            trial = min(lower + step, upper)
+            found, cycle = self.ends_on_cycle(trial, state, march_periods)
+            if found:
+                lower, state = trial, cycle
+                continue
+            found, cycle = self.ends_on_cycle(trial, state, periods)  # confirm with full D
+            if found:
+                lower, state = trial, cycle
+                continue
+            high = trial
+            break
+        while high - lower > tol:
+            middle = 0.5 * (lower + high)
+            found, cycle = self.ends_on_cycle(middle, state, periods)
+            if found:
+                lower, state = middle, cycle
+            else:
+                high = middle
+        return Bisection(lower, high, self.simulations, self.periods,
+                         time.perf_counter() - start_time)
+
+
+def fold_figures(scratch: Path, tol: float, periods: int) -> None:
+    from whirl_cli.pipeline import run_study
+    from whirl_cli.results import PointType
+    from whirl_cli.study import load_study
+
+    heading("(f) fold of cycles (LPC) of softening case 2: continuation vs simulation bisection")
+    study = load_study(CHAPTER3 / "softening_case2.yaml")
+    quick = study.model_copy(update={"cross_check": False})
+    start = time.perf_counter()
+    with tempfile.TemporaryDirectory(dir=scratch) as work:
+        result = run_study(quick, Path(work))
+    continuation_seconds = time.perf_counter() - start
+    (continuation,) = result.continuations
+    (lpc,) = [p for p in continuation.special_points if p.point_type == PointType.LPC]
+    family = next(b for b in continuation.branches if b.name == lpc.branch)
+    family_auto = sum(r.wall_seconds for r in result.runs
+                      if r.name.startswith(f"{continuation.name}.{family.name}"))
+    k1_lpc = float(lpc.parameters[0])
+    print(f"  continuation: K1_LPC = {k1_lpc:.8f} N m/rad; whole study (no cross-check) "
+          f"{continuation_seconds:.2f} s, AUTO runs of its periodic family {family_auto:.2f} s")
+
+    stable = [o for o in family.orbits if family.stable[o.index] and o.states.shape[0] > 1]
+    seed_orbit = min(stable, key=lambda o: abs(o.parameters[0] - 0.4))
+    seed = seed_orbit.states[int(np.argmax(seed_orbit.states[:, 0]))]
+    model = study.variant()
+    search = FoldBySimulation(model, study.parameter_values(), float(lpc.period))
+    found = search.locate(float(seed_orbit.parameters[0]), seed, tol, periods)
+    estimate = 0.5 * (found.lower + found.upper)
+    print(f"  bisection: K1 in [{found.lower:.8f}, {found.upper:.8f}] (width "
+          f"{found.upper - found.lower:.1e}, D = {periods} periods), estimate {estimate:.8f}, "
+          f"{estimate - k1_lpc:+.1e} from AUTO's LPC; {found.simulations} simulation chunks, "
+          f"{found.periods:.0f} periods simulated, {found.seconds:.1f} s")
+    print(f"  bisection / continuation (whole study): "
+          f"{found.seconds / continuation_seconds:.0f}x slower")
+
+
+# ------------------------------------------------------------------------------ main
+def main(argv: Sequence[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--only", default="abcdef",
+                        help="letters of the figures to produce, e.g. 'ad' [default: all]")
+    parser.add_argument("--fold-tol", type=float, default=1e-5,
+                        help="bracket width at which the bisection of (f) stops [N m/rad]")
+    parser.add_argument("--fold-periods", type=int, default=3000,
+                        help="periods a start must survive to count as a cycle in (f)")
+    parser.add_argument("--exclude", action="append", default=[], metavar="GLOB",
+                        help="leave out chapter-3 study files matching GLOB (repeatable), "
+                        "e.g. 'boundary_*.yaml'")
+    options = parser.parse_args(argv)
+    only = set(options.only.replace(",", ""))
+    print(f"whirl benchmarks: {os.cpu_count()} CPUs, load average {load()} at start")
+    scratch = Path(tempfile.mkdtemp(prefix="whirl-bench-"))
+    cache = scratch / "cache"
+    env = dict(os.environ, WHIRL_CACHE_DIR=str(cache))
+    os.environ["WHIRL_CACHE_DIR"] = str(cache)
+    studies = selected_studies(scratch / "studies", options.exclude)
+    print(f"studies: {len(list(studies.glob('*.yaml')))} of studies/thesis_ch3"
+          + (f" (excluding {', '.join(options.exclude)})" if options.exclude else ""))
+    try:
+        if only & set("abc"):
+            figures = sweeps(studies, scratch, env, cache)
+            report_sweeps(figures, env)
+            print(f"  in-process second run of linear_case2: "
+                  f"{recompilations_in_process()} Executable.compiled")
+        if "d" in only:
+            linear_figures()
+        if "e" in only:
+            per_case(studies, scratch, env)
+        if "f" in only:
+            fold_figures(scratch, options.fold_tol, options.fold_periods)
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+    print(f"\nload average at the end: {load()}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,197 @@
+"""``whirl sweep``: planning (no AUTO), parallel runs on the real AUTO, resuming, failures,
+Ctrl-C, and the same results through a Dask cluster."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import h5py
+import pytest
+from click.testing import CliRunner
+
+from whirl_cli import __version__, store
+from whirl_cli.cli import cli
+from whirl_cli.compare import compare_files
+from whirl_cli.errors import WhirlError
+from whirl_cli.sweep import INVALID, RUN, SKIP, dask_pool, find_studies, plan
+
+from ..conftest import ROOT, STUDIES
+
+SMALL = ("linear_case2", "linear_datum_airspeed")  # about a second of AUTO each
+
+
+def copy_studies(directory: Path, names=SMALL) -> list[Path]:
+    directory.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for name in names:
+        path = directory / f"{name}.yaml"
+        path.write_text((STUDIES / f"{name}.yaml").read_text())
+        paths.append(path)
+    return paths
+
+
+def renamed(path: Path, name: str, **replace: str) -> Path:
+    """A copy of the study at ``path`` under another study name (and other text changes)."""
+    text = path.read_text()
+    old = next(line for line in text.splitlines() if line.startswith("name:"))
+    text = text.replace(old, f"name: {name}")
+    for before, after in replace.items():
+        text = text.replace(before, after)
+    target = path.with_name(f"{name}.yaml")
+    target.write_text(text)
+    return target
+
+
+def fake_output(path: Path, sha: str, version: str = __version__) -> None:
+    with h5py.File(path, "w") as handle:
+        handle.attrs.update(whirl_schema=1, study_sha256=sha, whirl_version=version)
+
+
+# ------------------------------------------------------------------------------ plan (no AUTO)
+def test_plan_decides_run_skip_and_invalid(tmp_path):
+    studies = tmp_path / "studies"
+    first, second = copy_studies(studies / "nested")
+    (studies / "broken.yaml").write_text("name: broken\nmodel: classical\ncolour: red\n")
+    renamed(first, "linear-datum-airspeed")  # a second file claiming the same study name
+    out = tmp_path / "results"
+    out.mkdir()
+    items = {item.source.name: item for item in plan([studies], out)}
+    assert sorted(items) == ["broken.yaml", "linear-datum-airspeed.yaml", "linear_case2.yaml",
+                             "linear_datum_airspeed.yaml"]
+    assert items["broken.yaml"].action == INVALID
+    assert "broken.yaml:3: colour: unknown key" in items["broken.yaml"].reason
+    duplicate = [i for i in items.values() if "also used by" in i.reason]
+    assert len(duplicate) == 1 and duplicate[0].action == INVALID
+    assert items["linear_case2.yaml"].action == RUN
+    assert items["linear_case2.yaml"].reason == "new"
+    assert items["linear_case2.yaml"].output == out / "linear-case2.h5"
+
+    study = items["linear_case2.yaml"].study
+    fake_output(out / "linear-case2.h5", study.sha256)
+    assert {i.source.name: (i.action, i.reason) for i in plan([first], out)} == {
+        "linear_case2.yaml": (SKIP, "up to date")}
+    assert plan([first], out, force=True)[0].action == RUN
+    fake_output(out / "linear-case2.h5", "0" * 64)
+    assert plan([first], out)[0].reason == "study changed"
+    fake_output(out / "linear-case2.h5", study.sha256, version="0.0.1")
+    assert plan([first], out)[0].reason == f"whirl 0.0.1 -> {__version__}"
+    (out / "linear-case2.h5").write_text("not HDF5")
+    assert plan([first], out)[0].reason.startswith("unreadable output")
+    assert second.name == "linear_datum_airspeed.yaml"
+
+
+def test_find_studies_errors_and_order(tmp_path):
+    with pytest.raises(WhirlError, match="no such file or directory"):
+        find_studies([tmp_path / "missing"])
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(WhirlError, match="no study files"):
+        find_studies([tmp_path / "empty"])
+    paths = copy_studies(tmp_path / "s")
+    assert find_studies([tmp_path / "s", paths[0]]) == sorted(paths)  # each file once
+
+
+def test_missing_dask_says_how_to_install(monkeypatch):
+    monkeypatch.setitem(sys.modules, "dask.distributed", None)
+    with pytest.raises(WhirlError, match=r"pip install 'whirl\[dask\]'"):
+        with dask_pool("tcp://127.0.0.1:1"):
+            pass
+
+
+# ------------------------------------------------------------------------------ real AUTO
+def test_sweep_runs_in_parallel_resumes_and_reports_failures(tmp_path):
+    studies = tmp_path / "studies"
+    copy_studies(studies)
+    (studies / "broken.yaml").write_text("name: broken\nmodel: classical\ncolour: red\n")
+    out = tmp_path / "results"
+    runner = CliRunner()
+    first = runner.invoke(cli, ["sweep", str(studies), "-o", str(out), "-j", "2"])
+    assert first.exit_code == 1, first.output  # the broken study; the others still ran
+    assert "broken.yaml:3: colour: unknown key" in first.output
+    assert "sweep: 2 ok, 0 up to date, 1 invalid of 3 studies" in first.output
+    assert sorted(p.name for p in out.iterdir()) == [
+        "linear-case2.h5", "linear-case2_k1_bifurcation.png", "linear-datum-airspeed.h5",
+        "linear-datum-airspeed_airspeed_bifurcation.png", "linear-datum-airspeed_linear_V.png"]
+
+    # the same physics as `whirl run` of the same study
+    single = tmp_path / "single.h5"
+    assert runner.invoke(cli, ["run", str(STUDIES / "linear_case2.yaml"), "-o", str(single),
+                               "--no-plots"]).exit_code == 0
+    assert compare_files(single, out / "linear-case2.h5") == []
+
+    (studies / "broken.yaml").unlink()
+    stamps = {p: p.stat().st_mtime_ns for p in out.glob("*.h5")}
+    again = runner.invoke(cli, ["sweep", str(studies), "-o", str(out)])
+    assert again.exit_code == 0, again.output
+    assert again.output.count("up to date") == 3  # two lines and the summary
+    assert {p: p.stat().st_mtime_ns for p in out.glob("*.h5")} == stamps
+
+    forced = runner.invoke(cli, ["sweep", str(studies / "linear_case2.yaml"), "-o", str(out),
+                                 "--force", "--no-plots"])
+    assert forced.exit_code == 0, forced.output
+    assert (out / "linear-case2.h5").stat().st_mtime_ns != stamps[out / "linear-case2.h5"]
+
+
+def test_sweep_exits_1_on_a_failed_branch_and_keeps_its_result(tmp_path):
+    source = copy_studies(tmp_path / "studies", ("linear_case2",))[0]
+    # Newton cannot converge to 1e-30: AUTO spins until the 2 s timeout, keeping one point
+    source.write_text(source.read_text()
+                      + "auto: {tolerance: 1.0e-30, newton_max_iterations: 1, timeout: 2}\n")
+    out = tmp_path / "results"
+    result = CliRunner().invoke(cli, ["sweep", str(source), "-o", str(out), "--no-plots"])
+    assert result.exit_code == 1, result.output
+    assert "1 of 1 studies failed" in result.output
+    stored = store.read(out / "linear-case2.h5")
+    assert {b.status for c in stored.continuations for b in c.branches} - {"ok"}
+    # resuming reports the stored failure again instead of hiding it
+    again = CliRunner().invoke(cli, ["sweep", str(source), "-o", str(out), "--no-plots"])
+    assert again.exit_code == 1 and "up to date" in again.output
+
+
+def test_ctrl_c_keeps_finished_outputs_and_exits_130(tmp_path):
+    source = copy_studies(tmp_path / "studies", ("linear_case2",))[0]
+    for k in range(6):
+        renamed(source, f"copy-{k}")
+    source.unlink()
+    out, scratch = tmp_path / "results", tmp_path / "tmp"
+    scratch.mkdir()
+    env = dict(os.environ, TMPDIR=str(scratch))
+    process = subprocess.Popen(
+        [sys.executable, "-m", "whirl_cli", "sweep", str(tmp_path / "studies"), "-o", str(out),
+         "-j", "1", "--no-plots"], cwd=ROOT, env=env, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not list(out.glob("*.h5")):
+        time.sleep(0.1)
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 130, stderr
+    assert "interrupted" in stderr
+    finished = sorted(out.glob("*.h5"))
+    assert 1 <= len(finished) < 6
+    assert [p.name for p in out.iterdir() if p.suffix != ".h5"] == []  # no temporary files
+    for path in finished:
+        assert store.read(path).continuations
+    assert list(scratch.iterdir()) == []  # work directories removed
+
+
+def test_dask_cluster_gives_the_same_results_as_the_local_pool(tmp_path):
+    distributed = pytest.importorskip("dask.distributed")
+    studies = tmp_path / "studies"
+    copy_studies(studies)
+    runner = CliRunner()
+    local = runner.invoke(cli, ["sweep", str(studies), "-o", str(tmp_path / "local"), "-j", "2",
+                                "--no-plots"])
+    assert local.exit_code == 0, local.output
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        remote = runner.invoke(cli, ["sweep", str(studies), "-o", str(tmp_path / "dask"),
+                                     "--dask", cluster.scheduler_address, "--no-plots"])
+    assert remote.exit_code == 0, remote.output
+    for name in ("linear-case2.h5", "linear-datum-airspeed.h5"):
+        compared = runner.invoke(cli, ["compare", str(tmp_path / "local" / name),
+                                       str(tmp_path / "dask" / name)])
+        assert compared.exit_code == 0, compared.output

@@ -1,0 +1,77 @@
+"""Determinism: the same study run twice (once with one AUTO job, once with two in parallel)
+gives equal files. Every dataset is equal (numpy array_equal, NaN positions included), every
+attribute too, except the provenance attribute ``created`` (root) and ``wall_seconds``
+(each run record). Groups and datasets are the same, in the same order."""
+
+from __future__ import annotations
+
+import h5py
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from whirl_cli.cli import cli
+
+from .helpers import STUDIES
+
+pytestmark = pytest.mark.auto
+
+#: Attributes that may differ between two runs of one study.
+VOLATILE = {("/", "created"), ("runs", "wall_seconds")}
+
+
+def contents(path) -> dict:
+    """name -> ("group" | dataset array, attributes) for every object of an HDF5 file."""
+    found: dict = {}
+    with h5py.File(path, "r") as handle:
+        def visit(name: str, item) -> None:
+            data = "group" if isinstance(item, h5py.Group) else item[()]
+            found[name] = (data, dict(item.attrs))
+
+        visit("/", handle)
+        handle.visititems(visit)
+    return found
+
+
+def volatile(name: str, key: str) -> bool:
+    return (name, key) in VOLATILE or (name.startswith("runs/") and ("runs", key) in VOLATILE)
+
+
+def equal(a, b) -> bool:
+    if isinstance(a, str) or isinstance(b, str):
+        return a == b
+    a, b = np.asarray(a), np.asarray(b)
+    if a.dtype != b.dtype or a.shape != b.shape:
+        return False
+    if a.dtype.kind in "fc":
+        return bool(np.array_equal(a, b, equal_nan=True))
+    return bool(np.array_equal(a, b))
+
+
+def test_the_same_study_twice_gives_equal_files(tmp_path):
+    study = STUDIES / "softening_case2.yaml"  # periodic branches (NaN periods), cross-checks
+    paths = []
+    for k, jobs in enumerate(("1", "2")):
+        path = tmp_path / f"run{k}.h5"
+        result = CliRunner().invoke(cli, ["run", str(study), "-o", str(path), "--jobs", jobs,
+                                          "--no-plots"])
+        assert result.exit_code == 0, result.output
+        paths.append(path)
+    first, second = contents(paths[0]), contents(paths[1])
+    assert list(first) == list(second)  # same objects, same order
+    differences = []
+    nan_datasets = 0
+    for name, (data, attributes) in first.items():
+        other_data, other_attributes = second[name]
+        if not equal(data, other_data):
+            differences.append(f"{name}: data")
+        nan_datasets += isinstance(data, np.ndarray) and data.dtype.kind in "fc" and bool(
+            np.isnan(data).any())
+        assert list(attributes) == list(other_attributes), name
+        for key, value in attributes.items():
+            if not volatile(name, key) and not equal(value, other_attributes[key]):
+                differences.append(f"{name}@{key}: {value!r} != {other_attributes[key]!r}")
+    assert not differences, differences
+    assert nan_datasets > 0  # the comparison did see NaN positions
+    periodic = [n for n in first if "/branches/periodic_" in n and n.endswith("/period")]
+    assert periodic and any(n.startswith("runs/") for n in first)

@@ -1,0 +1,285 @@
+"""Atomic, lossless output and clean interruption.
+
+* ``whirl run`` killed (SIGKILL) at seeded random moments never leaves a partial HDF5 file at
+  the output path, nor a temporary file next to it, nor an AUTO process running;
+* the writer itself, failing at every step (store-level fault injection), leaves the old
+  file or nothing, and no temporary file, with O_TMPFILE and with the named fallback;
+* an existing output is never replaced without ``--overwrite``, also when it appears while
+  the study runs (byte-identical afterwards);
+* SIGINT (exit 130) and SIGTERM (exit 143) stop at once without a traceback, kill the running
+  AUTO processes and remove the work directory.
+"""
+
+from __future__ import annotations
+
+import os
+import random
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import h5py
+import pytest
+from click.testing import CliRunner
+
+from whirl_cli import pipeline, store
+from whirl_cli.cli import cli
+from whirl_cli.errors import OutputError
+from whirl_cli.results import StudyResult
+
+from .helpers import STUDIES, WHIRL, auto_processes, environment
+
+SEED = 20240601
+KILLS = 10
+
+
+def session_cache() -> Path:
+    return Path(os.environ["WHIRL_CACHE_DIR"])
+
+
+def wait_for_no_auto(cache: Path, seconds: float = 5.0) -> list[int]:
+    deadline = time.monotonic() + seconds
+    while (left := auto_processes(cache)) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return left
+
+
+def check_output_dir(directory: Path, name: str = "r.h5", plot_temporaries: list | None = None
+                     ) -> bool:
+    """The output is absent or a complete whirl file, with no temporary file of it and nothing
+    else but its plots. Returns whether the output exists. Temporary files of plots (plots.py,
+    not atomic under SIGKILL) are collected in ``plot_temporaries`` if given, else refused."""
+    names = sorted(p.name for p in directory.iterdir()) if directory.exists() else []
+    hidden = [n for n in names if n.startswith(".") or "tmp" in n]
+    assert not [n for n in hidden if name in n or ".png." not in n], names
+    if plot_temporaries is None:
+        assert not hidden, names
+    else:
+        plot_temporaries += hidden
+    names = [n for n in names if n not in hidden]
+    assert set(names) <= {name} | {n for n in names if n.startswith(Path(name).stem + "_")
+                                   and n.endswith(".png")}, names
+    if name not in names:
+        return False
+    with h5py.File(directory / name, "r") as handle:
+        assert handle.attrs["whirl_schema"] == 1
+    result = store.read(directory / name)  # every dataset readable
+    assert result.continuations and result.runs
+    return True
+
+
+# ------------------------------------------------------------------------------ SIGKILL
+@pytest.mark.auto
+def test_sigkill_at_random_moments_never_leaves_a_partial_file(tmp_path):
+    cache = session_cache()
+    study = STUDIES / "linear_datum_airspeed.yaml"
+    env = environment(cache, TMPDIR=str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
+    started = time.monotonic()
+    reference = subprocess.run([str(WHIRL), "run", str(study), "-o", str(tmp_path / "ref.h5")],
+                               env=env, capture_output=True, text=True, timeout=120)
+    duration = time.monotonic() - started
+    assert reference.returncode == 0, reference.stderr
+    rng = random.Random(SEED)
+    delays = sorted(rng.uniform(0, duration) for _ in range(KILLS))
+    written, plot_temporaries = 0, []
+    for k, delay in enumerate(delays):
+        out = tmp_path / f"kill{k}"
+        process = subprocess.Popen([str(WHIRL), "run", str(study), "-o", str(out / "r.h5")],
+                                   env=env, stdout=subprocess.DEVNULL,
+                                   stderr=subprocess.DEVNULL)
+        time.sleep(delay)
+        process.kill()
+        process.wait(timeout=30)
+        assert wait_for_no_auto(cache) == [], f"AUTO left running after SIGKILL at {delay:.2f} s"
+        written += check_output_dir(out, plot_temporaries=plot_temporaries)
+    print(f"\n  {KILLS} SIGKILLs in [0, {duration:.2f}] s: {written} complete outputs, "
+          f"{KILLS - written} none; no partial HDF5 file, no temporary of it"
+          + (f"; plot temporaries left by plots.py: {plot_temporaries}" if plot_temporaries
+             else ""))
+
+
+# ------------------------------------------------------------------------------ the writer
+def small_result() -> StudyResult:
+    return StudyResult(study_name="s", model="m", continuations=(), linear_sweeps=(), runs=(),
+                       attributes={"study_yaml": "name: s\n", "note": "x" * 100_000})
+
+
+class Boom(BaseException):
+    pass
+
+
+def explode(*args, **kwargs):
+    raise Boom
+
+
+@pytest.mark.parametrize("tmpfile", [True, False], ids=["O_TMPFILE", "named"])
+@pytest.mark.parametrize("step", ["write", "link", "replace"])
+@pytest.mark.parametrize("overwrite", [False, True])
+def test_a_write_that_fails_at_any_step_leaves_the_old_file_or_nothing(
+        tmp_path, monkeypatch, tmpfile, step, overwrite):
+    if not tmpfile:
+        monkeypatch.delattr(os, "O_TMPFILE")
+    path = tmp_path / "r.h5"
+    old = b"previous content"
+    if overwrite:
+        path.write_bytes(old)
+    if step == "write":
+        def half(fd, data):
+            os.write(fd, data[:len(data) // 2])
+            raise Boom
+        monkeypatch.setattr(store, "_write_all", half)
+    elif step == "link":
+        monkeypatch.setattr(store.os, "link", explode)
+    else:
+        monkeypatch.setattr(store.os, "replace", explode)
+    failed = step != "replace" or overwrite  # without overwrite nothing is replaced
+    if step == "link" and overwrite and not tmpfile:
+        failed = False  # the named fallback replaces instead of linking
+    if failed:
+        with pytest.raises(Boom):
+            store.write(small_result(), path, overwrite=overwrite)
+    else:
+        store.write(small_result(), path, overwrite=overwrite)
+    names = sorted(p.name for p in tmp_path.iterdir())
+    if failed:
+        assert names == (["r.h5"] if overwrite else []), names
+        if overwrite:
+            assert path.read_bytes() == old
+    else:
+        assert names == ["r.h5"]
+        assert store.read(path).study_name == "s"
+
+
+@pytest.mark.parametrize("tmpfile", [True, False], ids=["O_TMPFILE", "named"])
+def test_the_writer_never_replaces_a_file_without_overwrite(tmp_path, monkeypatch, tmpfile):
+    if not tmpfile:
+        monkeypatch.delattr(os, "O_TMPFILE")
+    path = tmp_path / "r.h5"
+    store.write(small_result(), path)
+    assert store.read(path).attributes["note"] == "x" * 100_000
+    before = path.read_bytes()
+    with pytest.raises(OutputError, match="output exists; pass --overwrite"):
+        store.write(small_result(), path)
+    # the file appears between the check and the link (another process): still refused
+    with pytest.raises(OutputError, match="output exists; pass --overwrite"):
+        store._publish(b"other", path, overwrite=False)
+    assert path.read_bytes() == before
+    store.write(small_result(), path, overwrite=True)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.h5"]
+    mode = path.stat().st_mode & 0o777
+    umask = os.umask(0)
+    os.umask(umask)
+    assert mode == 0o666 & ~umask
+
+
+def test_publish_writes_bytes_the_same_way(tmp_path):
+    """``store.publish`` (for plots rendered to memory): no-clobber unless overwrite."""
+    path = store.publish(b"first", tmp_path / "p.png")
+    with pytest.raises(OutputError, match="output exists"):
+        store.publish(b"second", path)
+    assert path.read_bytes() == b"first"
+    store.publish(b"third", path, overwrite=True)
+    assert path.read_bytes() == b"third" and [p.name for p in tmp_path.iterdir()] == ["p.png"]
+
+
+def test_an_unwritable_directory_is_an_output_error(tmp_path):
+    if os.geteuid() == 0:
+        locked = tmp_path / "file"  # root ignores permissions: a file as the directory
+        locked.write_text("")
+        with pytest.raises(OutputError, match="does not exist"):
+            store.write(small_result(), locked / "r.h5")
+        return
+    locked = tmp_path / "locked"
+    locked.mkdir(mode=0o500)
+    with pytest.raises(OutputError, match="cannot write the output"):
+        store.write(small_result(), locked / "r.h5")
+
+
+@pytest.mark.auto
+def test_whirl_run_never_overwrites_without_overwrite(tmp_path, monkeypatch):
+    study = STUDIES / "linear_datum_airspeed.yaml"
+    output = tmp_path / "r.h5"
+    output.write_bytes(b"not even HDF5")
+    runner = CliRunner()
+    refused = runner.invoke(cli, ["run", str(study), "-o", str(output)])
+    assert refused.exit_code == 1 and "output exists; pass --overwrite" in refused.output
+    assert output.read_bytes() == b"not even HDF5"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.h5"]
+
+    # the file appears while the study runs (e.g. a second `whirl run`): refused at the end
+    output.unlink()
+    real = pipeline.run_study
+
+    def racing(*args, **kwargs):
+        result = real(*args, **kwargs)
+        output.write_bytes(b"written meanwhile")
+        return result
+
+    monkeypatch.setattr(pipeline, "run_study", racing)
+    raced = runner.invoke(cli, ["run", str(study), "-o", str(output), "--no-plots"])
+    assert raced.exit_code == 1 and "output exists; pass --overwrite" in raced.output
+    assert output.read_bytes() == b"written meanwhile"
+    monkeypatch.setattr(pipeline, "run_study", real)
+
+    replaced = runner.invoke(cli, ["run", str(study), "-o", str(output), "--overwrite",
+                                   "--no-plots"])
+    assert replaced.exit_code == 0, replaced.output
+    assert check_output_dir(tmp_path)
+
+
+# ------------------------------------------------------------------------------ signals
+SLOW = """name: slow
+model: classical
+continuations:
+  - {name: one, type: one-parameter, parameter: K1, start: 0.1, range: [-0.3, 0.5]}
+  - {name: two, type: one-parameter, parameter: V, start: 6.7, range: [0.0, 10.0]}
+auto: {max_steps: 100000000, step_initial: 1.0e-9, step_min: 1.0e-12, step_max: 1.0e-9,
+       timeout: 60}
+plots: []
+"""
+
+
+@pytest.mark.auto
+@pytest.mark.parametrize(("signum", "status"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)],
+                         ids=["SIGINT", "SIGTERM"])
+def test_a_signal_stops_cleanly_and_kills_auto(tmp_path, signum, status):
+    cache = session_cache()
+    study = tmp_path / "slow.yaml"
+    study.write_text(SLOW)
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    env = environment(cache, TMPDIR=str(scratch))
+    process = subprocess.Popen([str(WHIRL), "run", str(study), "-o", str(tmp_path / "r.h5"),
+                                "--jobs", "2"], env=env, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while len(auto_processes(cache)) < 2 and process.poll() is None:
+            assert time.monotonic() < deadline, "AUTO never started"
+            time.sleep(0.05)
+        assert len(auto_processes(cache)) == 2
+        sent = time.monotonic()
+        process.send_signal(signum)
+        stdout, stderr = process.communicate(timeout=30)
+        stopped = time.monotonic() - sent
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    assert process.returncode == status, (stdout, stderr)
+    assert stopped < 10, f"took {stopped:.1f} s to stop"
+    assert stderr.rstrip().endswith("interrupted") and "Traceback" not in stdout + stderr
+    assert wait_for_no_auto(cache, 2.0) == []
+    assert not (tmp_path / "r.h5").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["slow.yaml", "tmp"]
+    assert list(scratch.iterdir()) == [], "the work directory was not removed"
+
+
+def test_interrupted_is_a_keyboard_interrupt_with_the_signal():
+    from whirl_cli.auto import Interrupted
+
+    assert issubclass(Interrupted, KeyboardInterrupt)
+    assert Interrupted(signal.SIGTERM).signum == signal.SIGTERM
+    assert 128 + Interrupted().signum == 130

@@ -1,0 +1,335 @@
+"""``whirl compare`` on synthetic results: physics is compared, point indices are not."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import h5py
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from whirl_cli import store
+from whirl_cli.cli import cli
+from whirl_cli.compare import (
+    Tolerances,
+    compare_curves,
+    compare_files,
+    compare_results,
+    monotone_stretches,
+)
+from whirl_cli.results import (
+    Branch,
+    ContinuationResult,
+    LinearSweep,
+    PointType,
+    RunRecord,
+    SpecialPoint,
+    StudyResult,
+)
+
+STATES = ("theta", "psi", "dtheta", "dpsi")
+HOPF = 0.2
+
+
+def equilibrium_branch(values: np.ndarray) -> Branch:
+    """The origin along K1 (stable above the Hopf point at K1 = 0.2), HB marked at its row."""
+    n = len(values)
+    zeros = np.zeros((n, 4))
+    point_type = np.zeros(n, dtype=int)
+    point_type[np.argmin(np.abs(values - HOPF))] = PointType.HB
+    return Branch("main_down", "equilibrium", "start at K1 = 0.5", ("K1",), ("N m/rad",),
+                  STATES, ("rad", "rad", "rad/s", "rad/s"), values[:, None], zeros, zeros,
+                  np.zeros(n), np.full(n, np.nan), values > HOPF, point_type,
+                  np.zeros(n, dtype=int), np.full((n, 4), -1.0 + 2j), end="range")
+
+
+def periodic_branch(s: np.ndarray) -> Branch:
+    """A family born at the Hopf point, folding back at K1 = 0.3 (LPC), amplitude ~ s."""
+    k1 = HOPF + 0.1 * (1 - (1 - s) ** 2)  # up to 0.3 at s = 1, back down after
+    amplitude = 0.2 * s
+    high = np.column_stack([amplitude, 0.5 * amplitude, 3 * amplitude, 2 * amplitude])
+    point_type = np.zeros(len(s), dtype=int)
+    point_type[np.argmin(np.abs(s - 1))] = PointType.LPC
+    return Branch("periodic_1", "periodic", "HB of main_down", ("K1",), ("N m/rad",), STATES,
+                  ("rad", "rad", "rad/s", "rad/s"), k1[:, None], high, -high,
+                  np.zeros(len(s)), 0.3 + 0.1 * s, s > 1, point_type,
+                  np.zeros(len(s), dtype=int), np.ones((len(s), 4), dtype=complex),
+                  end="range")
+
+
+def special_points() -> tuple[SpecialPoint, ...]:
+    return (
+        SpecialPoint("main_down", 10, PointType.HB, ("K1",), np.array([HOPF]), np.zeros(4),
+                     0.3, False, criticality="subcritical"),
+        SpecialPoint("periodic_1", 40, PointType.LPC, ("K1",), np.array([0.3]),
+                     np.array([0.2, 0.1, 0.6, 0.4]), 0.4, False),
+    )
+
+
+def make_result(main_points: int = 201, periodic_points: int = 161, **changes) -> StudyResult:
+    """A small study result; ``main_points``/``periodic_points`` change only the sampling."""
+    branches = (equilibrium_branch(np.linspace(0.5, -0.3, main_points)),
+                periodic_branch(np.linspace(0.0, 1.6, periodic_points)))
+    continuation = ContinuationResult("k1", "one-parameter", branches, special_points())
+    values = np.linspace(0.0, 10.0, 11)
+    eigenvalues = np.column_stack([-1 + values * 0.1 + 2j, -1 + values * 0.1 - 2j])
+    sweep = LinearSweep("V", "m/s", values, eigenvalues, -eigenvalues.real / 2.2,
+                        np.abs(eigenvalues.imag), np.array([["FW", "BW"]] * 11))
+    attributes = {"study_sha256": "abc", "study_yaml": "name: x\n", "whirl_version": "0.1.0",
+                  "created": "2026-01-01T00:00:00Z", "auto_version": "0.9.2"}
+    result = StudyResult("x", "classical_poly_theta", (continuation,), (sweep,),
+                         (RunRecord("k1.main_down", "ok", "ok", "", 0, 0.1, main_points),),
+                         attributes)
+    return replace(result, **changes)
+
+
+def with_branch(result: StudyResult, name: str, **changes) -> StudyResult:
+    continuation = result.continuations[0]
+    branches = tuple(replace(b, **changes) if b.name == name else b
+                     for b in continuation.branches)
+    return replace(result, continuations=(replace(continuation, branches=branches),))
+
+
+def with_point(result: StudyResult, row: int, **changes) -> StudyResult:
+    continuation = result.continuations[0]
+    points = list(continuation.special_points)
+    points[row] = replace(points[row], **changes)
+    return replace(result, continuations=(replace(continuation,
+                                                  special_points=tuple(points)),))
+
+
+def paths(differences) -> list[str]:
+    return [d.path for d in differences]
+
+
+def test_identical_results_agree():
+    assert compare_results(make_result(), make_result()) == []
+
+
+def test_different_sampling_of_the_same_curves_agrees():
+    """Point indices and step sizes are not physics: resampled branches still agree."""
+    assert compare_results(make_result(), make_result(main_points=157, periodic_points=230)) \
+        == []
+
+
+def test_provenance_that_changes_legitimately_is_ignored():
+    other = make_result()
+    other.attributes.update(created="2027-01-01T00:00:00Z", whirl_version="9.9",
+                            auto_version="1.0", git_describe="abc-dirty")
+    assert compare_results(make_result(), other) == []
+    other.attributes["study_sha256"] = "def"
+    assert paths(compare_results(make_result(), other)) == ["/@study_sha256"]
+
+
+def test_moved_hopf_point_is_named_by_path():
+    moved = with_point(make_result(), 0, parameters=np.array([HOPF + 1e-3]))
+    (difference,) = compare_results(make_result(), moved)
+    assert difference.path == "/continuations/k1/special_points/parameters[0]"
+    assert "0.2" in difference.a and "0.201" in difference.b
+    # within the default tolerance (1e-6 x the K1 span of 0.8): no drift
+    assert compare_results(make_result(),
+                           with_point(make_result(), 0, parameters=np.array([HOPF + 1e-7]))) \
+        == []
+
+
+def test_special_point_state_period_criticality():
+    base = make_result()
+    changed = with_point(base, 1, state=np.array([0.2, 0.1, 0.6, 0.4 + 1e-4]), period=0.41)
+    changed = with_point(changed, 0, criticality="supercritical")
+    assert sorted(paths(compare_results(base, changed))) == [
+        "/continuations/k1/special_points/criticality[0]",
+        "/continuations/k1/special_points/period[1]",
+        "/continuations/k1/special_points/state[1, 3]"]
+
+
+def test_missing_special_point_is_reported():
+    base = make_result()
+    continuation = base.continuations[0]
+    fewer = replace(base, continuations=(replace(continuation,
+                                                 special_points=continuation.special_points[:1]),))
+    (difference,) = compare_results(base, fewer)
+    assert difference.path == "/continuations/k1/special_points"
+    assert "LPC" in difference.a
+
+
+def test_symmetric_points_are_paired_by_position_not_order():
+    base = make_result()
+    continuation = base.continuations[0]
+    twins = (SpecialPoint("main_down", 3, PointType.BP, ("K1",), np.array([0.1]),
+                          np.array([0.05, 0, 0, 0]), np.nan, True),
+             SpecialPoint("main_down", 4, PointType.BP, ("K1",), np.array([0.1]),
+                          np.array([-0.05, 0, 0, 0]), np.nan, True))
+    a = replace(base, continuations=(replace(
+        continuation, special_points=continuation.special_points + twins),))
+    b = replace(base, continuations=(replace(
+        continuation, special_points=continuation.special_points + twins[::-1]),))
+    assert compare_results(a, b) == []
+
+
+def test_flipped_stability_over_a_stretch_is_caught():
+    base = make_result()
+    stable = base.continuations[0].branches[0].stable.copy()
+    stable[20:60] = ~stable[20:60]
+    (difference,) = compare_results(base, with_branch(base, "main_down", stable=stable))
+    assert difference.path == "/continuations/k1/branches/main_down/stable"
+    assert difference.a == "stable" and difference.b == "unstable"
+
+
+def test_stability_may_disagree_within_one_cell_of_a_special_point():
+    base = make_result()
+    branch = base.continuations[0].branches[0]
+    row = int(np.flatnonzero(branch.point_type == PointType.HB)[0])
+    stable = branch.stable.copy()
+    stable[row] = not stable[row]  # where exactly the switch falls is not physics
+    assert compare_results(base, with_branch(base, "main_down", stable=stable)) == []
+
+
+def test_branch_state_drift_is_caught_on_common_parameter_values():
+    base = make_result()
+    branch = base.continuations[0].branches[1]
+    high = branch.state_max.copy()
+    high[:, 0] *= 1.001
+    found = compare_results(base, with_branch(base, "periodic_1", state_max=high))
+    assert {d.path for d in found} == {"/continuations/k1/branches/periodic_1/state_max"}
+    assert len(found) == 2  # both monotone stretches, below and above the fold
+    assert all("K1 =" in d.note for d in found)
+
+
+def test_branch_end_status_and_presence():
+    base = make_result()
+    changed = with_branch(base, "main_down", end="amplitude bound", status="mx")
+    assert sorted(paths(compare_results(base, changed))) == [
+        "/continuations/k1/branches/main_down/@end",
+        "/continuations/k1/branches/main_down/@status"]
+    continuation = base.continuations[0]
+    fewer = replace(base, continuations=(replace(continuation,
+                                                 branches=continuation.branches[:1]),))
+    assert "/continuations/k1/branches/periodic_1" in paths(compare_results(base, fewer))
+
+
+def test_extra_fold_changes_the_monotone_stretches():
+    base = make_result()
+    branch = base.continuations[0].branches[1]
+    shorter = replace(branch, parameters=branch.parameters[:60], state_max=branch.state_max[:60],
+                      state_min=branch.state_min[:60], stable=branch.stable[:60],
+                      point_type=branch.point_type[:60])
+    found = compare_results(base, with_branch(base, "periodic_1", **{
+        k: getattr(shorter, k) for k in ("parameters", "state_max", "state_min", "stable",
+                                          "point_type")}))
+    assert "/continuations/k1/branches/periodic_1/parameters" in paths(found)
+
+
+def test_linear_sweeps_compare_elementwise():
+    base = make_result()
+    sweep = base.linear_sweeps[0]
+    close = replace(sweep, eigenvalues=sweep.eigenvalues * (1 + 1e-12))
+    assert compare_results(base, replace(base, linear_sweeps=(close,))) == []
+    far = replace(sweep, damping_ratio=sweep.damping_ratio * (1 + 1e-6))
+    (difference,) = compare_results(base, replace(base, linear_sweeps=(far,)))
+    assert difference.path.startswith("/linear/sweeps/V/damping_ratio[")
+    whirl = sweep.whirl.copy()
+    whirl[3, 0] = "BW"
+    (difference,) = compare_results(base, replace(base, linear_sweeps=(replace(
+        sweep, whirl=whirl),)))
+    assert difference.path == "/linear/sweeps/V/whirl[3, 0]"
+
+
+def test_run_status_is_compared_but_not_wall_time():
+    base = make_result()
+    slower = replace(base, runs=(replace(base.runs[0], wall_seconds=5.0, n_points=7),))
+    assert compare_results(base, slower) == []
+    failed = replace(base, runs=(replace(base.runs[0], status="mx"),))
+    assert paths(compare_results(base, failed)) == ["/runs/k1.main_down"]
+
+
+def test_tolerances_from_cli_options():
+    assert Tolerances.from_options() == Tolerances()
+    chosen = Tolerances.from_options(rtol=1e-3, atol=1e-2)
+    assert (chosen.period, chosen.linear, chosen.parameter) == (1e-3, 1e-3, 1e-3)
+    assert (chosen.state, chosen.branch_state) == (1e-2, 1e-2)
+    moved = with_point(make_result(), 0, parameters=np.array([HOPF + 1e-5]))
+    assert compare_results(make_result(), moved) != []
+    assert compare_results(make_result(), moved, chosen) == []
+
+
+def test_monotone_stretches_cut_at_folds_and_lines():
+    values = np.array([0.0, 1.0, 2.0, 1.5, 1.5, 1.5, 3.0])
+    assert [(s.start, s.stop, s.direction) for s in monotone_stretches(values, 1e-9)] == [
+        (0, 2, 1), (2, 3, -1), (3, 5, 0), (5, 6, 1)]
+    assert [s.direction for s in monotone_stretches(np.array([1.0]), 1e-9)] == [0]
+
+
+def circle(points: int, radius: float = 1.0) -> np.ndarray:
+    angle = np.linspace(0, 2 * np.pi, points)
+    return np.column_stack([radius * np.cos(angle), radius * np.sin(angle)])
+
+
+def test_curves_compare_by_distance_not_by_sampling():
+    assert compare_curves("/boundaries/b/hopf", circle(4001), circle(3001), 1e-5) == []
+    (difference,) = compare_curves("/boundaries/b/hopf", circle(4001), circle(3001, 1.001),
+                                   1e-5)
+    assert difference.path == "/boundaries/b/hopf"
+
+
+def write_pair(tmp_path, curve_b: np.ndarray):
+    """Two result files, equal but for a locus curve under /boundaries (layout of store.py)."""
+    a, b = tmp_path / "a.h5", tmp_path / "b.h5"
+    for path, curve in ((a, circle(2001)), (b, curve_b)):
+        store.write(make_result(), path, overwrite=True)
+        with h5py.File(path, "r+") as handle:
+            group = handle.create_group("boundaries/k1-kpsi")
+            group.attrs.update(parameters=["K1", "K_psi"], units=["N m/rad", "N m/rad"],
+                               method="loci", slices=np.array([0.1, 0.2]))
+            group.create_dataset("loci/hopf_1", data=curve).attrs["kind"] = "hopf"
+            group.create_dataset("unsafe/polygon_0", data=circle(50, 0.5))
+            table = group.create_group("unsafe_intervals")
+            for key in ("slice_value", "lower", "upper"):
+                table.create_dataset(key, data=np.array([0.1]))
+            table.create_dataset("cause", data=["flutter"], dtype=h5py.string_dtype())
+    return a, b
+
+
+def test_files_with_boundaries(tmp_path):
+    a, b = write_pair(tmp_path, circle(1500))
+    assert compare_files(a, b) == []
+    a, b = write_pair(tmp_path, circle(1500) + [0.0, 0.01])
+    assert paths(compare_files(a, b)) == ["/boundaries/k1-kpsi/loci/hopf_1"]
+
+
+@pytest.fixture
+def files(tmp_path):
+    a, b = tmp_path / "a.h5", tmp_path / "b.h5"
+    store.write(make_result(), a)
+    moved = with_point(make_result(main_points=150), 0, parameters=np.array([HOPF + 1e-3]))
+    store.write(moved, b)
+    return a, b
+
+
+def test_cli_exit_status_and_output(files):
+    a, b = files
+    runner = CliRunner()
+    same = runner.invoke(cli, ["compare", str(a), str(a)])
+    assert same.exit_code == 0, same.output
+    assert "agree" in same.output
+    drift = runner.invoke(cli, ["compare", str(a), str(b)])
+    assert drift.exit_code == 1
+    assert "/continuations/k1/special_points/parameters[0]: K1 = 0.2 vs 0.201" in drift.output
+    assert "differ (1 difference(s))" in drift.output
+    relaxed = runner.invoke(cli, ["compare", str(a), str(b), "--rtol", "1e-2"])
+    assert relaxed.exit_code == 0, relaxed.output
+
+
+def test_cli_prints_at_most_the_limit(tmp_path):
+    base = make_result()
+    sweep = base.linear_sweeps[0]
+    other = replace(base, attributes={**base.attributes, "study_sha256": "zzz",
+                                      "study_yaml": "other"}, study_name="y", model="m",
+                    linear_sweeps=(replace(sweep, values=sweep.values + 1,
+                                           eigenvalues=sweep.eigenvalues + 1,
+                                           damping_ratio=sweep.damping_ratio + 1,
+                                           frequency=sweep.frequency + 1),))
+    a, b = store.write(base, tmp_path / "a.h5"), store.write(other, tmp_path / "b.h5")
+    result = CliRunner().invoke(cli, ["compare", str(a), str(b), "--limit", "3"])
+    assert result.exit_code == 1
+    assert "... and 5 more" in result.output

@@ -1,0 +1,239 @@
+"""Stability boundaries in two parameters and the unsafe (overhang) region.
+
+The *unsafe* region holds the parameters where linear analysis calls the undeflected
+equilibrium stable, yet whirl flutter (a limit-cycle family with a stable part) or static
+divergence (secondary equilibria) exists. Along a slice (the second parameter fixed) it is:
+
+* flutter: between a fold of cycles (LPC) and the Hopf point its family leans over from,
+* divergence: between a fold of the secondary equilibria (LP) and the pitchfork (BP),
+
+each intersected with the linearly stable part of the slice. Two ways to get it:
+
+* ``loci``: cross the Hopf, LPC, BP and LP loci (two-parameter continuation) with each slice;
+* ``slices`` (the thesis' method): from one-parameter runs with periodic branches per slice.
+
+Polygons of the region are assembled from the intervals of consecutive slices.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import linear
+from .models import Model
+from .results import Boundary, Branch, BranchKind, UnsafeInterval
+
+Interval = tuple[float, float]
+
+
+def stable_intervals(model: Model, overrides: dict[str, float], first: str, second: str,
+                     value: float, bounds: Interval, points: int = 4001) -> list[Interval]:
+    """Intervals of ``first`` where y = 0 is linearly stable at ``second`` = ``value``."""
+    from scipy.optimize import brentq
+
+    grid = np.linspace(bounds[0], bounds[1], points)
+    fixed = {**overrides, second: value}
+
+    def growth(values: np.ndarray) -> np.ndarray:
+        params = linear.parameter_matrix(model, fixed, first, values)
+        eigenvalues = linear.batched_eigenvalues(np.ascontiguousarray(
+            linear.jacobians(model, params)))
+        return eigenvalues.real.max(axis=1)
+
+    rates = growth(grid)
+    stable = rates < 0
+    edges = {}  # grid index k -> exact crossing between grid[k] and grid[k + 1]
+    for k in np.flatnonzero(stable[:-1] != stable[1:]):
+        edges[k] = brentq(lambda v: float(growth(np.array([v]))[0]), grid[k], grid[k + 1],
+                          xtol=1e-12)
+    intervals = []
+    for lo, hi in _runs(grid, stable):
+        lo_index = int(np.searchsorted(grid, lo)) - 1
+        hi_index = int(np.searchsorted(grid, hi)) - 1
+        intervals.append((edges.get(lo_index, lo), edges.get(hi_index, hi)))
+    return intervals
+
+
+def _runs(grid: np.ndarray, flag: np.ndarray) -> list[Interval]:
+    """Maximal intervals of ``grid`` where ``flag`` holds (ends at the mid-points)."""
+    intervals = []
+    edges = np.flatnonzero(np.diff(flag.astype(int))) + 1
+    for part in np.split(np.arange(len(grid)), edges):
+        if flag[part[0]]:
+            lo = grid[part[0]] if part[0] == 0 else 0.5 * (grid[part[0] - 1] + grid[part[0]])
+            hi = grid[part[-1]] if part[-1] == len(grid) - 1 else 0.5 * (
+                grid[part[-1]] + grid[part[-1] + 1])
+            intervals.append((float(lo), float(hi)))
+    return intervals
+
+
+def intersect(intervals: list[Interval], allowed: list[Interval],
+              minimum: float = 0.0) -> list[Interval]:
+    """The parts of ``intervals`` inside ``allowed`` (both lists of (lo, hi)), dropping pieces
+    not longer than ``minimum``."""
+    out = []
+    for lo, hi in intervals:
+        for a, b in allowed:
+            left, right = max(lo, a), min(hi, b)
+            if right - left > minimum:
+                out.append((left, right))
+    return merge(out)
+
+
+def merge(intervals: list[Interval]) -> list[Interval]:
+    """Union of intervals, sorted."""
+    out: list[list[float]] = []
+    for lo, hi in sorted(intervals):
+        if out and lo <= out[-1][1]:
+            out[-1][1] = max(out[-1][1], hi)
+        else:
+            out.append([lo, hi])
+    return [(a, b) for a, b in out]
+
+
+def crossings(curve: np.ndarray, value: float) -> list[float]:
+    """First-coordinate values where the polyline ``curve`` (K, 2) crosses second = value."""
+    y = curve[:, 1] - value
+    found = []
+    for k in np.flatnonzero(y[:-1] * y[1:] <= 0):
+        if y[k] == y[k + 1]:
+            continue
+        w = y[k] / (y[k] - y[k + 1])
+        found.append(float(curve[k, 0] + w * (curve[k + 1, 0] - curve[k, 0])))
+    return found
+
+
+def _paired(folds: list[float], anchors: list[float]) -> list[Interval]:
+    """Each fold with the nearest anchor (Hopf or pitchfork) as an interval."""
+    if not anchors:
+        return []
+    return [tuple(sorted((f, min(anchors, key=lambda a: abs(a - f))))) for f in folds]
+
+
+def unsafe_from_loci(loci: dict[str, list[np.ndarray]], stable: list[Interval], value: float,
+                     minimum: float = 0.0) -> list[UnsafeInterval]:
+    """Unsafe intervals of the slice second = ``value`` from the locus curves (keys: hopf,
+    fold_of_cycles, branch_point, fold)."""
+    def at(kind: str) -> list[float]:
+        return [x for curve in loci.get(kind, []) for x in crossings(curve, value)]
+
+    flutter = intersect(_paired(at("fold_of_cycles"), at("hopf")), stable, minimum)
+    divergence = intersect(_paired(at("fold"), at("branch_point")), stable, minimum)
+    return ([UnsafeInterval(value, lo, hi, "flutter") for lo, hi in flutter]
+            + [UnsafeInterval(value, lo, hi, "divergence") for lo, hi in divergence])
+
+
+def unsafe_from_branches(branches: tuple[Branch, ...], stable: list[Interval], value: float,
+                         minimum: float = 0.0) -> list[UnsafeInterval]:
+    """Unsafe intervals of one slice from its one-parameter branches: the extent of every
+    periodic family with a stable part, and of every secondary equilibrium branch with a fold,
+    intersected with the linearly stable part of the slice."""
+    flutter, divergence = [], []
+    for branch in branches:
+        if not len(branch):
+            continue
+        extent = (float(branch.parameters[:, 0].min()), float(branch.parameters[:, 0].max()))
+        if branch.kind == BranchKind.PERIODIC and branch.stable[1:-1].any():
+            flutter.append(extent)
+        elif (branch.kind == BranchKind.EQUILIBRIUM and branch.origin.startswith("BP at")
+              and np.any(branch.point_type == 2)):
+            divergence.append(extent)
+    return ([UnsafeInterval(value, lo, hi, "flutter")
+             for lo, hi in intersect(flutter, stable, minimum)]
+            + [UnsafeInterval(value, lo, hi, "divergence")
+               for lo, hi in intersect(divergence, stable, minimum)])
+
+
+def polygons(intervals: list[UnsafeInterval], values: list[float],
+             tolerance: float = 0.0) -> list[np.ndarray]:
+    """Closed polygons (K, 2) in (first, second) covering the unsafe intervals of the rows
+    ``values`` (every row examined, also those without intervals): intervals of neighbouring
+    rows that overlap are joined into one polygon; an interval with no partner on a
+    neighbouring row becomes a flat outline."""
+    values = sorted(values)
+    rows = {v: merge([(i.lower, i.upper) for i in intervals if i.slice_value == v])
+            for v in values}
+    chains: list[list[tuple[float, Interval]]] = []
+    open_chains: list[list[tuple[float, Interval]]] = []
+    for value in values:
+        following = []
+        for interval in rows[value]:
+            chain = next((c for c in open_chains if c[-1][1][0] <= interval[1] + tolerance
+                          and interval[0] <= c[-1][1][1] + tolerance and c not in following),
+                         None)
+            if chain is None:
+                chain = []
+                chains.append(chain)
+            chain.append((value, interval))
+            following.append(chain)
+        open_chains = following
+    shapes = []
+    for chain in chains:
+        left = [(lo, v) for v, (lo, _) in chain]
+        right = [(hi, v) for v, (_, hi) in reversed(chain)]
+        if len(chain) == 1:
+            (v, (lo, hi)), = chain
+            shape = [(lo, v), (hi, v), (hi, v), (lo, v)]
+        else:
+            shape = left + right
+        shape.append(shape[0])
+        shapes.append(np.array(shape, dtype=float))
+    return shapes
+
+
+#: Locus branch kinds -> the names used in ``unsafe_from_loci``.
+LOCUS_NAMES = {
+    BranchKind.HOPF_LOCUS: "hopf",
+    BranchKind.FOLD_OF_CYCLES_LOCUS: "fold_of_cycles",
+    BranchKind.BRANCH_POINT_LOCUS: "branch_point",
+    BranchKind.FOLD_LOCUS: "fold",
+}
+
+
+def loci_curves(curves: list[Branch]) -> dict[str, list[np.ndarray]]:
+    """Locus curves by name. Hopf and fold-of-cycles loci count only where they concern the
+    undeflected equilibrium and its flutter (orbits centred on y = 0): other stretches (the
+    secondary equilibria, asymmetric cycles) are cut out."""
+    found: dict[str, list[np.ndarray]] = {}
+    for curve in curves:
+        name = LOCUS_NAMES[curve.kind]
+        keep = np.ones(len(curve), dtype=bool)
+        if name in ("hopf", "fold_of_cycles"):  # centred within 2 % of the orbit's size
+            centre = np.abs(0.5 * (curve.state_max + curve.state_min))
+            size = 0.5 * (curve.state_max - curve.state_min)
+            keep = np.all(centre <= 0.02 * size + 1e-6, axis=1)
+        cuts = np.flatnonzero(np.diff(keep.astype(int))) + 1
+        for part in np.split(np.arange(len(curve)), cuts):
+            if keep[part[0]] and len(part) >= 2:
+                found.setdefault(name, []).append(curve.parameters[part, :2])
+    return found
+
+
+def boundary(name: str, model: Model, overrides: dict[str, float], pair: tuple[str, str],
+             bounds: dict[str, Interval], method: str, slices: tuple[float, ...],
+             resolution: int, curves: list[Branch], slice_branches: list[tuple[Branch, ...]]
+             ) -> Boundary:
+    """The unsafe region of a two-parameter continuation, by ``method`` ("loci": on
+    ``resolution`` rows across the second parameter's range plus the slices; "slices": on the
+    slices, from their one-parameter branches)."""
+    first, second = pair
+    minimum = 1e-3 * (bounds[first][1] - bounds[first][0])  # narrower pieces are round-off
+
+    def stable(value: float) -> list[Interval]:
+        return stable_intervals(model, overrides, first, second, value, bounds[first], 4001)
+
+    intervals: list[UnsafeInterval] = []
+    if method == "loci":
+        curves_by_name = loci_curves(curves)
+        rows = sorted(set(np.linspace(*bounds[second], resolution).tolist()) | set(slices))
+        for value in rows:
+            intervals += unsafe_from_loci(curves_by_name, stable(value), value, minimum)
+    else:
+        rows = list(slices)
+        for value, branches in zip(slices, slice_branches, strict=True):
+            main = tuple(b for b in branches if b.kind != BranchKind.PERIODIC
+                         or b.origin.endswith(("main_down", "main_up")))
+            intervals += unsafe_from_branches(main, stable(value), value, minimum)
+    loci = {c.name: (LOCUS_NAMES[c.kind], c.parameters[:, :2]) for c in curves}
+    return Boundary(name, pair, tuple(model.parameter(p).unit for p in pair), method, loci,
+                    tuple(intervals), tuple(polygons(intervals, rows)), tuple(slices))
