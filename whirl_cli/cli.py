@@ -255,16 +255,16 @@ def sweep(paths: tuple[Path, ...], out_dir: Path, jobs: int, dask_address: str |
     """Run every study in PATHS (files, or directories searched for *.yaml), in parallel.
 
     Resumable: a study whose output has the same study_sha256 and whirl_version is skipped.
-    Exit 1 if any study failed (the others still run), 130 when interrupted.
+    Exit 1 if any study failed (the others still run), 130 on Ctrl-C, 143 on SIGTERM.
     """
     from .sweep import run_sweep
 
     try:
         tally = run_sweep(paths, out_dir, jobs=jobs, dask_address=dask_address, force=force,
                           plots=plots, console=_console())
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as error:
         click.echo("interrupted", err=True)
-        raise SystemExit(130) from None
+        raise SystemExit(128 + getattr(error, "signum", 2)) from None  # 130 SIGINT, 143 TERM
     if tally.failures:
         raise WhirlError(f"{len(tally.failures)} of {tally.total} studies failed")
 

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import pickle
 import shutil
 import signal
 import tempfile
@@ -180,6 +181,23 @@ def _init_worker(cancelled) -> None:
     global _CANCELLED
     _CANCELLED = cancelled
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _die_with_parent()
+
+
+def _die_with_parent() -> None:
+    """Ask Linux to SIGKILL this worker when the sweep process dies (e.g. SIGKILL), so that
+    no idle worker outlives it (its AUTO processes already die with it, see
+    :mod:`whirl_cli.auto`). A no-op where ``prctl`` is unavailable."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        pr_set_pdeathsig = 1
+        libc.prctl(pr_set_pdeathsig, signal.SIGKILL, 0, 0, 0)
+    except (OSError, AttributeError):
+        return
+    if os.getppid() == 1:  # the parent died before the request took effect
+        os._exit(1)
 
 
 def compute(study: Study) -> StudyResult:
@@ -192,11 +210,24 @@ def compute(study: Study) -> StudyResult:
     workroot = Path(tempfile.mkdtemp(prefix=f"whirl-sweep-{study.name}-"))
     try:
         return run_study(study, workroot, jobs=1)
-    except BaseException:
+    except BaseException as error:
         _join_helper_threads(study.auto.timeout if study.auto else None)
-        raise
+        raise portable(error) from None
     finally:
         shutil.rmtree(workroot, ignore_errors=True)
+
+
+def portable(error: BaseException) -> BaseException:
+    """``error`` if it survives pickling (it travels back to the parent), else a plain
+    KeyboardInterrupt or RuntimeError with its message. An exception that cannot be
+    unpickled makes a process pool declare itself broken and kill every worker."""
+    try:
+        pickle.loads(pickle.dumps(error))
+        return error
+    except Exception:
+        text = f"{type(error).__name__}: {error}"
+        return KeyboardInterrupt(text) if isinstance(error, KeyboardInterrupt) \
+            else RuntimeError(text)
 
 
 def _join_helper_threads(timeout: float | None) -> None:
@@ -360,11 +391,26 @@ class LocalPool(ProcessPoolExecutor):
         for started in [self.submit(os.getpid) for _ in range(self.jobs)]:
             started.result()
 
+    def close(self, timeout: float) -> None:
+        """Shut down after an interrupt without risking a hang: workers not gone after
+        ``timeout`` s (a worker killed inside the pool's queue code leaves the others
+        waiting on its lock) are terminated; by then they run no study."""
+        workers = self.workers()
+        self.shutdown(wait=False)
+        deadline = time.monotonic() + timeout
+        for process in workers:
+            process.join(max(0.0, deadline - time.monotonic()))
+        for process in workers:
+            if process.is_alive():
+                process.terminate()
+                process.join(5)
+
     def interrupt(self) -> None:
         self.cancelled.set()
         for process in self.workers():
             if process.is_alive():
                 os.kill(process.pid, signal.SIGINT)
+
 
 @contextmanager
 def local_pool(jobs: int) -> Iterator[Executor]:
@@ -374,7 +420,10 @@ def local_pool(jobs: int) -> Iterator[Executor]:
     try:
         pool.start()
         yield pool
-    finally:  # after an interrupt every task has returned (see _stop_running): no waiting
+    except BaseException:  # every task has returned (see _stop_running)
+        pool.close(timeout=10.0)
+        raise
+    else:
         pool.shutdown(wait=True)
 
 
@@ -508,6 +557,7 @@ def run_sweep(paths: Sequence[str | os.PathLike[str]], out_dir: Path, jobs: int 
         Path(out_dir).mkdir(parents=True, exist_ok=True)
     reporter = Reporter(len(items), console)
     interrupted = False
+    previous_term = _term_as_interrupt()
     try:
         if dask_address:
             pool = dask_pool(dask_address)
@@ -520,5 +570,22 @@ def run_sweep(paths: Sequence[str | os.PathLike[str]], out_dir: Path, jobs: int 
         interrupted = True
         raise
     finally:
+        if previous_term is not None:
+            signal.signal(signal.SIGTERM, previous_term)
         reporter.console.print(reporter.tally.summary(interrupted), markup=False, soft_wrap=True)
     return reporter.tally
+
+
+def _term_as_interrupt():
+    """Make SIGTERM (a batch system's cancel, ``kill``) stop a sweep like Ctrl-C: queued studies
+    cancelled, running ones interrupted, finished outputs kept. Returns the previous handler
+    (None off the main thread, where signals cannot be handled)."""
+    from .auto import Interrupted
+
+    def on_term(signum, frame):
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)  # once: let the clean-up finish
+        raise Interrupted(signum)
+
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    return signal.signal(signal.SIGTERM, on_term)

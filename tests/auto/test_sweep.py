@@ -152,7 +152,9 @@ def test_sweep_exits_1_on_a_failed_branch_and_keeps_its_result(tmp_path):
     assert again.exit_code == 1 and "up to date" in again.output
 
 
-def test_ctrl_c_keeps_finished_outputs_and_exits_130(tmp_path):
+def start_interruptible_sweep(tmp_path: Path, jobs: int = 1):
+    """A ``whirl sweep`` of six small studies in its own session, and (out, scratch) dirs,
+    returned once the first output exists."""
     source = copy_studies(tmp_path / "studies", ("linear_case2",))[0]
     for k in range(6):
         renamed(source, f"copy-{k}")
@@ -162,20 +164,59 @@ def test_ctrl_c_keeps_finished_outputs_and_exits_130(tmp_path):
     env = dict(os.environ, TMPDIR=str(scratch))
     process = subprocess.Popen(
         [sys.executable, "-m", "whirl_cli", "sweep", str(tmp_path / "studies"), "-o", str(out),
-         "-j", "1", "--no-plots"], cwd=ROOT, env=env, stderr=subprocess.PIPE, text=True)
+         "-j", str(jobs), "--no-plots"], cwd=ROOT, env=env, stderr=subprocess.PIPE, text=True,
+        start_new_session=True)
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline and not list(out.glob("*.h5")):
         time.sleep(0.1)
-    process.send_signal(signal.SIGINT)
-    _, stderr = process.communicate(timeout=60)
-    assert process.returncode == 130, stderr
-    assert "interrupted" in stderr
+    return process, out, scratch
+
+
+def session_processes(session: int) -> list[int]:
+    """PIDs still alive in a session (the sweep, its workers and their AUTO runs)."""
+    alive = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                if os.getsid(int(entry.name)) == session:
+                    alive.append(int(entry.name))
+            except (ProcessLookupError, PermissionError):
+                pass
+    return alive
+
+
+def assert_finished_outputs_kept(out: Path, scratch: Path) -> None:
     finished = sorted(out.glob("*.h5"))
     assert 1 <= len(finished) < 6
     assert [p.name for p in out.iterdir() if p.suffix != ".h5"] == []  # no temporary files
     for path in finished:
         assert store.read(path).continuations
+
+
+@pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_interrupt_keeps_finished_outputs_and_leaves_no_process(tmp_path, signum, code):
+    process, out, scratch = start_interruptible_sweep(tmp_path, jobs=2)
+    process.send_signal(signum)  # the parent only (Ctrl-C on a terminal reaches the workers too)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == code, stderr
+    assert "interrupted" in stderr
+    assert_finished_outputs_kept(out, scratch)
     assert list(scratch.iterdir()) == []  # work directories removed
+    deadline = time.monotonic() + 10
+    while session_processes(process.pid) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert session_processes(process.pid) == []
+
+
+def test_sigkill_of_the_sweep_takes_its_workers_and_auto_runs_along(tmp_path):
+    process, out, _ = start_interruptible_sweep(tmp_path, jobs=2)
+    process.kill()
+    process.communicate(timeout=30)
+    deadline = time.monotonic() + 10
+    while session_processes(process.pid) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert session_processes(process.pid) == []  # no orphaned worker or AUTO process
+    assert_finished_outputs_kept(out, out)
 
 
 def test_dask_cluster_gives_the_same_results_as_the_local_pool(tmp_path):
