@@ -8,7 +8,8 @@
 (c) recompilations: a cold compile cache, then a ``--force`` re-run: new cache entries
     (compiled executables, ``Executable.compiled``) on the re-run.
 (d) linear analysis: ``whirl_cli.linear.sweep`` over 2000 airspeeds at once against a Python
-    loop calling it point by point.
+    loop calling it point by point, and ``linear.grid`` over 400 x 400 (K_theta, K_psi)
+    against a per-point loop.
 (e) ``whirl run`` wall time of every chapter-3 case (plots and cross-checks as the studies
     ask), warm cache.
 (f) a fold of cycles: the LPC of softening case 2 by continuation (``run_study``, and the AUTO
@@ -257,6 +258,39 @@ def linear_figures(points: int = 2000) -> None:
                               for k in range(points)], repeats=1)
     print(f"  linear.sweep over all points {vectorised * 1e3:8.1f} ms; loop "
           f"{looped * 1e3:8.1f} ms: {looped / vectorised:.0f}x")
+    grid_figures(model, overrides)
+
+
+def grid_figures(model, overrides, size: int = 400) -> None:
+    """``linear.grid`` (max real part over a size x size K_theta-K_psi grid, one batched
+    eigenvalue call, and its zero contour) against a per-point loop computing the same max
+    real part (Jacobian and ``numpy.linalg.eigvals`` at each point)."""
+    from whirl_cli import linear
+
+    axis = np.linspace(0.0, 0.6, size)
+    vectorised = best_of(lambda: linear.grid(model, overrides, "K_theta", axis, "K_psi", axis))
+    x_index = model.parameter_names.index(model.canonical("K_theta"))
+    y_index = model.parameter_names.index(model.canonical("K_psi"))
+    base = model.parameter_vector(overrides)
+    zero = np.zeros(model.n_states)
+
+    def loop() -> np.ndarray:
+        out = np.empty((size, size))
+        params = base.copy()
+        for i, k_psi in enumerate(axis):
+            params[y_index] = k_psi
+            for j, k_theta in enumerate(axis):
+                params[x_index] = k_theta
+                out[i, j] = np.linalg.eigvals(model.jacobian_numpy(zero, params)).real.max()
+        return out
+
+    start = time.perf_counter()
+    looped_values = loop()
+    looped = time.perf_counter() - start
+    grid = linear.grid(model, overrides, "K_theta", axis, "K_psi", axis)
+    agree = np.allclose(grid.max_real, looped_values, rtol=1e-9, atol=1e-9)
+    print(f"  linear.grid {size}x{size} (with contour) {vectorised * 1e3:8.1f} ms; loop "
+          f"{looped * 1e3:8.1f} ms: {looped / vectorised:.0f}x (same values: {agree})")
 
 
 # ------------------------------------------------------------------------------ (e)

@@ -8,7 +8,8 @@ on other machines. Point indices, step counts and provenance are not compared; i
 * **special points** of each continuation, matched by (type, kind of their branch) with an
   optimal assignment on parameter and state, then compared on the parameter values (tolerance
   ``parameter`` x the span of that parameter over the continuation), the state (``state``, SI
-  units), the period (relative ``period``) and criticality and status (exact);
+  units), the period (relative ``period``), the first Lyapunov coefficient (relative
+  ``lyapunov``) and criticality and status (exact);
 * **branches**, matched by name: ``kind``, ``end`` and ``status`` exact; each branch is cut
   into stretches where the principal parameter is monotone, and ``state_max``/``state_min``
   of both files are interpolated onto common parameter values of each stretch (tolerance
@@ -46,7 +47,8 @@ class Tolerances:
         continuation's branches [-]; state: special-point states [rad, rad/s];
     period: relative, special-point periods [-]; branch_state: interpolated
         state_max/state_min of branches [rad, rad/s]; linear: relative, linear sweeps [-];
-    boundary: boundary curves, fraction of each axis' span [-].
+    boundary: boundary curves, fraction of each axis' span [-]; lyapunov: relative, first
+    Lyapunov coefficients of Hopf points [-].
     """
 
     parameter: float = 1e-6
@@ -55,6 +57,7 @@ class Tolerances:
     branch_state: float = 1e-5
     linear: float = 1e-9
     boundary: float = 1e-5
+    lyapunov: float = 1e-4
 
     @classmethod
     def from_options(cls, rtol: float | None = None, atol: float | None = None) -> Tolerances:
@@ -241,6 +244,11 @@ def _compare_point(path: str, row: int, a: SpecialPoint, b: SpecialPoint, spans:
     if not _close(a.period, b.period, tolerances.period * scale):
         found.append(Difference(f"{path}/period[{row}]", f"{a.period:.10g}", f"{b.period:.10g}",
                                 where))
+    scale = max(abs(a.lyapunov), abs(b.lyapunov)) if np.isfinite([a.lyapunov, b.lyapunov]).all() \
+        else 0
+    if not _close(a.lyapunov, b.lyapunov, tolerances.lyapunov * scale):
+        found.append(Difference(f"{path}/lyapunov[{row}]", f"{a.lyapunov:.10g}",
+                                f"{b.lyapunov:.10g}", where))
     for key in ("criticality", "status"):
         if getattr(a, key) != getattr(b, key):
             found.append(Difference(f"{path}/{key}[{row}]", getattr(a, key), getattr(b, key),

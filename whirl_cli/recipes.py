@@ -21,9 +21,10 @@ from pathlib import Path
 import numpy as np
 
 from . import auto, global_bifurcations
-from .branches import amplitude, head, join, read_branch
+from .branches import amplitude, head, join, parse_b, read_branch
 from .codegen import AMPLITUDE, base_constants, fortran_source, par_layout, source_key
 from .models import Model
+from .normal_form import criticality_of, hopf_lyapunov_coefficient
 from .results import Branch, BranchKind, ContinuationResult, PointType, RunRecord, SpecialPoint
 
 #: How deep branch switching recurses (main -> secondary -> tertiary).
@@ -188,6 +189,7 @@ def one_parameter(engine: Engine, name: str, parameter: str, start: float,
     numerics = replace(numerics, orbits_at=tuple(orbits_at))
     branches, points = equilibria(engine, name, parameter, start, bounds, parameters, numerics,
                                   branch_points)
+    points = with_lyapunov(engine.model, parameter, parameters, points)
     # a linear model has no limit cycles: at a Hopf point it carries a continuum of neutral
     # orbits of every amplitude, which AUTO reports as folds everywhere
     if periodic and not is_linear(engine.model, parameters):
@@ -396,12 +398,104 @@ def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
             if whole.status == "mx":  # AUTO's expected failure right at the blow-up
                 whole = replace(whole, status="ok", message="ended with MX at the period "
                                 "blow-up (expected near a global bifurcation)")
+            if global_point.point_type == PointType.HOMOCLINIC:
+                global_point = locate_homoclinic(engine, name, whole, global_point, bounds,
+                                                 parameters)
             found.append(global_point)
         kept.append(replace(whole, end=end))
         small = amplitude(whole, model) < HOPF_RETURN_AMPLITUDE
         found += [p for p in special_points(whole, skip_first=True)
                   if not small[p.index] and _hopf_at(whole, p.index, hopfs, width, scale) is None]
     return kept, found
+
+
+#: HomCont: a homoclinic orbit counts as located when the principal parameter varies by less
+#: than this fraction of the range while the truncation period grows (it converges
+#: exponentially in the period).
+HOMOCLINIC_SPREAD = 1e-6
+#: HomCont run length (steps in the truncation period) and mesh intervals.
+HOMOCLINIC_STEPS = 30
+HOMOCLINIC_MESH = 100
+
+
+def homoclinic_constants(model: Model, parameter: str, bounds: tuple[float, float],
+                         period_tau: float, n_unstable: int) -> dict:
+    """Constants of a HomCont run (IPS=9) from a long-period orbit: the homoclinic orbit to
+    an equilibrium (solved for, IEQUIB=1) continued in ``parameter`` and the truncation
+    period at fixed other parameters, so the parameter converges to its homoclinic value.
+    ISTART=5 phase-shifts the orbit so that it starts and ends at the equilibrium."""
+    return base_constants(model) | {
+        "IPS": 9, "ISW": 1, "ICP": [parameter, "PERIOD"], "IEQUIB": 1, "ISTART": 5,
+        "NUNSTAB": n_unstable, "NSTAB": model.n_states - n_unstable, "ITWIST": 0,
+        "ILP": 0, "ISP": 0, "MXBF": 0, "NMX": HOMOCLINIC_STEPS, "NPR": HOMOCLINIC_STEPS,
+        "IID": 2, "NTST": HOMOCLINIC_MESH, "NCOL": 4, "IAD": 3,
+        "DS": 1e-3 * period_tau, "DSMIN": 1e-9, "DSMAX": 0.02 * period_tau,
+        "EPSL": 1e-8, "EPSU": 1e-8, "EPSS": 1e-6, "ITMX": 30, "ITNW": 7, "NWTN": 3,
+        "RL0": bounds[0], "RL1": bounds[1],
+        "UZSTOP": {"PERIOD": [0.5 * period_tau, 4.0 * period_tau]},
+    }
+
+
+def locate_homoclinic(engine: Engine, name: str, family: Branch, point: SpecialPoint,
+                      bounds: tuple[float, float], parameters: dict[str, float]
+                      ) -> SpecialPoint:
+    """Try to locate a bracketed homoclinic end of ``family`` with AUTO's HomCont, restarted
+    from the family's longest labelled orbit. On success the point's parameter becomes the
+    HomCont value and its status "located"; otherwise it stays bracketed and the note says
+    why. A symmetric orbit passing the saddle twice per period (a pair of homoclinic loops
+    of a symmetric model) is not tried: HomCont follows one loop."""
+    model = engine.model
+    parameter = family.parameter_names[0]
+    labelled = [k for k in np.flatnonzero(family.label) if np.isfinite(family.period[k])]
+    if not labelled:
+        return replace(point, note=_joined(point.note, "HomCont not tried: no stored orbit"))
+    row = max(labelled, key=lambda k: family.period[k])
+    if model.symmetric and np.allclose(family.state_max[row], -family.state_min[row],
+                                       rtol=1e-6, atol=1e-9):
+        return replace(point, note=_joined(point.note, "HomCont not tried: the orbit is "
+                                           "symmetric and passes the saddle twice per period"))
+    saddle_params = model.parameter_vector({**parameters, parameter: point.parameters[0]})
+    n_unstable = int((np.linalg.eigvals(model.jacobian_numpy(point.state, saddle_params)).real
+                      > 0).sum())
+    label = int(family.label[row])
+    source = next((run for run in reversed(family.run.split("+"))
+                   if any(found == label for _, found in engine.outcomes[run].labels)), None)
+    if source is None or not n_unstable:
+        return replace(point, note=_joined(point.note, "HomCont not tried: no saddle or no "
+                                           "restart solution"))
+    period_tau = float(family.period[row]) * model.time_scale
+    spec = RunSpec(f"{name}/{family.name}.homoclinic",
+                   homoclinic_constants(model, parameter, bounds, period_tau, n_unstable),
+                   "homoclinic", point.note, (parameter,), restart=(source, label))
+    (outcome,) = engine.run_many([spec])
+    return _homoclinic_verdict(outcome, point, parameter, bounds, model.time_scale)
+
+
+def _homoclinic_verdict(outcome: auto.RunOutcome, point: SpecialPoint, parameter: str,
+                        bounds: tuple[float, float], time_scale: float) -> SpecialPoint:
+    """The special point after a HomCont run: located if the parameter converged."""
+    width = bounds[1] - bounds[0]
+    values = periods = np.empty(0)
+    if outcome.has_output:
+        segments = parse_b(outcome.file("b").read_text(errors="replace"))
+        if segments:
+            values = np.concatenate([s.column(parameter) for s in segments])
+            periods = np.concatenate([s.column("PERIOD") for s in segments])
+    if len(values) < 5:
+        return replace(point, note=_joined(
+            point.note, f"HomCont (IPS=9) did not converge ({outcome.status}: "
+            f"{outcome.message})"))
+    tail = values[len(values) // 2:]
+    spread = float(np.ptp(tail))
+    if spread > HOMOCLINIC_SPREAD * width:
+        return replace(point, note=_joined(
+            point.note, f"HomCont (IPS=9): {parameter} did not settle (spread {spread:.2g} "
+            f"over {len(tail)} points)"))
+    value = float(values[-1])
+    span = periods[len(values) // 2:] / time_scale
+    return replace(point, parameters=np.array([value]), status="located", note=_joined(
+        point.note, f"located by HomCont (IPS=9): {parameter} = {value:.10g}, spread "
+        f"{spread:.2g} while the truncation period runs {span.min():.4g}-{span.max():.4g} s"))
 
 
 def _assemble(family: _Family, hopfs: list[SpecialPoint], width: float,
@@ -560,10 +654,36 @@ def _with_criticality(points: list[SpecialPoint], families: list[Branch],
             growth = _hopf_growth_direction(equilibria[point.branch], point)
             side = sides.get(k, 0.0)
             if side and growth:
-                point = replace(point, criticality="supercritical" if side == growth
-                                else "subcritical")
+                from_family = "supercritical" if side == growth else "subcritical"
+                if point.criticality and point.criticality != from_family:
+                    point = replace(point, note=_joined(
+                        point.note, f"first Lyapunov coefficient says {point.criticality}"))
+                point = replace(point, criticality=from_family)
         labelled.append(point)
     return labelled
+
+
+def with_lyapunov(model: Model, parameter: str, parameters: dict[str, float],
+                  points: list[SpecialPoint]) -> list[SpecialPoint]:
+    """Hopf points of equilibria with their first Lyapunov coefficient and, from its sign, a
+    provisional criticality (a periodic family, when computed, has the last word: see
+    :func:`_with_criticality`)."""
+    labelled = []
+    for point in points:
+        if point.point_type == PointType.HB:
+            values = model.parameter_vector({**parameters, parameter: point.parameters[0]})
+            try:
+                l1 = hopf_lyapunov_coefficient(model, point.state, values)
+            except (ValueError, np.linalg.LinAlgError):
+                l1 = float("nan")
+            point = replace(point, lyapunov=l1,
+                            criticality=criticality_of(l1, 2 * np.pi / point.period))
+        labelled.append(point)
+    return labelled
+
+
+def _joined(*notes: str) -> str:
+    return "; ".join(n for n in notes if n)
 
 
 def _origin(hopf: SpecialPoint) -> str:

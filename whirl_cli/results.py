@@ -162,7 +162,10 @@ class SpecialPoint:
 
     ``status``: "located" (AUTO converged on it) or "bracketed" (estimated between points, e.g.
     a period blow-up, with ``bracket`` the interval of the principal parameter and ``residual``
-    the relative fit residual). ``criticality``: "supercritical" | "subcritical" | "" (Hopf).
+    the relative fit residual). ``criticality``: "supercritical" | "subcritical" | "" (Hopf
+    points: from the periodic family leaving it, else from ``lyapunov``). ``lyapunov``: first
+    Lyapunov coefficient of a Hopf point of equilibria [1/(s unit^2), SI states; < 0
+    supercritical], NaN otherwise (see :mod:`whirl_cli.normal_form`).
     """
 
     branch: str
@@ -179,6 +182,7 @@ class SpecialPoint:
     note: str = ""
     bracket: np.ndarray = field(default_factory=lambda: np.full(2, np.nan))  # bracketed only
     residual: float = float("nan")  # relative rms fit residual (bracketed global points)
+    lyapunov: float = float("nan")  # first Lyapunov coefficient (Hopf points of equilibria)
 
     @property
     def type_name(self) -> str:

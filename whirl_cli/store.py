@@ -16,7 +16,8 @@ Layout (units in a ``units`` attribute on every physical dataset)::
                                                                 parameters
         special_points/             columns: branch, index, point_type, type_name, label,
                                     parameters (K, P), state (K, n), period, stable, status,
-                                    criticality, note, bracket (K, 2), residual
+                                    criticality, note, bracket (K, 2), residual,
+                                    lyapunov (first Lyapunov coefficient of Hopf points)
         cross_checks/               (study `cross_check: true`) columns: branch, index, kind
                                     (orbit | equilibrium), parameter, expected, simulated,
                                     passed
@@ -115,6 +116,9 @@ def _write_special_points(group: h5py.Group, points: tuple[SpecialPoint, ...],
         group.create_dataset(key, data=_strings(getattr(p, key) for p in points), dtype=_STR)
     group.create_dataset("bracket", data=np.array([p.bracket for p in points]).reshape(-1, 2))
     group.create_dataset("residual", data=np.array([p.residual for p in points], dtype=float))
+    lyapunov = group.create_dataset("lyapunov",
+                                    data=np.array([p.lyapunov for p in points], dtype=float))
+    lyapunov.attrs["units"] = "1/(s*state_unit^2)"
 
 
 def _write_cross_checks(group: h5py.Group, checks: tuple[CrossCheck, ...]) -> None:
@@ -394,7 +398,8 @@ def _read_special_points(group: h5py.Group) -> tuple[SpecialPoint, ...]:
             period=float(columns["period"][k]), stable=bool(columns["stable"][k]),
             label=int(columns["label"][k]), status=_text(columns["status"][k]),
             criticality=_text(columns["criticality"][k]), note=_text(columns["note"][k]),
-            bracket=columns["bracket"][k], residual=float(columns["residual"][k]))
+            bracket=columns["bracket"][k], residual=float(columns["residual"][k]),
+            lyapunov=float(columns["lyapunov"][k]) if "lyapunov" in columns else float("nan"))
         for k in range(len(columns["index"])))
 
 

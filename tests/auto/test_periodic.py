@@ -145,6 +145,34 @@ def test_cross_checks_pass_on_every_stable_periodic_branch(run_thesis, case):
         (b.name, b.message) for b in continuation.branches if b.status != "ok"]
 
 
+@pytest.mark.parametrize("case", NONLINEAR)
+def test_criticality_from_the_family_agrees_with_the_lyapunov_coefficient(run_thesis, case):
+    """Two independent verdicts on every Hopf point: the side the AUTO periodic family leaves
+    on, and the sign of the first Lyapunov coefficient from the symbolic model."""
+    result = run_thesis(case)
+    hopfs = _points(result, PointType.HB)
+    labelled = [h for h in hopfs if h.criticality]
+    assert labelled or not hopfs
+    for hopf in hopfs:
+        assert np.isfinite(hopf.lyapunov) and hopf.lyapunov != 0, hopf
+    disagreeing = [(h.branch, h.parameters[0], h.criticality, h.lyapunov) for h in labelled
+                   if h.criticality != ("supercritical" if h.lyapunov < 0 else "subcritical")]
+    assert disagreeing == []
+
+
+def test_lyapunov_coefficient_without_periodic_branches(tmp_path):
+    """``periodic: false``: the criticality comes from l1 alone; the hardening case 2 verdicts
+    match the families' (right Hopf supercritical, left subcritical)."""
+    text = (STUDIES / "hardening_case2.yaml").read_text()
+    text = text.replace("periodic: true", "periodic: false").replace("cross_check: true",
+                                                                      "cross_check: false")
+    study = validate_text(text, "hardening_case2.yaml")
+    result = run_study(study, tmp_path)
+    assert not _periodic(result)
+    assert _hopf(result, 0.2888).criticality == "supercritical"
+    assert _hopf(result, 0.0807).criticality == "subcritical"
+
+
 def test_cross_check_fails_for_a_wrong_orbit(run_thesis):
     from dataclasses import replace
 
@@ -171,10 +199,49 @@ def test_period_blow_up_is_bracketed(run_thesis):
                                                                PointType.HETEROCLINIC)]
         assert [p.point_type for p in found] == [kind]
         (point,) = found
-        assert point.status == "bracketed"
+        assert point.status == "bracketed"  # symmetric / heteroclinic: HomCont not applicable
         assert point.bracket[0] <= point.parameters[0] <= point.bracket[1]
         assert main.period.max() > 3 * main.period[0]
         assert "saddle" in point.note
+
+
+def _return_distance(model, params, sign: float, duration: float = 1.5) -> float:
+    """How close the unstable manifold of the origin comes back to it (non-dimensional
+    states): leave along the unstable eigenvector on side ``sign``, integrate, and take the
+    smallest distance after the trajectory has gone round (beyond half its reach)."""
+    values, vectors = np.linalg.eig(model.jacobian_numpy(np.zeros(model.n_states), params))
+    unstable = np.real(vectors[:, np.argmax(values.real)])
+    start = 1e-7 * sign * unstable / np.linalg.norm(unstable)
+    _, states = simulate.integrate(model, params, start, duration, samples=60000, rtol=1e-11)
+    scaled = np.linalg.norm(states / np.asarray(model.state_scale), axis=1)
+    far = np.flatnonzero(scaled > 0.5 * scaled.max())
+    return float(scaled[far[-1]:].min()) / float(scaled.max())
+
+
+def test_homoclinic_orbit_located_by_homcont_and_by_simulation(run_thesis):
+    """Hardening case 3: the secondary families end at a homoclinic orbit to the origin
+    (a saddle-focus, so the family snakes); HomCont locates it inside the fitted bracket, and
+    the origin's unstable manifold, simulated, returns to the origin there far closer than
+    5e-4 to either side."""
+    result = run_thesis("hardening_case3")
+    located = [p for p in result.continuations[0].special_points
+               if p.point_type == PointType.HOMOCLINIC and p.status == "located"]
+    assert sorted(p.branch for p in located) == ["periodic_2", "periodic_3"]
+    value = located[0].parameters[0]
+    assert located[1].parameters[0] == pytest.approx(value, abs=1e-9)  # mirror images
+    low, high = located[0].bracket
+    assert low - 1e-4 <= value <= high + 1e-4
+    assert "located by HomCont" in located[0].note
+    model = get_model("classical")
+    secondary = next(b for b in result.continuations[0].branches if b.name == "secondary_1a")
+    side = float(np.sign(secondary.state_max[-1, 0]))  # the loop circles this focus
+
+    def distance(k1: float) -> float:
+        params = model.parameter_vector({"K1": k1, "K2": 10.0, "K3": 0.0, "K_psi": 0.2})
+        return _return_distance(model, params, side)
+
+    at, left, right = distance(value), distance(value - 5e-4), distance(value + 5e-4)
+    assert at < 0.01 * min(left, right), (at, left, right)
 
 
 def test_airspeed_continuation_overhang(run_thesis):

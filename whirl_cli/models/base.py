@@ -185,6 +185,24 @@ class Model:
             (self.state_symbols, self.parameter_symbols), list(jac), modules="numpy", cse=True
         )
 
+    @cached_property
+    def _numpy_derivative_tensors(self):
+        """Second and third derivatives of the rhs with respect to the states, flattened."""
+        y, n = self.state_symbols, self.n_states
+        rows = [sp.diff(self.rhs[i], y[j]) for i in range(n) for j in range(n)]
+        second = [sp.diff(row, y[k]) for row in rows for k in range(n)]
+        third = [sp.diff(entry, y[m]) for entry in second for m in range(n)]
+        return sp.lambdify((self.state_symbols, self.parameter_symbols), second + third,
+                           modules="numpy", cse=True)
+
+    def derivative_tensors(self, y: np.ndarray, params: np.ndarray
+                           ) -> tuple[np.ndarray, np.ndarray]:
+        """(d2f/dy2, d3f/dy3) at one point, shapes (n, n, n) and (n, n, n, n), SI units:
+        entry [i, j, k(, m)] is the derivative of dy_i/dt by y_j, y_k (and y_m)."""
+        n = self.n_states
+        values = np.array(self._numpy_derivative_tensors(tuple(y), tuple(params)), dtype=float)
+        return values[:n ** 3].reshape(n, n, n), values[n ** 3:].reshape(n, n, n, n)
+
     def field_at(self, params: np.ndarray):
         """(f, J): dy/dt (SI) and its Jacobian as fast functions of the state alone, for fixed
         parameter values (substituted symbolically once; for time integration)."""
