@@ -115,7 +115,7 @@ class Engine:
     def run_with_label(self, runs: str, label: int) -> str:
         """Which of the AUTO runs ``runs`` ("a+b+..." for a branch joined from several runs)
         wrote the solution labelled ``label``."""
-        for name in runs.split("+"):
+        for name in reversed(runs.split("+")):  # the latest run of a chain of restarts
             if any(found == label for _, found in self.outcomes[name].labels):
                 return name
         raise KeyError(f"label {label} not found in runs {runs}")
@@ -772,10 +772,42 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
 def _loci(engine: Engine, name: str, pair: tuple[str, str],
           bounds: dict[str, tuple[float, float]], numerics: Numerics,
           starts: list[tuple[SpecialPoint, str]]) -> list[Branch]:
-    """Locus branches from every start point, both directions, duplicates dropped."""
+    """Locus branches from the start points, both directions, each locus once.
+
+    Starts are taken slice by slice: a start lying on a locus of its type already traced
+    from an earlier slice is the same locus and is not run again (AUTO's runs, not just the
+    results, are saved). Duplicates left (two starts of one slice on one locus) are dropped."""
+    width = np.array([bounds[p][1] - bounds[p][0] for p in pair])
+    numbered = list(enumerate(starts, 1))
+    waves: dict[str, list] = {}
+    for k, (point, runs) in numbered:
+        waves.setdefault(point.branch.split(".", 1)[0], []).append((k, point, runs))
+    curves: list[tuple[int, Branch]] = []
+    for wave in waves.values():
+        todo = [(k, point, runs) for k, point, runs in wave if not any(
+            kind == point.point_type and _near_polyline(point.parameters[:2], curve.parameters,
+                                                        width)
+            for kind, curve in curves)]
+        curves += _trace(engine, name, pair, bounds, numerics, todo)
+    kept: list[Branch] = []
+    for _, curve in sorted(curves, key=lambda c: c[1].name):
+        curve = _closed(curve, width)
+        if len(curve) and not any(_on_curve(curve.parameters[0], other.parameters, width)
+                                  and _on_curve(curve.parameters[-1], other.parameters, width)
+                                  for other in kept):
+            kept.append(curve)
+    codim2 = [p for c in kept for p in special_points(c, skip_first=True)
+              if PointType(p.point_type) in CODIM2]
+    return [_locus_end(c, codim2, bounds, width) for c in kept]
+
+
+def _trace(engine: Engine, name: str, pair: tuple[str, str],
+           bounds: dict[str, tuple[float, float]], numerics: Numerics,
+           starts: list[tuple[int, SpecialPoint, str]]) -> list[tuple[int, Branch]]:
+    """(point type, locus branch) of every start, both directions, run in parallel."""
     model = engine.model
     specs = []
-    for k, (point, runs) in enumerate(starts, 1):
+    for k, point, runs in starts:
         kind = PointType(point.point_type)
         locus, branch_kind = LOCI[kind]
         source = engine.run_with_label(runs, point.label)
@@ -788,28 +820,85 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
                                         origin, pair, restart=(source, point.label))))
     outcomes = engine.run_many([spec for _, spec in specs])
     second_stage = []
-    final: list[tuple[RunSpec, auto.RunOutcome]] = []
+    final: list[tuple[int, RunSpec, auto.RunOutcome]] = []
     for (kind, spec), outcome in zip(specs, outcomes, strict=True):
         if kind == PointType.LPC and outcome.has_output:
-            constants = dict(spec.constants, NMX=numerics.max_steps)
-            second_stage.append(replace(spec, name=spec.name + "2", constants=constants,
-                                        restart=(outcome.name, outcome.labels[-1][1])))
+            constants = dict(spec.constants, NMX=min(LOCUS_CHUNK, numerics.max_steps))
+            second_stage.append((kind, replace(spec, name=spec.name + "2", constants=constants,
+                                               restart=(outcome.name, outcome.labels[-1][1]))))
         else:
-            final.append((spec, outcome))
-    final += list(zip(second_stage, engine.run_many(second_stage), strict=True))
-    curves = [_read(engine, spec, outcome) for spec, outcome in final]
-    curves = _retried(engine, [spec for spec, _ in final], curves)
-    kept: list[Branch] = []
-    width = np.array([bounds[p][1] - bounds[p][0] for p in pair])
-    for curve in sorted(curves, key=lambda c: c.name):
-        curve = _closed(curve, width)
-        if len(curve) and not any(_on_curve(curve.parameters[0], other.parameters, width)
-                                  and _on_curve(curve.parameters[-1], other.parameters, width)
-                                  for other in kept):
-            kept.append(curve)
-    codim2 = [p for c in kept for p in special_points(c, skip_first=True)
-              if PointType(p.point_type) in CODIM2]
-    return [_locus_end(c, codim2, bounds, width) for c in kept]
+            final.append((kind, spec, outcome))
+    final += [(kind, spec, outcome) for (kind, spec), outcome in zip(
+        second_stage, engine.run_many([spec for _, spec in second_stage]), strict=True)]
+    curves = [_read(engine, spec, outcome) for _, spec, outcome in final]
+    curves = _extended(engine, [spec for _, spec, _ in final], curves, numerics, bounds)
+    curves = _retried(engine, [spec for _, spec, _ in final], curves)
+    return [(kind, curve) for (kind, _, _), curve in zip(final, curves, strict=True)]
+
+
+#: Locus runs go LOCUS_CHUNK steps at a time: a closed locus is recognised after the chunk
+#: that closes it instead of being traced round and round up to the step limit.
+LOCUS_CHUNK = 400
+
+
+def _extended(engine: Engine, specs: list[RunSpec], curves: list[Branch], numerics: Numerics,
+              bounds: dict[str, tuple[float, float]]) -> list[Branch]:
+    """Loci that used up a chunk of steps without closing or reaching the range, continued
+    chunk by chunk from their last point (up to ``numerics.max_steps`` in all)."""
+    done = list(curves)
+    width = np.array([bounds[p][1] - bounds[p][0] for p in specs[0].parameter_names[:2]]) \
+        if specs else np.ones(2)
+    budget = numerics.max_steps
+    chunk = 1
+    while True:
+        again, where = [], []
+        for k, (spec, curve) in enumerate(zip(specs, done, strict=True)):
+            if spec.constants.get("NMX") != LOCUS_CHUNK or not _chunk_used(curve, width,
+                                                                          bounds):
+                continue
+            if len(curve) >= budget or not curve.label[-1]:
+                continue
+            again.append(replace(spec, name=f"{spec.name}c{chunk}",
+                                 restart=(curve.run.rsplit("+", 1)[-1], int(curve.label[-1]))))
+            where.append(k)
+        if not again:
+            return done
+        for spec, k, outcome in zip(again, where, engine.run_many(again), strict=True):
+            extra = _read(engine, spec, outcome)
+            if len(extra) > 1:
+                done[k] = join(done[k], extra, done[k].name)
+        chunk += 1
+
+
+def _chunk_used(curve: Branch, width: np.ndarray, bounds: dict[str, tuple[float, float]]
+                ) -> bool:
+    """True if a locus run stopped only because its chunk of steps was used up: it ended
+    with status ok on a plain end point, not closed, not at the range edge."""
+    if curve.status != "ok" or len(curve) < 2 or curve.point_type[-1] != PointType.EP:
+        return False
+    if len(_closed(curve, width)) < len(curve):
+        return False
+    last = curve.parameters[-1, :2]
+    edges = np.array([bounds[p] for p in curve.parameter_names[:2]])
+    return not np.any(np.abs(last[:, None] - edges) < 1e-6 * width[:, None])
+
+
+def _near_polyline(point: np.ndarray, curve: np.ndarray, width: np.ndarray,
+                   tolerance: float = 1e-3) -> bool:
+    """True if ``point`` lies within ``tolerance`` of the polyline ``curve`` (K, >= 2), in
+    axes scaled by the ranges ``width`` (Euclidean distance to the nearest segment)."""
+    if len(curve) == 0:
+        return False
+    scaled = curve[:, :2] / width
+    target = np.asarray(point[:2]) / width
+    if len(scaled) == 1:
+        return bool(np.linalg.norm(scaled[0] - target) < tolerance)
+    start, step = scaled[:-1], np.diff(scaled, axis=0)
+    length = np.einsum("ij,ij->i", step, step)
+    along = np.clip(np.einsum("ij,ij->i", target - start, step) / np.where(length > 0, length, 1),
+                    0.0, 1.0)
+    nearest = start + along[:, None] * step
+    return bool(np.linalg.norm(nearest - target, axis=1).min() < tolerance)
 
 
 #: Codimension-2 points where loci may end (Bogdanov-Takens, cusp, zero-Hopf, Bautin, ...).
@@ -829,7 +918,8 @@ def _retried(engine: Engine, specs: list[RunSpec], curves: list[Branch]) -> list
         constants = dict(spec.constants, NTST=spec.constants["NTST"] * 2,
                          DSMAX=spec.constants["DSMAX"] / 2)
         again.append(replace(spec, name=spec.name + "r", constants=constants,
-                             restart=(curve.run, int(curve.label[row]))))
+                             restart=(engine.run_with_label(curve.run, int(curve.label[row])),
+                                      int(curve.label[row]))))
         where.append((k, row))
     done = list(curves)
     for spec, (k, row), outcome in zip(again, where, engine.run_many(again), strict=True):
