@@ -35,8 +35,9 @@ def cli() -> None:
 @click.argument("study_file", type=click.Path(dir_okay=False, path_type=Path))
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               help="HDF5 result file [default: <study name>.h5 in the current directory].")
-@click.option("-j", "--jobs", type=click.IntRange(1, 64), default=1, show_default=True,
-              help="AUTO runs in parallel.")
+@click.option("-j", "--jobs", type=click.IntRange(1, 64), default=min(os.cpu_count() or 1, 64),
+              show_default=True,
+              help="AUTO runs (and time-simulation cross-checks) in parallel.")
 @click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
 @click.option("--plots/--no-plots", default=True, show_default=True,
               help="Write the study's plots (PNG) next to the output file.")

@@ -74,9 +74,8 @@ def _run_study(study: Study, workroot: Path, jobs: int,
             numerics, branch_points=spec.branch_points, periodic=spec.periodic,
             orbits_at=spec.orbits_at))
     if study.cross_check:
-        continuations = [replace(c, cross_checks=simulate.cross_check(model, parameters,
-                                                                      c.branches))
-                         for c in continuations]
+        continuations = [replace(c, cross_checks=simulate.cross_check(
+            model, parameters, c.branches, jobs=jobs)) for c in continuations]
     sweeps = []
     if study.linear is not None:
         for sweep in study.linear.sweeps:

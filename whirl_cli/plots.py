@@ -18,10 +18,9 @@ matplotlib ``Line2D`` keyword arguments that draw it and its legend label. Stabi
 
 from __future__ import annotations
 
+import io
 import itertools
-import os
 import re
-import tempfile
 from collections.abc import Iterator, Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -387,7 +386,7 @@ def _new_figure(**kwargs) -> Figure:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    figure = Figure(**kwargs)
+    figure = Figure(**{"layout": "constrained", **kwargs})  # no clipped labels, no bbox pass
     FigureCanvasAgg(figure)
     return figure
 
@@ -862,21 +861,16 @@ def _unique(path: Path, taken: list[Path]) -> Path:
 
 
 def _write_png(figure: Figure, path: Path, dpi: int) -> None:
-    """Save ``figure`` as PNG to a temporary file beside ``path``, then rename it atomically."""
+    """Render ``figure`` as PNG in memory and publish it at ``path`` the way result files are
+    written: complete or not at all, no temporary file left behind even by SIGKILL."""
+    from .store import publish
+
+    buffer = io.BytesIO()
     try:
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    except OSError as exc:
-        figure.clear()
-        raise OutputError(f"cannot write plot {path}: {exc}") from exc
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            figure.savefig(handle, format="png", dpi=dpi, bbox_inches="tight")
-        os.replace(tmp, path)
-    except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
-        raise OutputError(f"cannot write plot {path}: {exc}") from exc
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+        figure.savefig(buffer, format="png", dpi=dpi)
     finally:
         figure.clear()
+    try:
+        publish(buffer.getvalue(), path, overwrite=True)
+    except OutputError as error:
+        raise OutputError(f"cannot write plot {path}: {error}") from None

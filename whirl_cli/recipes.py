@@ -458,11 +458,9 @@ def locate_homoclinic(engine: Engine, name: str, family: Branch, point: SpecialP
     n_unstable = int((np.linalg.eigvals(model.jacobian_numpy(point.state, saddle_params)).real
                       > 0).sum())
     label = int(family.label[row])
-    source = next((run for run in reversed(family.run.split("+"))
-                   if any(found == label for _, found in engine.outcomes[run].labels)), None)
-    if source is None or not n_unstable:
-        return replace(point, note=_joined(point.note, "HomCont not tried: no saddle or no "
-                                           "restart solution"))
+    if not n_unstable:
+        return replace(point, note=_joined(point.note, "HomCont not tried: no saddle"))
+    source = engine.run_with_label(family.run, label)
     period_tau = float(family.period[row]) * model.time_scale
     spec = RunSpec(f"{name}/{family.name}.homoclinic",
                    homoclinic_constants(model, parameter, bounds, period_tau, n_unstable),
@@ -831,7 +829,8 @@ def _trace(engine: Engine, name: str, pair: tuple[str, str],
     final += [(kind, spec, outcome) for (kind, spec), outcome in zip(
         second_stage, engine.run_many([spec for _, spec in second_stage]), strict=True)]
     curves = [_read(engine, spec, outcome) for _, spec, outcome in final]
-    curves = _extended(engine, [spec for _, spec, _ in final], curves, numerics, bounds)
+    width = np.array([bounds[p][1] - bounds[p][0] for p in pair])
+    curves = _extended(engine, [spec for _, spec, _ in final], curves, numerics, bounds, width)
     curves = _retried(engine, [spec for _, spec, _ in final], curves)
     return [(kind, curve) for (kind, _, _), curve in zip(final, curves, strict=True)]
 
@@ -842,13 +841,10 @@ LOCUS_CHUNK = 400
 
 
 def _extended(engine: Engine, specs: list[RunSpec], curves: list[Branch], numerics: Numerics,
-              bounds: dict[str, tuple[float, float]]) -> list[Branch]:
+              bounds: dict[str, tuple[float, float]], width: np.ndarray) -> list[Branch]:
     """Loci that used up a chunk of steps without closing or reaching the range, continued
     chunk by chunk from their last point (up to ``numerics.max_steps`` in all)."""
     done = list(curves)
-    width = np.array([bounds[p][1] - bounds[p][0] for p in specs[0].parameter_names[:2]]) \
-        if specs else np.ones(2)
-    budget = numerics.max_steps
     chunk = 1
     while True:
         again, where = [], []
@@ -856,7 +852,7 @@ def _extended(engine: Engine, specs: list[RunSpec], curves: list[Branch], numeri
             if spec.constants.get("NMX") != LOCUS_CHUNK or not _chunk_used(curve, width,
                                                                           bounds):
                 continue
-            if len(curve) >= budget or not curve.label[-1]:
+            if len(curve) >= numerics.max_steps or not curve.label[-1]:
                 continue
             again.append(replace(spec, name=f"{spec.name}c{chunk}",
                                  restart=(curve.run.rsplit("+", 1)[-1], int(curve.label[-1]))))
@@ -876,11 +872,15 @@ def _chunk_used(curve: Branch, width: np.ndarray, bounds: dict[str, tuple[float,
     with status ok on a plain end point, not closed, not at the range edge."""
     if curve.status != "ok" or len(curve) < 2 or curve.point_type[-1] != PointType.EP:
         return False
-    if len(_closed(curve, width)) < len(curve):
-        return False
+    return len(_closed(curve, width)) == len(curve) and not _at_range_edge(curve, bounds, width)
+
+
+def _at_range_edge(curve: Branch, bounds: dict[str, tuple[float, float]], width: np.ndarray
+                   ) -> bool:
+    """True if the locus ends on the edge of the study's range (where UZSTOP stops it)."""
     last = curve.parameters[-1, :2]
     edges = np.array([bounds[p] for p in curve.parameter_names[:2]])
-    return not np.any(np.abs(last[:, None] - edges) < 1e-6 * width[:, None])
+    return bool(np.any(np.abs(last[:, None] - edges) < 1e-6 * width[:, None]))
 
 
 def _near_polyline(point: np.ndarray, curve: np.ndarray, width: np.ndarray,
@@ -934,8 +934,7 @@ def _locus_end(curve: Branch, codim2: list[SpecialPoint], bounds: dict[str, tupl
     """The locus with its end classified: range edge, closed, or a codimension-2 point (where
     AUTO typically stops with MX: that is the locus' natural end, not a failure)."""
     last = curve.parameters[-1, :2]
-    edges = np.array([bounds[p] for p in curve.parameter_names[:2]])
-    if np.any(np.abs(last[:, None] - edges) < 1e-6 * width[:, None]):
+    if _at_range_edge(curve, bounds, width):
         return replace(curve, end="range")
     if len(curve) > 2 and np.abs((last - curve.parameters[0, :2]) / width).max() < 0.005:
         return replace(curve, end="closed")

@@ -1,5 +1,5 @@
-"""Time simulation with scipy ``solve_ivp`` on the numpy right-hand side of the symbolic model:
-the independent check of what continuation claims.
+"""Time simulation with scipy (LSODA, ``odeint``) on the numpy right-hand side of the symbolic
+model: the independent check of what continuation claims.
 
 * A stable periodic orbit: started on AUTO's orbit, the simulation must stay on it (the maximum
   of the law's degree of freedom over the last periods within ``tolerance`` of AUTO's).
@@ -9,6 +9,9 @@ Time in seconds, states in SI units (rad, rad/s), as everywhere outside AUTO.
 """
 
 from __future__ import annotations
+
+import multiprocessing
+from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
@@ -22,18 +25,20 @@ ORBIT_TOLERANCE = 0.01
 
 def integrate(model: Model, params: np.ndarray, y0: np.ndarray, duration: float,
               samples: int = 4000, rtol: float = 1e-8) -> tuple[np.ndarray, np.ndarray]:
-    """(t (K,), y (K, n)): the trajectory from ``y0`` over ``duration`` seconds (LSODA with the
-    analytic Jacobian, so stiff points of strongly hardening springs cost no more than others)."""
-    from scipy.integrate import solve_ivp
+    """(t (K,), y (K, n)): the trajectory from ``y0`` over ``duration`` seconds, sampled at
+    ``samples`` equally spaced times (LSODA through ``scipy.integrate.odeint``, with the
+    analytic Jacobian, so stiff points of strongly hardening springs cost no more than others;
+    odeint drives the Fortran solver with far less Python per step than ``solve_ivp``)."""
+    from scipy.integrate import odeint
 
     field, jacobian = model.field_at(params)
     times = np.linspace(0.0, duration, samples)
-    solution = solve_ivp(lambda _t, y: field(y), (0.0, duration), np.asarray(y0, dtype=float),
-                         method="LSODA", jac=lambda _t, y: jacobian(y), t_eval=times,
-                         rtol=rtol, atol=rtol * 1e-3)
-    if not solution.success:
-        raise RuntimeError(f"time integration failed: {solution.message}")
-    return solution.t, solution.y.T
+    states, info = odeint(lambda y, _t: field(y), np.asarray(y0, dtype=float), times,
+                          Dfun=lambda y, _t: jacobian(y), rtol=rtol, atol=rtol * 1e-3,
+                          mxstep=1_000_000, full_output=True)
+    if info["message"] != "Integration successful.":
+        raise RuntimeError(f"time integration failed: {info['message']}")
+    return times, states
 
 
 def _parameters(model: Model, overrides: dict[str, float], names: tuple[str, ...],
@@ -88,28 +93,63 @@ def _interior_stable(branch: Branch, index: int) -> bool:
 
 
 def cross_check(model: Model, overrides: dict[str, float], branches: tuple[Branch, ...],
-                per_branch: int = 2) -> tuple[CrossCheck, ...]:
+                per_branch: int = 2, jobs: int = 1) -> tuple[CrossCheck, ...]:
     """Checks of up to ``per_branch`` stable points of every branch (orbits for periodic
     branches, perturbations for equilibria), spread along each branch. Not checked: points next
     to bifurcations, orbits in a period blow-up (T > 3 T_Hopf) and equilibria too weakly damped
-    or too stiff to simulate in bounded time."""
-    checks: list[CrossCheck] = []
-    for branch in branches:
+    or too stiff to simulate in bounded time. ``jobs`` > 1 simulates in that many forked
+    processes (results identical, in the same order)."""
+    tasks = planned_checks(branches, per_branch)
+    if jobs > 1 and len(tasks) > 1 and "fork" in multiprocessing.get_all_start_methods():
+        global _SHARED
+        _SHARED = (model, overrides, branches)
+        try:
+            context = multiprocessing.get_context("fork")
+            with ProcessPoolExecutor(min(jobs, len(tasks)), mp_context=context) as pool:
+                return tuple(pool.map(_run_check, tasks))
+        finally:
+            _SHARED = None
+    return tuple(_check(model, overrides, branches, task) for task in tasks)
+
+
+#: (model, overrides, branches) of the cross-check in progress, inherited by forked workers.
+_SHARED: tuple | None = None
+
+
+def _run_check(task: tuple[int, str, int]) -> CrossCheck:
+    assert _SHARED is not None
+    return _check(*_SHARED, task)
+
+
+def _check(model: Model, overrides: dict[str, float], branches: tuple[Branch, ...],
+           task: tuple[int, str, int]) -> CrossCheck:
+    number, kind, item = task
+    branch = branches[number]
+    if kind == "orbit":
+        return check_orbit(model, overrides, branch, branch.orbits[item])
+    return check_equilibrium(model, overrides, branch, item)
+
+
+def planned_checks(branches: tuple[Branch, ...], per_branch: int = 2
+                   ) -> list[tuple[int, str, int]]:
+    """What :func:`cross_check` simulates: (branch index, "orbit" | "equilibrium", orbit index
+    in ``branch.orbits`` or row of the equilibrium branch)."""
+    tasks: list[tuple[int, str, int]] = []
+    for number, branch in enumerate(branches):
         if branch.kind == BranchKind.PERIODIC:
             # orbits in a period blow-up (near a homoclinic/heteroclinic orbit) are too
             # sensitive for simulation to follow for 20 periods; they are not checked
             hopf_period = branch.period[0]
-            candidates = [o for o in branch.orbits if 0 < o.index < len(branch) - 1
+            candidates = [k for k, o in enumerate(branch.orbits)
+                          if 0 < o.index < len(branch) - 1
                           and _interior_stable(branch, o.index) and o.states.shape[0] > 1
                           and o.period < BLOWUP_FACTOR * hopf_period]
-            for orbit in _spread(candidates, per_branch):
-                checks.append(check_orbit(model, overrides, branch, orbit))
+            tasks += [(number, "orbit", k) for k in _spread(candidates, per_branch)]
         elif branch.kind == BranchKind.EQUILIBRIUM:
             rows = [k for k in range(1, len(branch) - 1)
                     if _interior_stable(branch, k) and _checkable(branch.eigenvalues[k])]
-            for row in _spread(rows, per_branch):
-                checks.append(check_equilibrium(model, overrides, branch, row))
-    return tuple(checks)
+            tasks += [(number, "equilibrium", row) for row in _spread(rows, per_branch)]
+    return tasks
 
 
 def _checkable(eigenvalues: np.ndarray, max_cycles: float = 300.0) -> bool:

@@ -173,6 +173,17 @@ def test_lyapunov_coefficient_without_periodic_branches(tmp_path):
     assert _hopf(result, 0.0807).criticality == "subcritical"
 
 
+def test_parallel_cross_check_equals_the_serial_one(run_thesis):
+    result = run_thesis("combined_case2")
+    (continuation,) = result.continuations
+    model = get_model("classical")
+    parameters = {"K2": -10.0, "K3": 350.0, "K_psi": 0.3}
+    serial = simulate.cross_check(model, parameters, continuation.branches, jobs=1)
+    parallel = simulate.cross_check(model, parameters, continuation.branches, jobs=2)
+    assert len(serial) >= 4
+    assert serial == parallel
+
+
 def test_cross_check_fails_for_a_wrong_orbit(run_thesis):
     from dataclasses import replace
 
