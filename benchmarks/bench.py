@@ -30,10 +30,9 @@
     confirmed with the full ``D``), then bisected to ``--fold-tol``.
 
 Run: ``.venv/bin/python benchmarks/bench.py [--only abcdef] [--exclude GLOB] [--fold-tol 1e-5]
-[--fold-periods 3000]``. With the 22 one-parameter cases it takes about fifteen minutes on two
-cores (two-parameter ``boundary_*`` studies add much more; ``--exclude 'boundary_*.yaml'``
-leaves them out); other load on the machine shows in the numbers (the load average is
-printed).
+[--fold-periods 3000]``. With all 26 chapter-3 studies it takes about 35 minutes on two cores,
+most of it in the two-parameter ``boundary_*`` studies (``--exclude 'boundary_*.yaml'`` leaves
+them out); other load on the machine shows in the numbers (the load average is printed).
 """
 
 from __future__ import annotations

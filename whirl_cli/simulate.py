@@ -105,8 +105,14 @@ def cross_check(model: Model, overrides: dict[str, float], branches: tuple[Branc
         _SHARED = (model, overrides, branches)
         try:
             context = multiprocessing.get_context("fork")
-            with ProcessPoolExecutor(min(jobs, len(tasks)), mp_context=context) as pool:
+            pool = ProcessPoolExecutor(min(jobs, len(tasks)), mp_context=context)
+            try:
                 return tuple(pool.map(_run_check, tasks))
+            except BaseException:  # e.g. Ctrl-C: drop the checks not started, then wait
+                pool.shutdown(wait=True, cancel_futures=True)
+                raise
+            finally:
+                pool.shutdown(wait=True)
         finally:
             _SHARED = None
     return tuple(_check(model, overrides, branches, task) for task in tasks)
