@@ -383,6 +383,7 @@ def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
 
     kept: list[Branch] = []
     found: list[SpecialPoint] = []
+    homoclinic: list[tuple[int, Branch]] = []  # (row in found, family) to locate with HomCont
     reached: set[int] = set()
     for family in families:
         if family.index - 1 in reached:
@@ -398,14 +399,17 @@ def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
             if whole.status == "mx":  # AUTO's expected failure right at the blow-up
                 whole = replace(whole, status="ok", message="ended with MX at the period "
                                 "blow-up (expected near a global bifurcation)")
-            if global_point.point_type == PointType.HOMOCLINIC:
-                global_point = locate_homoclinic(engine, name, whole, global_point, bounds,
-                                                 parameters)
             found.append(global_point)
+            if global_point.point_type == PointType.HOMOCLINIC:
+                homoclinic.append((len(found) - 1, whole))
         kept.append(replace(whole, end=end))
         small = amplitude(whole, model) < HOPF_RETURN_AMPLITUDE
         found += [p for p in special_points(whole, skip_first=True)
                   if not small[p.index] and _hopf_at(whole, p.index, hopfs, width, scale) is None]
+    for row, point in zip([row for row, _ in homoclinic], locate_homoclinics(
+            engine, name, [(family, found[row]) for row, family in homoclinic], bounds,
+            parameters), strict=True):
+        found[row] = point
     return kept, found
 
 
@@ -436,37 +440,54 @@ def homoclinic_constants(model: Model, parameter: str, bounds: tuple[float, floa
     }
 
 
-def locate_homoclinic(engine: Engine, name: str, family: Branch, point: SpecialPoint,
-                      bounds: tuple[float, float], parameters: dict[str, float]
-                      ) -> SpecialPoint:
-    """Try to locate a bracketed homoclinic end of ``family`` with AUTO's HomCont, restarted
-    from the family's longest labelled orbit. On success the point's parameter becomes the
-    HomCont value and its status "located"; otherwise it stays bracketed and the note says
-    why. A symmetric orbit passing the saddle twice per period (a pair of homoclinic loops
-    of a symmetric model) is not tried: HomCont follows one loop."""
+def locate_homoclinics(engine: Engine, name: str, ends: list[tuple[Branch, SpecialPoint]],
+                       bounds: tuple[float, float], parameters: dict[str, float]
+                       ) -> list[SpecialPoint]:
+    """Try to locate the bracketed homoclinic ends of families with AUTO's HomCont (the runs
+    in parallel), each restarted from its family's longest labelled orbit. On success a
+    point's parameter becomes the HomCont value and its status "located"; otherwise it stays
+    bracketed and its note says why."""
+    points = [point for _, point in ends]
+    runs = []
+    for k, (family, point) in enumerate(ends):
+        planned = _homoclinic_run(engine, name, family, point, bounds, parameters)
+        if isinstance(planned, str):
+            points[k] = replace(point, note=_joined(point.note, planned))
+        else:
+            runs.append((k, planned))
+    outcomes = engine.run_many([spec for _, spec in runs])
+    for (k, spec), outcome in zip(runs, outcomes, strict=True):
+        points[k] = _homoclinic_verdict(outcome, points[k], spec.parameter_names[0], bounds,
+                                        engine.model.time_scale)
+    return points
+
+
+def _homoclinic_run(engine: Engine, name: str, family: Branch, point: SpecialPoint,
+                    bounds: tuple[float, float], parameters: dict[str, float]
+                    ) -> RunSpec | str:
+    """The HomCont run for one homoclinic end, or why none is tried. A symmetric orbit passing
+    the saddle twice per period (a pair of homoclinic loops of a symmetric model) is not:
+    HomCont follows one loop."""
     model = engine.model
     parameter = family.parameter_names[0]
     labelled = [k for k in np.flatnonzero(family.label) if np.isfinite(family.period[k])]
     if not labelled:
-        return replace(point, note=_joined(point.note, "HomCont not tried: no stored orbit"))
+        return "HomCont not tried: no stored orbit"
     row = max(labelled, key=lambda k: family.period[k])
     if model.symmetric and np.allclose(family.state_max[row], -family.state_min[row],
                                        rtol=1e-6, atol=1e-9):
-        return replace(point, note=_joined(point.note, "HomCont not tried: the orbit is "
-                                           "symmetric and passes the saddle twice per period"))
+        return "HomCont not tried: the orbit is symmetric and passes the saddle twice per period"
     saddle_params = model.parameter_vector({**parameters, parameter: point.parameters[0]})
     n_unstable = int((np.linalg.eigvals(model.jacobian_numpy(point.state, saddle_params)).real
                       > 0).sum())
-    label = int(family.label[row])
     if not n_unstable:
-        return replace(point, note=_joined(point.note, "HomCont not tried: no saddle"))
-    source = engine.run_with_label(family.run, label)
+        return "HomCont not tried: no saddle"
+    label = int(family.label[row])
     period_tau = float(family.period[row]) * model.time_scale
-    spec = RunSpec(f"{name}/{family.name}.homoclinic",
+    return RunSpec(f"{name}/{family.name}.homoclinic",
                    homoclinic_constants(model, parameter, bounds, period_tau, n_unstable),
-                   "homoclinic", point.note, (parameter,), restart=(source, label))
-    (outcome,) = engine.run_many([spec])
-    return _homoclinic_verdict(outcome, point, parameter, bounds, model.time_scale)
+                   "homoclinic", point.note, (parameter,),
+                   restart=(engine.run_with_label(family.run, label), label))
 
 
 def _homoclinic_verdict(outcome: auto.RunOutcome, point: SpecialPoint, parameter: str,

@@ -187,20 +187,25 @@ class Model:
 
     @cached_property
     def _numpy_derivative_tensors(self):
-        """Second and third derivatives of the rhs with respect to the states, flattened."""
+        """(flat indices, function of (y, params)) of the non-zero second and third derivatives
+        of the rhs with respect to the states (flattened one after the other)."""
         y, n = self.state_symbols, self.n_states
         rows = [sp.diff(self.rhs[i], y[j]) for i in range(n) for j in range(n)]
         second = [sp.diff(row, y[k]) for row in rows for k in range(n)]
         third = [sp.diff(entry, y[m]) for entry in second for m in range(n)]
-        return sp.lambdify((self.state_symbols, self.parameter_symbols), second + third,
-                           modules="numpy", cse=True)
+        nonzero = [k for k, entry in enumerate(second + third) if entry != 0]
+        entries = [(second + third)[k] for k in nonzero]
+        return np.array(nonzero, dtype=int), sp.lambdify(
+            (self.state_symbols, self.parameter_symbols), entries, modules="numpy", cse=True)
 
     def derivative_tensors(self, y: np.ndarray, params: np.ndarray
                            ) -> tuple[np.ndarray, np.ndarray]:
         """(d2f/dy2, d3f/dy3) at one point, shapes (n, n, n) and (n, n, n, n), SI units:
         entry [i, j, k(, m)] is the derivative of dy_i/dt by y_j, y_k (and y_m)."""
         n = self.n_states
-        values = np.array(self._numpy_derivative_tensors(tuple(y), tuple(params)), dtype=float)
+        nonzero, function = self._numpy_derivative_tensors
+        values = np.zeros(n ** 3 + n ** 4)
+        values[nonzero] = np.array(function(tuple(y), tuple(params)), dtype=float)
         return values[:n ** 3].reshape(n, n, n), values[n ** 3:].reshape(n, n, n, n)
 
     def field_at(self, params: np.ndarray):
