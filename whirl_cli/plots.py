@@ -870,7 +870,4 @@ def _write_png(figure: Figure, path: Path, dpi: int) -> None:
         figure.savefig(buffer, format="png", dpi=dpi)
     finally:
         figure.clear()
-    try:
-        publish(buffer.getvalue(), path, overwrite=True)
-    except OutputError as error:
-        raise OutputError(f"cannot write plot {path}: {error}") from None
+    publish(buffer.getvalue(), path, overwrite=True, what="the plot")

@@ -216,22 +216,18 @@ def write(result: StudyResult, path: Path, overwrite: bool = False) -> Path:
         raise OutputError(f"{path}: output exists; pass --overwrite to replace it")
     if not path.parent.is_dir():
         raise OutputError(f"{path}: the output directory {path.parent} does not exist")
-    image = _image(result)
-    try:
-        _publish(image, path, overwrite)
-    except OSError as error:
-        raise OutputError(f"{path}: cannot write the output ({error.strerror or error})") from None
-    return path
+    return publish(_image(result), path, overwrite, what="the output")
 
 
-def publish(data: bytes, path: Path, overwrite: bool = False) -> Path:
+def publish(data: bytes, path: Path, overwrite: bool = False, what: str = "the file") -> Path:
     """Write ``data`` (e.g. a PNG rendered to memory) to ``path`` the way :func:`write` writes
-    result files: complete or not at all, no temporary file left even by SIGKILL."""
+    result files: complete or not at all, no temporary file left even by SIGKILL. ``what``
+    names the file in the error message."""
     path = Path(path)
     try:
         _publish(data, path, overwrite)
     except OSError as error:
-        raise OutputError(f"{path}: cannot write ({error.strerror or error})") from None
+        raise OutputError(f"{path}: cannot write {what} ({error.strerror or error})") from None
     return path
 
 

@@ -38,6 +38,7 @@ from pathlib import Path
 import h5py
 
 from . import __version__
+from .auto import interruptible
 from .errors import StudyError, WhirlError
 from .results import StudyResult
 from .study import Study, load_study
@@ -181,6 +182,7 @@ def _init_worker(cancelled) -> None:
     global _CANCELLED
     _CANCELLED = cancelled
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # not the parent's handler, inherited by fork
     _die_with_parent()
 
 
@@ -557,35 +559,18 @@ def run_sweep(paths: Sequence[str | os.PathLike[str]], out_dir: Path, jobs: int 
         Path(out_dir).mkdir(parents=True, exist_ok=True)
     reporter = Reporter(len(items), console)
     interrupted = False
-    previous_term = _term_as_interrupt()
     try:
-        if dask_address:
-            pool = dask_pool(dask_address)
-        else:
-            prepare_workers(items)
-            pool = local_pool(jobs)
-        with pool as executor, reporter:
-            execute(items, executor, plots=plots, report=reporter)
+        with interruptible():  # SIGTERM (a batch system's cancel) stops a sweep like Ctrl-C
+            if dask_address:
+                pool = dask_pool(dask_address)
+            else:
+                prepare_workers(items)
+                pool = local_pool(jobs)
+            with pool as executor, reporter:
+                execute(items, executor, plots=plots, report=reporter)
     except KeyboardInterrupt:
         interrupted = True
         raise
     finally:
-        if previous_term is not None:
-            signal.signal(signal.SIGTERM, previous_term)
         reporter.console.print(reporter.tally.summary(interrupted), markup=False, soft_wrap=True)
     return reporter.tally
-
-
-def _term_as_interrupt():
-    """Make SIGTERM (a batch system's cancel, ``kill``) stop a sweep like Ctrl-C: queued studies
-    cancelled, running ones interrupted, finished outputs kept. Returns the previous handler
-    (None off the main thread, where signals cannot be handled)."""
-    from .auto import Interrupted
-
-    def on_term(signum, frame):
-        signal.signal(signal.SIGTERM, signal.SIG_IGN)  # once: let the clean-up finish
-        raise Interrupted(signum)
-
-    if threading.current_thread() is not threading.main_thread():
-        return None
-    return signal.signal(signal.SIGTERM, on_term)
