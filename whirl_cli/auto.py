@@ -42,6 +42,7 @@ from pathlib import Path
 
 from .codegen import constants_text
 from .errors import ToolchainError, WhirlError
+from .interrupts import Interrupted
 
 AUTO_DIR = Path(os.environ.get("WHIRL_AUTO_DIR", "/usr/lib/auto-07p"))
 #: The flags of Debian's ``cmds/cmds.make`` (minus the build-path mapping).
@@ -172,14 +173,6 @@ def _remove_stale_builds(root: Path, age: float = 3600.0) -> None:
 
 
 # ------------------------------------------------------------------------------ running
-class Interrupted(KeyboardInterrupt):
-    """SIGINT or SIGTERM during :func:`interruptible`: every running AUTO process is killed."""
-
-    def __init__(self, signum: int = signal.SIGINT) -> None:
-        super().__init__(signal.Signals(signum).name)
-        self.signum = signum
-
-
 #: Running AUTO processes, and whether new runs are refused (after an interrupt).
 _LIVE: set[subprocess.Popen] = set()
 _LIVE_LOCK = threading.RLock()
@@ -391,5 +384,5 @@ def _classify(returncode: int | None, timed_out: bool, stdout: str, n_points: in
         return "error", "AUTO wrote no solution points"
     if any(kind == "MX" for kind, _ in labels):
         return "mx", ("no convergence with the minimum step size (MX): the branch ends early; "
-                      "try a smaller step.min or more mesh intervals")
+                      "try a smaller auto.step_min or more auto.mesh_intervals")
     return "ok", "ok"

@@ -16,6 +16,7 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 from .global_bifurcations import BLOWUP_FACTOR
+from .interrupts import end_processes, quiet_worker
 from .models import Model
 from .results import Branch, BranchKind, CrossCheck, Orbit, PointType
 
@@ -98,18 +99,23 @@ def cross_check(model: Model, overrides: dict[str, float], branches: tuple[Branc
     branches, perturbations for equilibria), spread along each branch. Not checked: points next
     to bifurcations, orbits in a period blow-up (T > 3 T_Hopf) and equilibria too weakly damped
     or too stiff to simulate in bounded time. ``jobs`` > 1 simulates in that many forked
-    processes (results identical, in the same order)."""
+    processes (results identical, in the same order); the workers ignore SIGINT and die with
+    the parent (:func:`whirl_cli.auto.quiet_worker`), and an interrupt of the parent kills them
+    at once."""
     tasks = planned_checks(branches, per_branch)
     if jobs > 1 and len(tasks) > 1 and "fork" in multiprocessing.get_all_start_methods():
         global _SHARED
         _SHARED = (model, overrides, branches)
         try:
             context = multiprocessing.get_context("fork")
-            pool = ProcessPoolExecutor(min(jobs, len(tasks)), mp_context=context)
+            pool = ProcessPoolExecutor(min(jobs, len(tasks)), mp_context=context,
+                                       initializer=quiet_worker)
             try:
                 return tuple(pool.map(_run_check, tasks))
-            except BaseException:  # e.g. Ctrl-C: drop the checks not started, then wait
-                pool.shutdown(wait=True, cancel_futures=True)
+            except BaseException:  # e.g. Ctrl-C: the workers hold nothing worth waiting for
+                workers = list((getattr(pool, "_processes", None) or {}).values())
+                pool.shutdown(wait=False, cancel_futures=True)
+                end_processes(workers)
                 raise
             finally:
                 pool.shutdown(wait=True)

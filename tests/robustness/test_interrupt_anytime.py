@@ -1,0 +1,122 @@
+"""Ctrl-C at any moment of a real ``whirl run``: it stops within seconds with exit 130 and
+leaves no process and no half set of outputs.
+
+A terminal's Ctrl-C sends SIGINT to the whole foreground process group (whirl and the
+cross-check workers it forked); ``kill -INT`` reaches whirl alone. Both are sent, at moments
+spread over a whole run and, because the cross-check pool is where interrupts used to hang
+(issue 13), at moments just after its workers appear.
+"""
+
+from __future__ import annotations
+
+import os
+import random
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+from .helpers import STUDIES, WHIRL, auto_processes, environment
+
+pytestmark = pytest.mark.auto
+
+STUDY = STUDIES / "combined_case2.yaml"  # periodic families, cross-checks, three plot kinds
+SPREAD, TARGETED = 10, 10
+SEED = 20261201
+#: Longest accepted time from the signal to the exit of whirl.
+STOP_SECONDS = 5.0
+
+
+def session_processes(session: int) -> list[int]:
+    """PIDs alive in a session (whirl and what it forked; AUTO runs have their own)."""
+    alive = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                if os.getsid(int(entry.name)) == session and "zombie" not in \
+                        (entry / "status").read_text():
+                    alive.append(int(entry.name))
+            except (OSError, ProcessLookupError):
+                pass
+    return alive
+
+
+def outputs(directory: Path) -> list[str]:
+    return sorted(p.name for p in directory.iterdir()) if directory.exists() else []
+
+
+def interrupt(cache: Path, scratch: Path, out: Path, delay: float, after_workers: bool,
+              group: bool, reference: list[str]) -> str:
+    """Run the study, send SIGINT ``delay`` s after the start (``after_workers``: after the
+    cross-check workers appear), and check how it ended; returns a word for it."""
+    env = environment(cache, TMPDIR=str(scratch))
+    process = subprocess.Popen([str(WHIRL), "run", str(STUDY), "-o", str(out / "r.h5")],
+                               env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                               text=True, start_new_session=True)
+    try:
+        while after_workers and len(session_processes(process.pid)) < 2 and \
+                process.poll() is None:
+            time.sleep(0.005)
+        time.sleep(delay)
+        sent = time.monotonic()
+        if group:
+            os.killpg(process.pid, signal.SIGINT)
+        else:
+            process.send_signal(signal.SIGINT)
+        try:
+            _, stderr = process.communicate(timeout=STOP_SECONDS)
+        except subprocess.TimeoutExpired:
+            pytest.fail(f"whirl did not stop within {STOP_SECONDS} s of SIGINT "
+                        f"(group={group}); alive: {session_processes(process.pid)}")
+        stopped = time.monotonic() - sent
+    finally:
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
+    assert "Traceback" not in stderr, stderr
+    deadline = time.monotonic() + 2.0
+    while (session_processes(process.pid) or auto_processes(cache)) and \
+            time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert session_processes(process.pid) == [], "a forked worker outlived whirl"
+    assert auto_processes(cache) == [], "an AUTO process outlived whirl"
+    assert list(scratch.iterdir()) == [], "the work directory was not removed"
+    written = outputs(out)
+    if process.returncode == 130:
+        assert stderr.rstrip().endswith("interrupted"), stderr
+        assert written in ([], reference), written  # nothing, or every output (see below)
+        return "interrupted" if not written else "interrupted after publishing"
+    # the signal came after the work was done: the run finished (0), or SIGINT reached it
+    # in the interpreter's shutdown, after the outputs were complete (killed by the signal)
+    assert process.returncode in (0, -signal.SIGINT), (process.returncode, stderr)
+    assert written == reference, written
+    assert stopped < STOP_SECONDS
+    return "finished"
+
+
+def test_sigint_at_any_moment_stops_at_once_without_a_trace(tmp_path):
+    cache = Path(os.environ["WHIRL_CACHE_DIR"])
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    env = environment(cache, TMPDIR=str(scratch))
+    started = time.monotonic()
+    done = subprocess.run([str(WHIRL), "run", str(STUDY), "-o", str(tmp_path / "ref" / "r.h5")],
+                          env=env, capture_output=True, text=True, timeout=300)
+    duration = time.monotonic() - started
+    assert done.returncode == 0, done.stderr
+    reference = outputs(tmp_path / "ref")
+    assert "r.h5" in reference and len(reference) > 3  # the HDF5 file and its plots
+
+    rng = random.Random(SEED)
+    plan = [((k + rng.random()) / SPREAD * duration, False, k % 2 == 0) for k in range(SPREAD)]
+    plan += [(rng.uniform(0.0, 0.3), True, k % 2 == 0) for k in range(TARGETED)]
+    endings = []
+    for k, (delay, after_workers, group) in enumerate(plan):
+        endings.append(interrupt(cache, scratch, tmp_path / f"run{k}", delay, after_workers,
+                                 group, reference))
+    counts = {word: endings.count(word) for word in sorted(set(endings))}
+    print(f"\n  {len(plan)} SIGINTs over a {duration:.1f} s run of {STUDY.name} "
+          f"(half to the process group): {counts}")
+    assert endings.count("interrupted") >= SPREAD // 2 + TARGETED  # most of them land mid-run

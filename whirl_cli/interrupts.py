@@ -1,0 +1,66 @@
+"""Interrupts and worker processes: what every part of whirl that forks or stops shares.
+
+* :class:`Interrupted` is the KeyboardInterrupt whirl raises for SIGINT and SIGTERM (see
+  :func:`whirl_cli.auto.interruptible`); it survives pickling, so it can travel back from a
+  worker process.
+* :func:`quiet_worker` is the initializer of every worker process whirl forks (cross-check
+  simulations, sweep studies); :func:`end_processes` ends such workers after an interrupt.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGINT or SIGTERM during :func:`interruptible`: every running AUTO process is killed."""
+
+    def __init__(self, signum: int = signal.SIGINT) -> None:
+        super().__init__(signal.Signals(signum).name)
+        self.signum = int(signum)
+
+    def __reduce__(self):
+        """Pickle by the signal number (the default would re-create it from its message, the
+        signal's name, which is no signal number): an interrupt raised in a worker process
+        must reach the parent intact, or the process pool breaks."""
+        return type(self), (self.signum,)
+
+
+def quiet_worker() -> None:
+    """Initializer of worker processes forked from whirl (cross-check and sweep pools).
+
+    A fork inherits the parent's signal handlers; whirl's (:func:`interruptible`) would raise
+    inside the pool's queue code of a worker, where an interrupt can leave a lock held and
+    the other workers waiting for ever. So: SIGINT is ignored (a terminal's Ctrl-C reaches the
+    whole process group; the parent alone decides and then ends its workers), SIGTERM is the
+    default (the parent, or a batch system, can end a worker at once), and the worker dies
+    with its parent (Linux parent-death signal), so none outlives a SIGKILLed whirl."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    die_with_parent()
+
+
+def die_with_parent() -> None:
+    """Ask Linux to SIGKILL this process when its parent dies (``prctl(PR_SET_PDEATHSIG)``);
+    a no-op where ``prctl`` is unavailable."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        pr_set_pdeathsig = 1
+        libc.prctl(pr_set_pdeathsig, signal.SIGKILL, 0, 0, 0)
+    except (OSError, AttributeError):
+        return
+    if os.getppid() == 1:  # the parent died before the request took effect
+        os._exit(1)
+
+
+def end_processes(processes) -> None:
+    """SIGKILL worker processes (``multiprocessing.Process``) and reap them: after an
+    interrupt they hold nothing worth waiting for."""
+    for process in processes:
+        if process.is_alive():
+            process.kill()
+    for process in processes:
+        process.join(5)
