@@ -31,9 +31,22 @@ def cli() -> None:
 
 
 # ------------------------------------------------------------------------------------ run
+def _output_file(ctx: click.Context, param: click.Parameter, value: str | None) -> Path | None:
+    """``-o``: a file path (not empty, not an existing directory)."""
+    if value is None:
+        return None
+    if not value.strip():
+        raise OutputError(f"-o/--output: expected the path of the HDF5 file, got {value!r}")
+    path = Path(value)
+    if path.is_dir() or value.endswith(os.sep):
+        raise OutputError(f"{value}: is a directory; -o/--output names the HDF5 file "
+                          "(e.g. out/study.h5)")
+    return path
+
+
 @cli.command()
 @click.argument("study_file", type=click.Path(dir_okay=False, path_type=Path))
-@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
+@click.option("-o", "--output", callback=_output_file,
               help="HDF5 result file [default: <study name>.h5 in the current directory].")
 @click.option("-j", "--jobs", type=click.IntRange(1, 64), default=min(os.cpu_count() or 1, 64),
               show_default=True,
@@ -49,7 +62,6 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     from .study import load_study
 
     study = load_study(study_file)  # first: a bad study is refused fast, before any import
-    from . import store
     from .pipeline import run_study
 
     output = output or Path(f"{study.name}.h5")
@@ -63,10 +75,12 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     console = _console()
 
     def report(outcome) -> None:
+        # an MX is only said to be a problem at the end: at a period blow-up it is expected
         mark = "ok" if outcome.success else outcome.status.upper()
+        detail = {"ok": "", "mx": "  no convergence (MX)"}.get(outcome.status,
+                                                               f"  {outcome.message}")
         console.print(f"  {outcome.name:<32} {mark:<8} {outcome.n_points:>6} points "
-                      f"{outcome.wall_seconds:7.3f} s"
-                      + ("" if outcome.success else f"  {outcome.message}"), soft_wrap=True)
+                      f"{outcome.wall_seconds:7.3f} s{detail}", soft_wrap=True)
 
     console.print(f"whirl {__version__}: {study.path} -> {output}", soft_wrap=True)
     if keep_runs:
@@ -76,35 +90,25 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
         workroot = Path(tempfile.mkdtemp(prefix="whirl-"))
     try:
         result = run_study(study, workroot, jobs=jobs, on_run=report)
-        store.write(result, output, overwrite=overwrite)
     finally:
         if not keep_runs:
             shutil.rmtree(workroot, ignore_errors=True)
-    console.print(f"wrote {output}")
-    if plots and study.plots:
-        from .plots import save_study_plots
+    from .outputs import publish_study
+    from .verdict import verdict
 
-        for path in save_study_plots(result, tuple(study.plots), output.parent, output.stem):
-            console.print(f"wrote {path}")
-    # a locus ending in MX has mostly reached a degenerate point (a cusp of folds of cycles,
-    # a Bogdanov-Takens point): reported, but not a failure of the study
-    loci_mx = [b for c in result.continuations for b in c.branches
-               if b.status == "mx" and b.kind.endswith("_locus")]
-    for branch in loci_mx:
-        console.print(f"note: locus {branch.name} ends with MX (no convergence) at "
-                      f"{', '.join(f'{v:.5g}' for v in branch.parameters[-1])}")
-    failed = [b for c in result.continuations for b in c.branches
-              if b.status != "ok" and b not in loci_mx]
+    published = publish_study(result, output, study.plots if plots else (), overwrite)
+    for path in published.paths:
+        console.print(f"wrote {path}", soft_wrap=True)
+    found = verdict(result, published.plot_error)
+    for note in found.notes:
+        console.print(f"note: {note}", soft_wrap=True)
     checks = [x for c in result.continuations for x in c.cross_checks]
-    wrong = [x for x in checks if not x.passed]
     if checks:
-        console.print(f"cross-checks by time simulation: {len(checks) - len(wrong)} of "
+        console.print(f"cross-checks by time simulation: {sum(x.passed for x in checks)} of "
                       f"{len(checks)} passed")
-    problems = [f"{b.name} ({b.run}): {b.message}" for b in failed]
-    problems += [f"cross-check failed on {x.branch} at {x.parameter:.6g}" for x in wrong]
-    if problems:
-        raise WhirlError(f"{len(problems)} problem(s); the results are stored with their "
-                         "status: " + "; ".join(problems))
+    if found.problems:
+        raise WhirlError(f"{len(found.problems)} problem(s); the results are stored with "
+                         "their status: " + "; ".join(found.problems))
 
 
 # ------------------------------------------------------------------------------------ check

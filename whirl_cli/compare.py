@@ -36,7 +36,8 @@ from . import store
 from .results import Branch, ContinuationResult, LinearSweep, PointType, SpecialPoint, StudyResult
 
 #: Root attributes that change from run to run without any physical meaning.
-IGNORED_ATTRIBUTES = frozenset({"created", "git_describe", "whirl_version", "auto_version"})
+IGNORED_ATTRIBUTES = frozenset({"created", "git_describe", "whirl_version", "whirl_code_sha256",
+                                "auto_version", "plots"})
 
 
 @dataclass(frozen=True)

@@ -6,39 +6,18 @@ directories under ``workroot`` (the caller stores the result with :mod:`whirl_cl
 
 from __future__ import annotations
 
-import subprocess
 from collections.abc import Callable
 from dataclasses import replace
-from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
 
-from . import __version__, boundaries, linear, simulate
-from .auto import RunOutcome, auto_version, interruptible
+from . import boundaries, linear, simulate
+from .auto import RunOutcome, interruptible
+from .provenance import provenance
 from .recipes import Engine, Numerics, one_parameter, two_parameter
 from .results import Boundary, ContinuationResult, StudyResult
 from .study import Study
-
-
-def provenance(study: Study) -> dict[str, str]:
-    """Root attributes of a result file: versions, the study text and its hash."""
-    attributes = {
-        "whirl_version": __version__,
-        "auto_version": auto_version(),
-        "study_yaml": study.source,
-        "study_sha256": study.sha256,
-        "created": datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
-    }
-    try:
-        described = subprocess.run(["git", "describe", "--always", "--dirty"],
-                                   cwd=Path(__file__).parent, capture_output=True, text=True,
-                                   timeout=5, check=False)
-        if described.returncode == 0 and described.stdout.strip():
-            attributes["git_describe"] = described.stdout.strip()
-    except (OSError, subprocess.TimeoutExpired):
-        pass
-    return attributes
 
 
 def run_study(study: Study, workroot: Path, jobs: int = 1,

@@ -755,23 +755,49 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
       of no branches if there is none); without boundaries but with a linear grid,
       ``<stem>_linear_grid.png`` (the grid alone).
 
-    Names are made filesystem-safe; repeats get ``_2``, ``_3``, ... Each file is written
-    under a temporary name in ``out_dir`` and moved into place, so none is ever half-written.
+    Names are made filesystem-safe; repeats get ``_2``, ``_3``, ... (:func:`plot_names`).
+    Each file is rendered in memory and published complete or not at all (an existing file
+    of the same name is replaced). ``whirl run`` and ``whirl sweep`` publish a study's plots
+    together with its HDF5 file instead (:mod:`whirl_cli.outputs`).
     """
-    unknown = set(kinds) - set(PLOT_KINDS)
-    if unknown:
-        raise WhirlError(f"unknown plot kind(s) {sorted(unknown)}; choose from {PLOT_KINDS}")
     out_dir = Path(out_dir)
+    rendered = render_study_plots(result, kinds, stem, state, dpi)
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"cannot create plot directory {out_dir}: {exc}") from exc
-    written: list[Path] = []
+    from .store import publish
+
+    return sorted(publish(data, out_dir / name, overwrite=True, what="the plot")
+                  for name, data in rendered)
+
+
+def plot_names(result: StudyResult, kinds: tuple[str, ...], stem: str,
+               state: str = "theta") -> list[str]:
+    """The file names :func:`save_study_plots` writes for ``result`` (in drawing order),
+    found without drawing anything."""
+    return [name for name, _ in _named_jobs(result, kinds, stem, state)]
+
+
+def render_study_plots(result: StudyResult, kinds: tuple[str, ...], stem: str,
+                       state: str = "theta", dpi: int = 150) -> list[tuple[str, bytes]]:
+    """(file name, PNG bytes) of every figure of :func:`save_study_plots`, rendered in
+    memory; nothing is written."""
+    return [(name, _png(make(), dpi)) for name, make in _named_jobs(result, kinds, stem, state)]
+
+
+def _named_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: str):
+    """(unique filesystem-safe file name, figure factory) pairs of the requested kinds."""
+    unknown = set(kinds) - set(PLOT_KINDS)
+    if unknown:
+        raise WhirlError(f"unknown plot kind(s) {sorted(unknown)}; choose from {PLOT_KINDS}")
+    taken: list[Path] = []
+    jobs = []
     for name, make in _figure_jobs(result, kinds, stem, state):
-        path = _unique(out_dir / _safe_name(name), written)
-        _write_png(make(), path, dpi)
-        written.append(path)
-    return sorted(written)
+        path = _unique(Path(_safe_name(name)), taken)
+        taken.append(path)
+        jobs.append((path.name, make))
+    return jobs
 
 
 def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: str):
@@ -860,14 +886,11 @@ def _unique(path: Path, taken: list[Path]) -> Path:
     return candidate
 
 
-def _write_png(figure: Figure, path: Path, dpi: int) -> None:
-    """Render ``figure`` as PNG in memory and publish it at ``path`` the way result files are
-    written: complete or not at all, no temporary file left behind even by SIGKILL."""
-    from .store import publish
-
+def _png(figure: Figure, dpi: int) -> bytes:
+    """``figure`` rendered as PNG bytes (the figure is cleared afterwards)."""
     buffer = io.BytesIO()
     try:
         figure.savefig(buffer, format="png", dpi=dpi)
     finally:
         figure.clear()
-    publish(buffer.getvalue(), path, overwrite=True, what="the plot")
+    return buffer.getvalue()

@@ -4,19 +4,21 @@
 
 * :func:`plan` (pure, no AUTO): find the study files, validate them, name each output
   ``<out_dir>/<study name>.h5`` and decide per study: ``run`` (no output yet, the study or
-  whirl changed, or ``force``), ``skip`` (the output holds the same ``study_sha256`` and
-  ``whirl_version``) or ``invalid`` (the YAML does not validate, or two files share a name).
+  whirl changed, or ``force``), ``skip`` (the output holds the same ``study_sha256``,
+  ``whirl_version`` and ``whirl_code_sha256``), ``plot`` (up to date, but plots it should
+  have are missing: they are drawn from the stored result) or ``invalid`` (the YAML does
+  not validate, or two files share a name).
 * :func:`compute`, the task a worker process runs: :func:`whirl_cli.pipeline.run_study` with
   ``jobs=1`` in its own temporary directory; it returns the :class:`StudyResult` (frozen
   dataclasses, picklable) and writes nothing else.
 * :func:`execute`: submits the planned studies to any ``concurrent.futures.Executor`` (a local
   process pool, or Dask's ``Client.get_executor()``) and, as each finishes, writes its HDF5
-  file (atomically, :func:`whirl_cli.store.write`) and plots **in the parent process only**.
+  file and plots as one unit (:func:`whirl_cli.outputs.publish_study`) **in the parent
+  process only**.
 
 Interrupting (Ctrl-C) cancels the studies not started yet, interrupts the running ones (their
 AUTO processes are killed and their working directories removed) and keeps every output
-already written; an output is never half-written because the store and the plots write to a
-temporary name and rename.
+already written; a study's outputs are never half a set (see :mod:`whirl_cli.outputs`).
 """
 
 from __future__ import annotations
@@ -40,10 +42,14 @@ import h5py
 from . import __version__
 from .auto import interruptible
 from .errors import StudyError, WhirlError
+from .interrupts import quiet_worker
+from .outputs import missing_plots, publish_plots, publish_study
+from .provenance import code_sha256
 from .results import StudyResult
 from .study import Study, load_study
+from .verdict import is_problem, verdict
 
-RUN, SKIP, INVALID = "run", "skip", "invalid"
+RUN, SKIP, PLOT, INVALID = "run", "skip", "plot", "invalid"
 DASK_HINT = "install with pip install 'whirl[dask]'"
 
 
@@ -52,10 +58,10 @@ DASK_HINT = "install with pip install 'whirl[dask]'"
 class SweepItem:
     """One study file of a sweep and what to do with it.
 
-    ``action``: "run" | "skip" | "invalid"; ``reason`` says why (e.g. "new", "study changed",
-    "up to date", or the validation errors). ``stored_problems``: problems recorded in an
-    up-to-date output that is skipped (failed branches or cross-checks), so that a resumed
-    sweep still reports them.
+    ``action``: "run" | "skip" | "plot" | "invalid"; ``reason`` says why (e.g. "new", "study
+    changed", "up to date", "up to date, plots missing", or the validation errors).
+    ``stored_problems``: problems recorded in an up-to-date output that is skipped (failed
+    branches or cross-checks), so that a resumed sweep still reports them.
     """
 
     source: Path
@@ -93,18 +99,19 @@ def find_studies(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
 
 
 def plan(paths: Iterable[str | os.PathLike[str]], out_dir: str | os.PathLike[str],
-         force: bool = False) -> list[SweepItem]:
+         force: bool = False, plots: bool = True) -> list[SweepItem]:
     """What a sweep of ``paths`` into ``out_dir`` will do, study by study (no AUTO, no writes).
 
     A study is skipped when ``<out_dir>/<study name>.h5`` exists with the same
-    ``study_sha256`` and ``whirl_version`` root attributes, unless ``force``.
+    ``study_sha256``, ``whirl_version`` and ``whirl_code_sha256`` root attributes, unless
+    ``force``; if ``plots`` and some of its plots are missing, they are drawn ("plot").
     """
     out_dir = Path(out_dir)
     items: list[SweepItem] = []
     owners: dict[str, Path] = {}
     for path in find_studies(paths):
         try:
-            study = load_study(path)
+            study = load_study(path, label=str(path))
         except StudyError as error:
             items.append(SweepItem(path, INVALID, error.message))
             continue
@@ -116,6 +123,12 @@ def plan(paths: Iterable[str | os.PathLike[str]], out_dir: str | os.PathLike[str
         owners[study.name] = path
         output = out_dir / f"{study.name}.h5"
         action, reason, problems = _decide(study, output, force)
+        if action == SKIP and plots:
+            try:
+                if missing_plots(output, study.plots):
+                    action, reason = PLOT, "up to date, plots missing"
+            except (OSError, KeyError, ValueError, WhirlError) as error:
+                action, reason = RUN, f"unreadable output ({type(error).__name__})"
         items.append(SweepItem(path, action, reason, study, output, problems))
     return items
 
@@ -127,46 +140,49 @@ def _decide(study: Study, output: Path, force: bool) -> tuple[str, str, tuple[st
     if not output.exists():
         return RUN, "new", ()
     try:
-        sha, version, problems = stored_state(output)
+        stored = stored_state(output)
     except (OSError, KeyError, ValueError) as error:
         return RUN, f"unreadable output ({type(error).__name__})", ()
-    if sha != study.sha256:
+    if stored.study_sha256 != study.sha256:
         return RUN, "study changed", ()
-    if version != __version__:
-        return RUN, f"whirl {version} -> {__version__}", ()
-    return SKIP, "up to date", problems
+    if stored.whirl_version != __version__:
+        return RUN, f"whirl {stored.whirl_version} -> {__version__}", ()
+    if stored.code_sha256 != code_sha256():
+        return RUN, "whirl's code changed", ()
+    return SKIP, "up to date", stored.problems
 
 
-def stored_state(output: Path) -> tuple[str, str, tuple[str, ...]]:
-    """(study_sha256, whirl_version, problems) of an existing result file, read with h5py
-    (root attributes, branch attributes and cross-check outcomes only)."""
+@dataclass(frozen=True)
+class StoredState:
+    """What a sweep needs to know of an existing result file."""
+
+    study_sha256: str
+    whirl_version: str
+    code_sha256: str  # "" in files written before whirl recorded it
+    problems: tuple[str, ...]  # by the failure policy of :mod:`whirl_cli.verdict`
+
+
+def stored_state(output: Path) -> StoredState:
+    """The provenance and stored problems of an existing result file, read with h5py (root
+    attributes, branch attributes and cross-check outcomes only, not the data)."""
     def text(value) -> str:
         return value.decode() if isinstance(value, bytes) else str(value)
 
     problems: list[str] = []
     with h5py.File(output, "r") as handle:
-        sha = text(handle.attrs["study_sha256"])
-        version = text(handle.attrs["whirl_version"])
+        attrs = handle.attrs
         for name, group in handle.get("continuations", {}).items():
             for branch, sub in group.get("branches", {}).items():
-                if text(sub.attrs.get("status", "ok")) != "ok":
+                if is_problem(text(sub.attrs.get("kind", "")),
+                              text(sub.attrs.get("status", "ok"))):
                     problems.append(f"{branch} ({text(sub.attrs.get('run', ''))}): "
                                     f"{text(sub.attrs.get('message', ''))}")
             if "cross_checks" in group:
                 failed = int((~group["cross_checks/passed"][()].astype(bool)).sum())
                 if failed:
                     problems.append(f"{failed} cross-check(s) failed in {name}")
-    return sha, version, tuple(problems)
-
-
-def result_problems(result: StudyResult) -> tuple[str, ...]:
-    """Why ``whirl run`` would exit 1 on this result: branches whose AUTO run did not succeed
-    and failed time-simulation cross-checks."""
-    problems = [f"{b.name} ({b.run}): {b.message}" for c in result.continuations
-                for b in c.branches if b.status != "ok"]
-    problems += [f"cross-check failed on {x.branch} at {x.parameter:.6g}"
-                 for c in result.continuations for x in c.cross_checks if not x.passed]
-    return tuple(problems)
+        return StoredState(text(attrs["study_sha256"]), text(attrs["whirl_version"]),
+                           text(attrs.get("whirl_code_sha256", "")), tuple(problems))
 
 
 # ------------------------------------------------------------------------------ the task
@@ -175,31 +191,13 @@ _CANCELLED = None
 
 
 def _init_worker(cancelled) -> None:
-    """Initializer of local worker processes: they ignore SIGINT, except inside
-    :func:`whirl_cli.pipeline.run_study`, whose own handler kills the running AUTO processes
-    and raises (so a signal can never land in the pool's queue code); ``cancelled`` (an
-    Event) makes tasks still queued return at once."""
+    """Initializer of local worker processes: :func:`whirl_cli.auto.quiet_worker` (SIGINT
+    ignored except inside :func:`whirl_cli.pipeline.run_study`, whose own handler kills the
+    running AUTO processes and raises; SIGTERM default; death with the sweep process), and
+    ``cancelled`` (an Event) makes tasks still queued return at once."""
     global _CANCELLED
     _CANCELLED = cancelled
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # not the parent's handler, inherited by fork
-    _die_with_parent()
-
-
-def _die_with_parent() -> None:
-    """Ask Linux to SIGKILL this worker when the sweep process dies (e.g. SIGKILL), so that
-    no idle worker outlives it (its AUTO processes already die with it, see
-    :mod:`whirl_cli.auto`). A no-op where ``prctl`` is unavailable."""
-    try:
-        import ctypes
-
-        libc = ctypes.CDLL(None, use_errno=True)
-        pr_set_pdeathsig = 1
-        libc.prctl(pr_set_pdeathsig, signal.SIGKILL, 0, 0, 0)
-    except (OSError, AttributeError):
-        return
-    if os.getppid() == 1:  # the parent died before the request took effect
-        os._exit(1)
+    quiet_worker()
 
 
 def compute(study: Study) -> StudyResult:
@@ -290,6 +288,9 @@ def execute(items: Sequence[SweepItem], executor: Executor, plots: bool = True,
     if on_submitted is not None:
         on_submitted(len(futures))
     try:
+        for item in items:  # while the workers compute
+            if item.action == PLOT:
+                done(_complete_plots(item))
         for future in as_completed(futures):
             done(_store(futures[future], future, plots))
     except BaseException:
@@ -323,9 +324,7 @@ def expected_cost(item: SweepItem) -> int:
 
 
 def _store(item: SweepItem, future: Future, plots: bool) -> Outcome:
-    """Write a finished study's HDF5 file (and plots); a task's exception becomes an outcome."""
-    from . import store
-
+    """Write a finished study's HDF5 file and plots; a task's exception becomes an outcome."""
     try:
         result: StudyResult = future.result()
     except WhirlError as error:
@@ -334,22 +333,27 @@ def _store(item: SweepItem, future: Future, plots: bool) -> Outcome:
         return Outcome(item, "error", (f"{type(error).__name__}: {error}",))
     assert item.output is not None and item.study is not None
     auto_seconds = sum(r.wall_seconds for r in result.runs)
-    problems = result_problems(result)
     try:
-        written = [store.write(result, item.output, overwrite=True)]
+        published = publish_study(result, item.output, item.study.plots if plots else (),
+                                  overwrite=True)
     except Exception as error:  # e.g. a result the store cannot represent: go on
         return Outcome(item, "error", (f"writing {item.output}: {type(error).__name__}: "
-                                       f"{error}", *problems), auto_seconds, len(result.runs))
-    if plots and item.study.plots:
-        from .plots import save_study_plots
-
-        try:
-            written += save_study_plots(result, tuple(item.study.plots), item.output.parent,
-                                        item.output.stem)
-        except Exception as error:  # the HDF5 file stands; say what went wrong with plots
-            problems += (f"plots: {type(error).__name__}: {error}",)
+                                       f"{error}", *verdict(result).problems), auto_seconds,
+                       len(result.runs))
+    problems = verdict(result, published.plot_error).problems
     return Outcome(item, "failed" if problems else "ok", problems, auto_seconds,
-                   len(result.runs), tuple(written))
+                   len(result.runs), published.paths)
+
+
+def _complete_plots(item: SweepItem) -> Outcome:
+    """Draw the missing plots of an up-to-date study from its stored result."""
+    assert item.output is not None and item.study is not None
+    try:
+        written = publish_plots(item.output, item.study.plots)
+    except Exception as error:  # the result file stands; say what went wrong with plots
+        return Outcome(item, "error", (f"plots: {type(error).__name__}: {error}",
+                                       *item.stored_problems))
+    return Outcome(item, "plotted", item.stored_problems, written=written)
 
 
 # ------------------------------------------------------------------------------ executors
@@ -474,15 +478,18 @@ class Tally:
     def line(self, outcome: Outcome) -> str:
         """One log line per study: counter, status, name, AUTO time, output or first problem."""
         width = len(str(self.total))
-        mark = {"ok": "ok", "skipped": "skip"}.get(outcome.status, outcome.status.upper())
+        mark = {"ok": "ok", "skipped": "skip", "plotted": "plot"}.get(outcome.status,
+                                                                       outcome.status.upper())
         head = f"[{self.done:>{width}}/{self.total}] {mark:<8} {outcome.item.name:<28}"
         if outcome.status == "skipped":
             detail = outcome.item.reason
+        elif outcome.status == "plotted":
+            detail = f"{outcome.item.reason}: {len(outcome.written)} drawn"
         elif outcome.status in ("ok", "failed"):
             detail = (f"{outcome.runs:>3} AUTO runs {outcome.auto_seconds:6.2f} s -> "
                       f"{outcome.item.output}")
-        else:
-            detail = str(outcome.item.source)
+        else:  # an invalid study's problems name its file
+            detail = "" if outcome.status == "invalid" else str(outcome.item.source)
         if outcome.problems:
             more = len(outcome.problems) - 1
             detail += f"  {outcome.problems[0]}" + (f" (+{more} more)" if more else "")
@@ -492,12 +499,14 @@ class Tally:
         """Counts and elapsed time, then one line per failed study."""
         seconds = time.perf_counter() - self.started
         parts = [f"{self.count('ok')} ok", f"{self.count('skipped')} up to date"]
+        parts += [f"{n} plots completed" for n in [self.count("plotted")] if n]
         parts += [f"{n} {s}" for s in ("failed", "error", "invalid") if (n := self.count(s))]
         if interrupted:
             parts.append(f"{self.total - self.done} not finished (interrupted)")
         text = f"sweep: {', '.join(parts)} of {self.total} studies in {seconds:.1f} s"
         for outcome in self.failures:
-            text += f"\n  {outcome.item.source}: " + "; ".join(outcome.problems)
+            named = "" if outcome.status == "invalid" else f"{outcome.item.source}: "
+            text += f"\n  {named}" + "; ".join(outcome.problems)
         return text
 
 
@@ -554,7 +563,7 @@ def run_sweep(paths: Sequence[str | os.PathLike[str]], out_dir: Path, jobs: int 
 
     The summary is printed in every case; a KeyboardInterrupt propagates after it.
     """
-    items = plan(paths, out_dir, force)
+    items = plan(paths, out_dir, force, plots)
     if any(item.action == RUN for item in items):
         Path(out_dir).mkdir(parents=True, exist_ok=True)
     reporter = Reporter(len(items), console)

@@ -18,6 +18,7 @@ from whirl_cli import __version__, store
 from whirl_cli.cli import cli
 from whirl_cli.compare import compare_files
 from whirl_cli.errors import WhirlError
+from whirl_cli.provenance import code_sha256
 from whirl_cli.sweep import INVALID, RUN, SKIP, dask_pool, find_studies, plan
 
 from ..conftest import ROOT, STUDIES
@@ -47,9 +48,13 @@ def renamed(path: Path, name: str, **replace: str) -> Path:
     return target
 
 
-def fake_output(path: Path, sha: str, version: str = __version__) -> None:
+def fake_output(path: Path, sha: str, version: str = __version__, code: str | None = None
+                ) -> None:
+    """A result file that has only the root attributes a sweep's plan reads (by default the
+    ones of an output of this very code)."""
     with h5py.File(path, "w") as handle:
-        handle.attrs.update(whirl_schema=1, study_sha256=sha, whirl_version=version)
+        handle.attrs.update(whirl_schema=1, study_sha256=sha, whirl_version=version,
+                            whirl_code_sha256=code_sha256() if code is None else code)
 
 
 # ------------------------------------------------------------------------------ plan (no AUTO)
@@ -73,8 +78,12 @@ def test_plan_decides_run_skip_and_invalid(tmp_path):
 
     study = items["linear_case2.yaml"].study
     fake_output(out / "linear-case2.h5", study.sha256)
-    assert {i.source.name: (i.action, i.reason) for i in plan([first], out)} == {
+    assert {i.source.name: (i.action, i.reason) for i in plan([first], out, plots=False)} == {
         "linear_case2.yaml": (SKIP, "up to date")}
+    # with plots, the fake file's result cannot be read to find the plots it should have
+    assert plan([first], out)[0].reason == "unreadable output (KeyError)"
+    fake_output(out / "linear-case2.h5", study.sha256, code="0" * 64)
+    assert plan([first], out, plots=False)[0].reason == "whirl's code changed"
     assert plan([first], out, force=True)[0].action == RUN
     fake_output(out / "linear-case2.h5", "0" * 64)
     assert plan([first], out)[0].reason == "study changed"

@@ -1,0 +1,146 @@
+"""A study's outputs as one unit: its HDF5 file and its plots appear together or not at all.
+
+:func:`publish_study` is how ``whirl run`` and ``whirl sweep`` write a finished study:
+
+1. every plot is rendered in memory first (:func:`whirl_cli.plots.render_study_plots`); if
+   drawing fails (a bug), the HDF5 file is still published, alone, and the error reported
+   (the result is not lost, and a sweep draws the missing plots again next time);
+2. without ``overwrite`` nothing is written if the HDF5 file or any of the plot files exists
+   (one message naming the first such file);
+3. the files are published with SIGINT and SIGTERM held back (an interrupt arriving then is
+   delivered once the set is complete): the plots first, the HDF5 file last. Its root
+   attribute ``plots`` lists the plot files published with it. Each file appears complete or
+   not at all (:func:`whirl_cli.store.publish`), so even a SIGKILL can leave at most plots
+   without their HDF5 file, never an HDF5 file without its plots; a sweep treats a study
+   without its HDF5 file as not run, and completes the plots of an up-to-date file that lacks
+   some (:func:`missing_plots`);
+4. with ``overwrite``, the plots the old HDF5 file recorded that the new result does not
+   draw are removed once the new file is in place (no stale figure of an old result stays
+   beside the new one).
+"""
+
+from __future__ import annotations
+
+import signal
+import threading
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from . import store
+from .errors import OutputError
+from .results import StudyResult
+
+#: Root attribute of the HDF5 file: names of the plot files published with it.
+PLOTS_ATTRIBUTE = "plots"
+
+
+@dataclass(frozen=True)
+class Published:
+    """What :func:`publish_study` wrote (the HDF5 file last) and, if the plots could not be
+    drawn, why (else "")."""
+
+    paths: tuple[Path, ...]
+    plot_error: str = ""
+
+
+def publish_study(result: StudyResult, output: Path, kinds: Sequence[str],
+                  overwrite: bool = False) -> Published:
+    """Write ``result`` to ``output`` and its plots of ``kinds`` next to it (``<output
+    stem>_*.png``), as one unit; see the module doc."""
+    output = Path(output)
+    plots, plot_error = [], ""
+    if kinds:
+        from .plots import render_study_plots
+
+        try:
+            plots = render_study_plots(result, tuple(kinds), output.stem)
+        except Exception as error:  # a bug in drawing: keep the result, say what went wrong
+            plot_error = f"plots: {type(error).__name__}: {error}"
+    targets = [output.parent / name for name, _ in plots]
+    if not overwrite:
+        for path in [output, *targets]:
+            if path.exists():
+                raise OutputError(f"{path}: output exists; pass --overwrite to replace it")
+    names = [name for name, _ in plots]
+    stale = [output.parent / name for name in recorded_plots(output)
+             if name not in names] if overwrite else []
+    result = replace(result, attributes={**result.attributes, PLOTS_ATTRIBUTE: names})
+    written: list[Path] = []
+    with held_signals():
+        try:
+            for (_, data), path in zip(plots, targets, strict=True):
+                written.append(store.publish(data, path, overwrite, what="the plot"))
+            written.append(store.write(result, output, overwrite=overwrite))
+        except BaseException:
+            if not overwrite:  # they did not exist before: leave no plots without their file
+                for path in written:
+                    path.unlink(missing_ok=True)
+            raise
+        for path in stale:
+            path.unlink(missing_ok=True)
+    return Published(tuple(written), plot_error)
+
+
+def publish_plots(output: Path, kinds: Sequence[str]) -> tuple[Path, ...]:
+    """Draw the plots of ``kinds`` of the existing result ``output`` next to it (replacing
+    files of the same names): how a sweep completes an up-to-date study's plots."""
+    from .plots import render_study_plots
+
+    rendered = render_study_plots(store.read(output), tuple(kinds), Path(output).stem)
+    with held_signals():
+        return tuple(store.publish(data, Path(output).parent / name, True, what="the plot")
+                     for name, data in rendered)
+
+
+def recorded_plots(output: Path) -> tuple[str, ...]:
+    """The plot file names an existing result file records (empty if it records none, is
+    absent or unreadable)."""
+    if not Path(output).exists():
+        return ()
+    try:
+        import h5py
+
+        with h5py.File(output, "r") as handle:
+            names = handle.attrs.get(PLOTS_ATTRIBUTE, ())
+            return tuple(n.decode() if isinstance(n, bytes) else str(n) for n in names)
+    except (OSError, ValueError, TypeError):
+        return ()
+
+
+def missing_plots(output: Path, kinds: Sequence[str]) -> list[str]:
+    """Plot files of ``kinds`` that should stand beside the existing result ``output`` and do
+    not: the ones it records, or, if it records none (written with ``--no-plots`` or by an
+    older whirl), the ones its result draws."""
+    if not kinds:
+        return []
+    names = recorded_plots(output)
+    if not names:
+        from .plots import plot_names
+
+        names = tuple(plot_names(store.read(output), tuple(kinds), Path(output).stem))
+    return [name for name in names if not (Path(output).parent / name).exists()]
+
+
+@contextmanager
+def held_signals() -> Iterator[None]:
+    """SIGINT and SIGTERM are held back while inside (main thread only; elsewhere a no-op):
+    one that arrives is recorded, and raised again on leaving, so that the handler that was
+    in place (Python's KeyboardInterrupt, :func:`whirl_cli.auto.interruptible`'s, or the
+    default action) deals with it then. (Blocking the signals would not do: the kernel hands
+    a process-directed signal to any thread that does not block it.)"""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    arrived: list[int] = []
+    held = (signal.SIGINT, signal.SIGTERM)
+    previous = {number: signal.signal(number, lambda signum, _frame: arrived.append(signum))
+                for number in held}
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+        for number in dict.fromkeys(arrived):
+            signal.raise_signal(number)

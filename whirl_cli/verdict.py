@@ -1,0 +1,53 @@
+"""What makes a study fail: the one failure policy of ``whirl run`` and ``whirl sweep``.
+
+A study has *problems* (``whirl run`` exits 1, a sweep counts it failed) when
+
+* a branch's AUTO run did not succeed (an error, a crash, a timeout, or MX = no convergence),
+  except where whirl has judged the end natural: an MX at a period blow-up (the family's
+  status is then "ok") and a locus ending in MX, which has mostly reached a degenerate point
+  (a cusp of folds of cycles, a Bogdanov-Takens point) and is reported as a *note*;
+* a time-simulation cross-check failed;
+* its plots could not be drawn.
+
+Either way the results are stored, with each branch's and run's status and message.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .results import StudyResult
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """``problems``: why the study failed (empty: it did not); ``notes``: worth saying."""
+
+    problems: tuple[str, ...]
+    notes: tuple[str, ...]
+
+
+def is_problem(kind: str, status: str) -> bool:
+    """True if a branch of ``kind`` that ended with run ``status`` makes the study fail."""
+    return status != "ok" and not is_locus_mx(kind, status)
+
+
+def is_locus_mx(kind: str, status: str) -> bool:
+    """A locus ending in MX: a note, not a problem (see the module doc)."""
+    return status == "mx" and kind.endswith("_locus")
+
+
+def verdict(result: StudyResult, plot_error: str = "") -> Verdict:
+    """The problems and notes of ``result`` (see the module doc); ``plot_error``: why its
+    plots could not be drawn, if so (a problem too)."""
+    branches = [b for c in result.continuations for b in c.branches]
+    loci_mx = [b for b in branches if is_locus_mx(b.kind, b.status)]
+    notes = tuple(f"locus {b.name} ends with MX (no convergence) "
+                  + (f"at {', '.join(f'{v:.5g}' for v in b.parameters[-1])}" if len(b)
+                     else "at its start") for b in loci_mx)
+    problems = [f"{b.name} ({b.run}): {b.message}" for b in branches
+                if is_problem(b.kind, b.status)]
+    problems += [f"cross-check failed on {x.branch} at {x.parameter:.6g}"
+                 for c in result.continuations for x in c.cross_checks if not x.passed]
+    problems += [plot_error] if plot_error else []
+    return Verdict(tuple(problems), notes)
