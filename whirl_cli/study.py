@@ -637,10 +637,12 @@ def _resolved_item(item: Any, variant: Model, values: dict[str, float] | None) -
 
 
 # --------------------------------------------------------------------------- entry points
-def load_study(path: str | os.PathLike[str]) -> Study:
-    """Read, check and return the study at ``path``; StudyError lists every problem."""
+def load_study(path: str | os.PathLike[str], label: str | None = None) -> Study:
+    """Read, check and return the study at ``path``; StudyError lists every problem, each
+    line starting with ``label`` (default: the file's name)."""
     path = Path(path)
-    return _validate(_read_text(path), path.name, str(path))
+    label = path.name if label is None else label
+    return _validate(_read_text(path, label), label, str(path))
 
 
 def validate_text(text: str, filename: str = "<study>") -> Study:
@@ -648,22 +650,22 @@ def validate_text(text: str, filename: str = "<study>") -> Study:
     return _validate(text, filename, filename)
 
 
-def _read_text(path: Path) -> str:
-    """The file's text: at most MAX_BYTES of UTF-8."""
+def _read_text(path: Path, label: str) -> str:
+    """The file's text: at most MAX_BYTES of UTF-8 (errors name the file ``label``)."""
     try:
         with path.open("rb") as stream:
             raw = stream.read(MAX_BYTES + 1)
             size = max(len(raw), os.fstat(stream.fileno()).st_size)
     except OSError as error:
         reason = f"cannot read the study file ({error.strerror or error})"
-        raise StudyError(f"{path.name}: {reason}") from None
+        raise StudyError(f"{label}: {reason}") from None
     if len(raw) > MAX_BYTES:
-        raise StudyError(_too_large(path.name, size))
+        raise StudyError(_too_large(label, size))
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as error:
         reason = f"not UTF-8 text (byte 0x{raw[error.start]:02x} at offset {error.start})"
-        raise StudyError(f"{path.name}: {reason}") from None
+        raise StudyError(f"{label}: {reason}") from None
 
 
 def _too_large(name: str, size: int) -> str:
@@ -922,20 +924,31 @@ def _meaning_problems(data: dict) -> list[Problem]:
         return []
     values = _study_values(data, variant)
     problems = _override_problems(data.get("parameters"), variant, family)
+    for name in _LAW_PARAMETERS if isinstance(block, dict) else ():
+        if name in block:
+            problems += _bound_problems(("nonlinearity", name), name, block[name], variant)
     items = data.get("continuations")
     problems += _continuation_problems(items, variant, family, values)
     linear = data.get("linear")
     sweeps = linear.get("sweeps") if isinstance(linear, dict) else None
     for i, sweep in _dict_items(sweeps):
-        loc = ("linear", "sweeps", i, "parameter")
-        problems += _parameter_problems(loc, sweep.get("parameter"), variant, family)
+        problems += _sweep_problems(("linear", "sweeps", i), sweep, variant, family)
     grid = linear.get("grid") if isinstance(linear, dict) else None
     for axis in ("x", "y"):
         spec = grid.get(axis) if isinstance(grid, dict) else None
         if isinstance(spec, dict):
-            loc = ("linear", "grid", axis, "parameter")
-            problems += _parameter_problems(loc, spec.get("parameter"), variant, family)
+            problems += _sweep_problems(("linear", "grid", axis), spec, variant, family)
     return problems
+
+
+def _sweep_problems(loc: Loc, spec: dict, variant: Model, family: str) -> list[Problem]:
+    """The parameter and range of a linear sweep or grid axis."""
+    name = spec.get("parameter")
+    found = _parameter_problems(loc + ("parameter",), name, variant, family)
+    if found or not isinstance(name, str):
+        return found
+    return _range_problems(loc + ("range",), variant.canonical(name), spec.get("range"),
+                           variant, "swept")
 
 
 def _dict_items(items: Any) -> Iterator[tuple[int, dict]]:
@@ -953,13 +966,54 @@ def _parameter_problems(loc: Loc, name: Any, variant: Model, family: str) -> lis
 
 def _override_problems(parameters: Any, variant: Model, family: str) -> list[Problem]:
     problems: list[Problem] = []
-    for name in parameters if isinstance(parameters, dict) else ():
+    spelled: dict[str, str] = {}  # canonical name -> the key that gave it first
+    for name, value in parameters.items() if isinstance(parameters, dict) else ():
         loc = ("parameters", name)
         found = _parameter_problems(loc, name, variant, family)
         if not found and variant.canonical(name) in _LAW_PARAMETERS:
             found = [(loc, f"set {name} under nonlinearity (type: polynomial)")]
+        if not found:
+            canonical = variant.canonical(name)
+            if canonical in spelled:
+                found = [(loc, _twice(name, spelled[canonical], canonical))]
+            spelled.setdefault(canonical, name)
+            found = found or _bound_problems(loc, canonical, value, variant)
         problems += found
     return problems
+
+
+def _twice(name: str, other: str, canonical: str) -> str:
+    """Why a parameter given under two spellings is refused."""
+    same = f"both name {canonical}" if canonical not in (name, other) else \
+        f"{(other if name == canonical else name)!r} is an alias of {canonical}"
+    return f"{name!r} and {other!r} are the same parameter ({same}); give it once"
+
+
+def _bound_problems(loc: Loc, canonical: str, value: Any, variant: Model) -> list[Problem]:
+    """A value outside the parameter's physical bounds (malformed values are reported as
+    structural problems)."""
+    number = _finite(value)
+    parameter = variant.parameter(canonical)
+    if number is None or parameter.bounds.contains(number):
+        return []
+    return [(loc, f"{canonical} must be {parameter.bounds.text(parameter.unit)}, got "
+             f"{value!r}")]
+
+
+def _range_problems(loc: Loc, canonical: str, bounds: Any, variant: Model,
+                    swept: str) -> list[Problem]:
+    """A continuation or sweep range reaching outside the parameter's physical bounds, or a
+    parameter that takes whole numbers only (which cannot be continued or swept)."""
+    parameter = variant.parameter(canonical)
+    if parameter.bounds.integer:
+        return [(loc, f"{canonical} takes whole numbers only ({parameter.bounds.text()}) and "
+                 f"cannot be {swept}")]
+    ends = [_finite(b) for b in bounds] if isinstance(bounds, list) and len(bounds) == 2 else []
+    outside = [e for e in ends if e is not None and not parameter.bounds.contains(e)]
+    if not outside:
+        return []
+    return [(loc, f"the range reaches {outside[0]!r}, outside the bounds of {canonical} "
+             f"({parameter.bounds.text(parameter.unit)})")]
 
 
 def _continuation_problems(
@@ -979,9 +1033,26 @@ def _continuation_problems(
             continue
         found = _parameter_problems(loc + ("parameter",), parameter, variant, family)
         if not found and isinstance(parameter, str):
-            found = _start_problems(loc, item, values[variant.canonical(parameter)])
+            canonical = variant.canonical(parameter)
+            found = _range_problems(loc + ("range",), canonical, item.get("range"), variant,
+                                    "continued")
+            found = found or _start_problems(loc, item, values[canonical])
+            found += _orbits_problems(loc, item)
         problems += found
     return problems
+
+
+def _orbits_problems(loc: Loc, item: dict) -> list[Problem]:
+    """``orbits_at`` values outside the continuation's range."""
+    bounds, orbits = item.get("range"), item.get("orbits_at")
+    if not (isinstance(bounds, list) and len(bounds) == 2 and isinstance(orbits, list)):
+        return []
+    lower, upper = (_finite(b) for b in bounds)
+    if lower is None or upper is None or not lower < upper:
+        return []
+    return [(loc + ("orbits_at", k), f"{number!r} is outside the range [{lower!r}, {upper!r}]")
+            for k, number in enumerate(map(_finite, orbits))
+            if number is not None and not lower <= number <= upper]
 
 
 def _pair_problems(loc: Loc, item: dict, variant: Model, family: str,
@@ -1001,11 +1072,20 @@ def _pair_problems(loc: Loc, item: dict, variant: Model, family: str,
     bounds = item.get("range")
     if not isinstance(bounds, dict):
         return problems
-    canonical = {variant.canonical(k) if k in variant.known_parameter_names() else k: k
-                 for k in bounds if isinstance(k, str)}
+    canonical: dict[str, str] = {}
+    for key in (k for k in bounds if isinstance(k, str)):
+        name = variant.canonical(key) if key in variant.known_parameter_names() else key
+        if name in canonical:
+            return [(loc + ("range", key), _twice(key, canonical[name], name))]
+        canonical[name] = key
     if set(canonical) != {first, second}:
         return [(loc + ("range",), f"expected the keys {first}, {second}, got "
                  f"{', '.join(map(str, bounds)) or 'none'}")]
+    for name in (first, second):
+        problems += _range_problems(loc + ("range", canonical[name]), name,
+                                    bounds[canonical[name]], variant, "continued")
+    if problems:
+        return problems
     start_item = {"range": bounds[canonical[first]], "start": item.get("start")}
     problems += _start_problems(loc, start_item, values[first])
     limits = bounds[canonical[second]]

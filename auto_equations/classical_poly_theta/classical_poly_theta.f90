@@ -24,7 +24,7 @@
 !   PAR(39) = I_x [kg m^2]: rotor polar inertia
 !   PAR(40) = R [m]: rotor radius
 !   PAR(41) = c [m]: blade chord (constant)
-!   PAR(42) = N [1]: number of blades (>= 3)
+!   PAR(42) = N [1]: number of blades (>= 3: the azimuth average of the blade forces is exact)
 !   PAR(43) = C_l_alpha [1/rad]: blade section lift slope
 !   PAR(11) = period in tau
 !   PAR(44..51) = max and min of each state over the solution (PVLS)

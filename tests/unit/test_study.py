@@ -666,3 +666,77 @@ def test_readme_yaml_reference_is_generated_from_the_schema():
 
     readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
     assert schema_reference() in readme
+
+
+# --------------------------------------------------------------------------- issue 13: 3, 4
+HEAD = "name: s\nmodel: classical\n"
+
+
+def test_a_parameter_given_by_name_and_by_alias_is_refused():
+    """Before, ``{K1: 0.1, K_theta: 0.4}`` was accepted and the last one won."""
+    assert problems(HEAD + "parameters: {K1: 0.1, K_theta: 0.4}\n") == [
+        "s.yaml:3: parameters.K_theta: 'K_theta' and 'K1' are the same parameter ('K_theta' "
+        "is an alias of K1); give it once"]
+    pair = ("continuations:\n  - name: b\n    type: two-parameter\n    parameters: [K1, K_psi]\n"
+            "    range: {K1: [-0.3, 0.5], K_psi: [0, 0.5], K_theta: [0, 1]}\n")
+    assert problems(HEAD + pair) == [
+        "s.yaml:7: continuations[0].range.K_theta: 'K_theta' and 'K1' are the same parameter "
+        "('K_theta' is an alias of K1); give it once"]
+
+
+@pytest.mark.parametrize(("override", "reason"), [
+    ("I_y: 0", "I_y must be > 0 kg m^2, got 0"),
+    ("N: 2.5", "N must be an integer >= 3, got 2.5"),
+    ("N: 2", "N must be an integer >= 3, got 2"),
+    ("rho: -1", "rho must be >= 0 kg/m^3, got -1"),
+    ("R: 0", "R must be > 0 m, got 0"),
+    ("Omega: -40", "Omega must be > 0 rad/s, got -40"),
+    ("C_theta: -0.001", "C_theta must be >= 0 N m s/rad, got -0.001"),
+    ("K_psi: 1.0e+12", "K_psi must be in [-1e+09, 1e+09] N m/rad, got 1000000000000.0"),
+])
+def test_non_physical_parameters_are_refused(override, reason):
+    name = override.split(":")[0]
+    assert problems(HEAD + f"parameters: {{{override}}}\n") == [
+        f"s.yaml:3: parameters.{name}: {reason}"]
+
+
+def test_law_coefficients_have_bounds_too():
+    assert problems(HEAD + "nonlinearity: {type: polynomial, K2: 1.0e+308}\n") == [
+        "s.yaml:3: nonlinearity.K2: K2 must be in [-1e+09, 1e+09] N m/rad^3, got 1e+308"]
+
+
+def test_ranges_stay_within_the_bounds_and_whole_numbers_are_not_continued():
+    text = HEAD + (
+        "continuations:\n"
+        "  - {name: a, type: one-parameter, parameter: V, range: [-1, 10]}\n"
+        "  - {name: b, type: one-parameter, parameter: N, range: [3, 10]}\n"
+        "  - {name: c, type: two-parameter, parameters: [K1, rho],"
+        " range: {K1: [-0.3, 0.5], rho: [-1, 1]}}\n"
+        "linear:\n  sweeps: [{parameter: N, range: [3, 5]}, {parameter: c, range: [-1, 1]}]\n")
+    assert problems(text) == [
+        "s.yaml:4: continuations[0].range: the range reaches -1.0, outside the bounds of V "
+        "(>= 0 m/s)",
+        "s.yaml:5: continuations[1].range: N takes whole numbers only (an integer >= 3) and "
+        "cannot be continued",
+        "s.yaml:6: continuations[2].range.rho: the range reaches -1.0, outside the bounds of "
+        "rho (>= 0 kg/m^3)",
+        "s.yaml:8: linear.sweeps[0].range: N takes whole numbers only (an integer >= 3) and "
+        "cannot be swept",
+        "s.yaml:8: linear.sweeps[1].range: the range reaches -1.0, outside the bounds of c "
+        "(>= 0 m)"]
+
+
+def test_orbits_at_values_outside_the_range_are_refused():
+    text = HEAD + ("continuations:\n  - {name: a, type: one-parameter, parameter: K1,"
+                   " range: [-0.3, 0.5], orbits_at: [0.1, 0.6]}\n")
+    assert problems(text) == [
+        "s.yaml:4: continuations[0].orbits_at[1]: 0.6 is outside the range [-0.3, 0.5]"]
+
+
+def test_every_datum_lies_within_its_bounds_and_models_lists_them():
+    from whirl_cli.models import all_variants
+
+    for model in all_variants():
+        for parameter in model.parameters:
+            assert parameter.bounds.contains(parameter.default), parameter
+        assert "an integer >= 3" in model.describe()

@@ -37,15 +37,60 @@ RESERVED_NAMES = frozenset(
 )
 
 
+#: Largest magnitude whirl accepts for any parameter, in its SI unit: far beyond any rotor,
+#: and far enough below the double-precision limit that the equations cannot overflow.
+MAGNITUDE_LIMIT = 1e9
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """The physical range of a parameter's value: ``lower`` <= value <= ``upper`` (strict where
+    ``*_open``), a whole number if ``integer``. Both ends are finite (at most
+    :data:`MAGNITUDE_LIMIT` in size)."""
+
+    lower: float = -MAGNITUDE_LIMIT
+    upper: float = MAGNITUDE_LIMIT
+    lower_open: bool = False
+    upper_open: bool = False
+    integer: bool = False
+
+    def contains(self, value: float) -> bool:
+        low = value > self.lower if self.lower_open else value >= self.lower
+        high = value < self.upper if self.upper_open else value <= self.upper
+        return low and high and (not self.integer or float(value).is_integer())
+
+    def text(self, unit: str = "") -> str:
+        """E.g. "> 0 kg m^2", "an integer in [3, 1e+09]", "in [-1e+09, 1e+09] N m/rad"."""
+        unit = f" {unit}" if unit and unit != "1" else ""
+        if self.upper == MAGNITUDE_LIMIT and not self.upper_open and \
+                self.lower > -MAGNITUDE_LIMIT:
+            text = f"{'>' if self.lower_open else '>='} {self.lower:g}{unit}"
+        else:
+            text = (f"in {'(' if self.lower_open else '['}{self.lower:g}, {self.upper:g}"
+                    f"{')' if self.upper_open else ']'}{unit}")
+        return f"an integer {text}" if self.integer else text
+
+
+POSITIVE = Bounds(lower=0.0, lower_open=True)
+NON_NEGATIVE = Bounds(lower=0.0)
+
+
 @dataclass(frozen=True)
 class Parameter:
-    """A model parameter: travels to AUTO through PAR, never compiled in."""
+    """A model parameter: travels to AUTO through PAR, never compiled in. ``bounds``: its
+    physical range (a study value outside it is refused)."""
 
     name: str
     default: float
     unit: str
     description: str
     aliases: tuple[str, ...] = ()
+    bounds: Bounds = Bounds()
+
+    def __post_init__(self) -> None:
+        if not self.bounds.contains(self.default):
+            raise ValueError(f"parameter {self.name}: datum {self.default!r} outside its bounds "
+                             f"{self.bounds.text()}")
 
 
 @dataclass(frozen=True)
@@ -243,7 +288,8 @@ class Model:
         lines.append("  parameters:")
         for p in self.parameters:
             alias = f" (alias {', '.join(p.aliases)})" if p.aliases else ""
-            lines.append(f"    {p.name:<10} {p.default:<12.6g} {p.unit:<14} {p.description}{alias}")
+            lines.append(f"    {p.name:<10} {p.default:<12.6g} {p.unit:<14} {p.description}{alias}"
+                         f"; {p.bounds.text()}")
         if self.notes:
             lines.append("  notes: " + self.notes)
         return "\n".join(lines)

@@ -35,7 +35,7 @@ import math
 
 import sympy as sp
 
-from .base import Model, Parameter, State
+from .base import NON_NEGATIVE, POSITIVE, Bounds, Model, Parameter, State
 from .nonlinearities import StiffnessLaw
 
 #: AUTO's time: tau = TIME_SCALE * t, with the datum rotor speed (the BW mode is ~34 rad/s).
@@ -57,18 +57,20 @@ _STIFFNESS = {
 }
 #: Parameters after the stiffness ones, in PAR order (the first nine PAR slots are 1..9).
 _OTHER = (
-    Parameter("V", 6.7, "m/s", "free-stream airspeed"),
-    Parameter("C_theta", 0.001, "N m s/rad", "pitch viscous damping"),
-    Parameter("C_psi", 0.001, "N m s/rad", "yaw viscous damping"),
-    Parameter("Omega", 40.0, "rad/s", "rotor speed"),
-    Parameter("I_y", 0.000178, "kg m^2", "nacelle + rotor inertia about the pivot (I_y = I_z)"),
-    Parameter("rho", 1.225, "kg/m^3", "air density"),
-    Parameter("a", 0.25, "1", "pivot-to-hub distance / R"),
-    Parameter("I_x", 0.000103, "kg m^2", "rotor polar inertia"),
-    Parameter("R", 0.152, "m", "rotor radius"),
-    Parameter("c", 0.026, "m", "blade chord (constant)"),
-    Parameter("N", 4.0, "1", "number of blades (>= 3)"),
-    Parameter("C_l_alpha", 2.0 * math.pi, "1/rad", "blade section lift slope"),
+    Parameter("V", 6.7, "m/s", "free-stream airspeed", bounds=NON_NEGATIVE),
+    Parameter("C_theta", 0.001, "N m s/rad", "pitch viscous damping", bounds=NON_NEGATIVE),
+    Parameter("C_psi", 0.001, "N m s/rad", "yaw viscous damping", bounds=NON_NEGATIVE),
+    Parameter("Omega", 40.0, "rad/s", "rotor speed", bounds=POSITIVE),
+    Parameter("I_y", 0.000178, "kg m^2", "nacelle + rotor inertia about the pivot (I_y = I_z)",
+              bounds=POSITIVE),
+    Parameter("rho", 1.225, "kg/m^3", "air density", bounds=NON_NEGATIVE),
+    Parameter("a", 0.25, "1", "pivot-to-hub distance / R", bounds=NON_NEGATIVE),
+    Parameter("I_x", 0.000103, "kg m^2", "rotor polar inertia", bounds=NON_NEGATIVE),
+    Parameter("R", 0.152, "m", "rotor radius", bounds=POSITIVE),
+    Parameter("c", 0.026, "m", "blade chord (constant)", bounds=NON_NEGATIVE),
+    Parameter("N", 4.0, "1", "number of blades (>= 3: the azimuth average of the blade "
+              "forces is exact)", bounds=Bounds(lower=3.0, integer=True)),
+    Parameter("C_l_alpha", 2.0 * math.pi, "1/rad", "blade section lift slope", bounds=POSITIVE),
 )
 
 NOTES = (

@@ -37,6 +37,7 @@ def _polynomial(x: sp.Symbol, stiffness: Parameter) -> tuple[sp.Expr, tuple[Para
         stiffness.unit,
         f"linear coefficient of the {x} restoring moment ({stiffness.name})",
         aliases=(stiffness.name, *stiffness.aliases),
+        bounds=stiffness.bounds,
     )
     k2 = Parameter("K2", 0.0, f"{unit}/rad^3", f"cubic coefficient of the {x} restoring moment")
     k3 = Parameter("K3", 0.0, f"{unit}/rad^5", f"quintic coefficient of the {x} restoring moment")
