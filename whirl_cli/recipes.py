@@ -711,7 +711,8 @@ def _origin(hopf: SpecialPoint) -> str:
 
 def _hopf_growth_direction(branch: Branch, hopf: SpecialPoint) -> float:
     """Sign of d(Re lambda)/dp of the critical pair at a Hopf point, from the eigenvalues AUTO
-    printed at the neighbouring points of the equilibrium branch."""
+    printed at the neighbouring points of the equilibrium branch; 0 (unknown) where AUTO
+    printed none there."""
     k = hopf.index
     if k == 0 or k + 1 >= len(branch):
         return 0.0
@@ -723,7 +724,7 @@ def _hopf_growth_direction(branch: Branch, hopf: SpecialPoint) -> float:
 
     slope = (critical(k + 1) - critical(k - 1)) / (branch.parameters[k + 1, 0]
                                                    - branch.parameters[k - 1, 0])
-    return float(np.sign(slope))
+    return float(np.sign(slope)) if np.isfinite(slope) else 0.0
 
 
 # ------------------------------------------------------------------------------- two-parameter
