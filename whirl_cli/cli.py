@@ -189,7 +189,11 @@ def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None) -> 
 
     result = store.read(result_file)
     output_dir = output_dir or result_file.parent
-    output_dir.mkdir(parents=True, exist_ok=True)
+    try:
+        output_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise OutputError(f"{output_dir}: cannot create the output directory "
+                          f"({error.strerror or error})") from None
     kinds = kinds or ("bifurcation", "linear", "period", "boundary")
     for path in save_study_plots(result, kinds, output_dir, result_file.stem):
         click.echo(f"wrote {path}")

@@ -594,7 +594,7 @@ def _datasets(path: Path, roots: tuple[str, ...]) -> dict[str, np.ndarray]:
                               for v in value.ravel()]).reshape(value.shape)
         return value
 
-    with h5py.File(path, "r") as handle:
+    with store.opened(path) as handle:
         for root in roots:
             if root not in handle:
                 continue

@@ -40,6 +40,9 @@ and linked into place, so an output path never holds a partial file and an inter
 from __future__ import annotations
 
 import os
+import re
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import h5py
@@ -399,10 +402,59 @@ def _read_special_points(group: h5py.Group) -> tuple[SpecialPoint, ...]:
         for k in range(len(columns["index"])))
 
 
+#: What reading a file that does not hold what a whirl result file holds can raise (h5py
+#: raises KeyError for a missing group or attribute, OSError for unreadable data, ValueError,
+#: TypeError or IndexError for data of the wrong type or shape).
+_DAMAGED = (KeyError, OSError, ValueError, TypeError, IndexError)
+
+
+@contextmanager
+def opened(path: Path) -> Iterator[h5py.File]:
+    """``path`` opened with h5py for reading, for the readers of result files (:func:`read`,
+    :mod:`whirl_cli.compare`). A file that is not HDF5, a truncated or unreadable one, and one
+    missing what its reader looks up inside the ``with`` block raise :class:`OutputError` as
+    one line ``<path>: <reason>``, never an h5py traceback."""
+    try:
+        handle = h5py.File(path, "r")
+    except OSError as error:
+        raise OutputError(f"{path}: {_open_failure(error)}") from None
+    try:
+        with handle:
+            yield handle
+    except _DAMAGED as error:
+        raise OutputError(f"{path}: not a complete whirl result file "
+                          f"({_reason(error)})") from None
+
+
+def _reason(error: Exception) -> str:
+    """h5py's reason of an error: the text in its ``Unable to ... (reason)`` message."""
+    text = str(error.args[0]) if isinstance(error, KeyError) and error.args else str(error)
+    found = re.search(r"\((.*)\)\s*$", text)
+    return found.group(1) if found else text
+
+
+def _open_failure(error: OSError) -> str:
+    """Why h5py could not open a file, in words."""
+    reason = _reason(error)
+    if "file signature not found" in reason:
+        return "not an HDF5 file"
+    truncated = re.search(r"truncated file: eof = (\d+).*stored_eof = (\d+)", reason)
+    if truncated:
+        return (f"truncated HDF5 file ({truncated.group(1)} of its {truncated.group(2)} "
+                "bytes)")
+    if "Permission denied" in reason or "errno = 13" in reason:
+        return "cannot read the file (permission denied)"
+    return f"cannot read as HDF5 ({reason})"
+
+
 def read(path: Path) -> StudyResult:
-    """The :class:`StudyResult` stored in a whirl HDF5 file."""
-    with h5py.File(path, "r") as handle:
-        schema = int(handle.attrs.get("whirl_schema", -1))
+    """The :class:`StudyResult` stored in a whirl HDF5 file; :class:`OutputError` (one line
+    naming the file) for a file that is not HDF5, not a whirl file, truncated or damaged."""
+    with opened(path) as handle:
+        if "whirl_schema" not in handle.attrs:
+            raise OutputError(f"{path}: an HDF5 file but not a whirl result file (no "
+                              "whirl_schema attribute)")
+        schema = int(handle.attrs["whirl_schema"])
         if schema != SCHEMA:
             raise OutputError(f"{path}: not a whirl result file of schema {SCHEMA} "
                               f"(found {schema})")
