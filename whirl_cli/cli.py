@@ -118,13 +118,22 @@ def check(result_file: Path) -> None:
     result = store.read(result_file)
     study = validate_text(str(result.attributes.get("study_yaml", "")), result_file.name)
     model, parameters = study.variant(), study.parameter_values()
+    unit = model.states[model.state_names.index(model.dof)].unit
+
+    def compared(x) -> str:  # what expected and simulated are (results.CrossCheck)
+        if x.kind == "equilibrium":
+            return (f"perturbation {x.expected:.6g} rad, final deviation {x.simulated:.6g} "
+                    "rad")
+        return f"max {model.dof} AUTO {x.expected:.6g} {unit}, simulation {x.simulated:.6g} " \
+            f"{unit}"
+
     wrong = 0
     for continuation in result.continuations:
         for x in simulate.cross_check(model, parameters, continuation.branches):
             mark = "ok  " if x.passed else "FAIL"
             click.echo(f"{mark} {continuation.name}/{x.branch}[{x.index}] {x.kind:<11} "
                        f"{continuation.branches[0].parameter_names[0]} = {x.parameter:.6g}: "
-                       f"AUTO {x.expected:.6g}, simulation {x.simulated:.6g}")
+                       f"{compared(x)}")
             wrong += not x.passed
     if wrong:
         raise WhirlError(f"{wrong} cross-check(s) failed")
