@@ -295,17 +295,24 @@ def sweep(paths: tuple[Path, ...], out_dir: Path, jobs: int, dask_address: str |
                    "[default: 1e-6, 1e-5].")
 @click.option("--limit", type=click.IntRange(1), default=20, show_default=True,
               help="Differences printed at most.")
+@click.option("--strict", is_flag=True,
+              help="Count differences of the study text and its hash (study_yaml, "
+                   "study_sha256) as drift [default: print them as notes].")
 def compare(file_a: Path, file_b: Path, rtol: float | None, atol: float | None,
-            limit: int) -> None:
+            limit: int, strict: bool) -> None:
     """Compare two result files on physics (special points, branches along the parameter,
     stability, linear sweeps, boundaries), not point indices. Exit 1 on drift."""
-    from .compare import Tolerances, compare_files
+    from .compare import Tolerances
+    from .compare import compare as compare_results
 
-    differences = compare_files(file_a, file_b, Tolerances.from_options(rtol, atol))
+    found = compare_results(file_a, file_b, Tolerances.from_options(rtol, atol), strict)
+    differences = found.differences
     for difference in differences[:limit]:
         click.echo(str(difference))
     if len(differences) > limit:
         click.echo(f"... and {len(differences) - limit} more")
+    for note in found.notes:
+        click.echo(f"note: {note}")
     if differences:
         raise WhirlError(f"{file_a} and {file_b} differ ({len(differences)} difference(s))")
     click.echo(f"{file_a} and {file_b} agree")

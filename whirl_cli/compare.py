@@ -3,8 +3,11 @@
 ``whirl compare A.h5 B.h5`` is the drift check of CI (``tests/regression``) and of sweeps run
 on other machines. Point indices, step counts and provenance are not compared; instead:
 
-* **root**: study name, model, study text and hash (``created``, ``git_describe``,
-  ``whirl_version``, ``auto_version`` are ignored: they legitimately change);
+* **root**: study name and model (``created``, ``git_describe``, ``whirl_version``,
+  ``auto_version`` are ignored: they legitimately change). The study text and its hash
+  (``study_yaml``, ``study_sha256``) are provenance: a difference there (a comment, the plots
+  asked for, a timeout) is reported as a note, not as drift, unless ``strict``; what the
+  study changes in the physics shows up in the results themselves;
 * **special points** of each continuation, matched by (type, kind of their branch) with an
   optimal assignment on parameter and state, then compared on the parameter values (tolerance
   ``parameter`` x the span of that parameter over the continuation), the state (``state``, SI
@@ -26,7 +29,7 @@ Files are read with :func:`whirl_cli.store.read`; ``/boundaries`` (not part of
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import h5py
@@ -37,6 +40,9 @@ from .results import Branch, ContinuationResult, LinearSweep, PointType, Special
 
 #: Root attributes that change from run to run without any physical meaning.
 IGNORED_ATTRIBUTES = frozenset({"created", "git_describe", "whirl_version", "auto_version"})
+#: Root attributes that say where a result came from: differences are notes, drift only when
+#: comparing ``strict``ly. (``study_name`` and ``model`` say what was computed: always drift.)
+PROVENANCE_ATTRIBUTES = frozenset({"study_yaml", "study_sha256"})
 
 
 @dataclass(frozen=True)
@@ -85,20 +91,40 @@ class Difference:
         return f"{self.path}: {self.a} vs {self.b}" + (f"  ({self.note})" if self.note else "")
 
 
+@dataclass(frozen=True)
+class Comparison:
+    """What :func:`compare` found: ``differences`` (drift) and ``notes`` (differences of
+    provenance, :data:`PROVENANCE_ATTRIBUTES`, that are not drift; empty when ``strict``)."""
+
+    differences: list[Difference]
+    notes: list[Difference]
+
+
 # ------------------------------------------------------------------------------ entry points
-def compare_files(a: Path, b: Path, tolerances: Tolerances | None = None) -> list[Difference]:
-    """All differences between the result files ``a`` and ``b`` (empty: they agree)."""
+def compare(a: Path, b: Path, tolerances: Tolerances | None = None, strict: bool = False
+            ) -> Comparison:
+    """Drift and provenance notes between the result files ``a`` and ``b``; with ``strict``
+    a difference of study text or hash is drift too."""
     tolerances = tolerances or Tolerances()
-    differences = compare_results(store.read(a), store.read(b), tolerances)
+    result_a, result_b = store.read(a), store.read(b)
+    differences = compare_results(result_a, result_b, tolerances, strict)
     differences += compare_boundaries(a, b, tolerances)
-    return differences
+    return Comparison(differences, [] if strict else provenance_notes(result_a, result_b))
 
 
-def compare_results(a: StudyResult, b: StudyResult, tolerances: Tolerances | None = None
-                    ) -> list[Difference]:
-    """Differences between two results in memory (everything but ``/boundaries``)."""
+def compare_files(a: Path, b: Path, tolerances: Tolerances | None = None, strict: bool = False
+                  ) -> list[Difference]:
+    """All drift between the result files ``a`` and ``b`` (empty: they agree)."""
+    return compare(a, b, tolerances, strict).differences
+
+
+def compare_results(a: StudyResult, b: StudyResult, tolerances: Tolerances | None = None,
+                    strict: bool = False) -> list[Difference]:
+    """Drift between two results in memory (everything but ``/boundaries``); study text and
+    hash count only if ``strict`` (else see :func:`provenance_notes`)."""
     tolerances = tolerances or Tolerances()
-    found = _compare_root(a, b)
+    found = _compare_root(a, b, IGNORED_ATTRIBUTES if strict
+                          else IGNORED_ATTRIBUTES | PROVENANCE_ATTRIBUTES)
     found += _compare_named(
         "/continuations", {c.name: c for c in a.continuations},
         {c.name: c for c in b.continuations},
@@ -124,15 +150,37 @@ def _compare_named(prefix: str, a: dict, b: dict, compare) -> list[Difference]:
     return found
 
 
-def _compare_root(a: StudyResult, b: StudyResult) -> list[Difference]:
+def _compare_root(a: StudyResult, b: StudyResult, skip: frozenset[str]) -> list[Difference]:
     found = []
     pairs = {"study_name": (a.study_name, b.study_name), "model": (a.model, b.model)}
-    for key in sorted((set(a.attributes) | set(b.attributes)) - IGNORED_ATTRIBUTES):
+    for key in sorted((set(a.attributes) | set(b.attributes)) - skip):
         pairs[key] = (a.attributes.get(key, "<missing>"), b.attributes.get(key, "<missing>"))
     for key, (x, y) in pairs.items():
         if str(x) != str(y):
-            found.append(Difference(f"/@{key}", _short(x), _short(y), "root attribute"))
+            shown = _first_different_line(x, y) if key == "study_yaml" and isinstance(
+                x, str) and isinstance(y, str) else (_short(x), _short(y))
+            found.append(Difference(f"/@{key}", *shown, "root attribute"))
     return found
+
+
+def provenance_notes(a: StudyResult, b: StudyResult) -> list[Difference]:
+    """Differences of study text and hash (:data:`PROVENANCE_ATTRIBUTES`): not drift."""
+    paths = {f"/@{key}" for key in PROVENANCE_ATTRIBUTES}
+    return [replace(d, note="provenance, not drift; --strict counts it")
+            for d in _compare_root(a, b, IGNORED_ATTRIBUTES) if d.path in paths]
+
+
+def _first_different_line(x: str, y: str) -> tuple[str, str]:
+    """The first line where two texts differ, as ``line <k>: <text>`` (``<end>`` past the
+    last line of the shorter text)."""
+    lines_x, lines_y = x.splitlines(), y.splitlines()
+    k = next((k for k, (p, q) in enumerate(zip(lines_x, lines_y, strict=False)) if p != q),
+             min(len(lines_x), len(lines_y)))
+
+    def line(lines: list[str]) -> str:
+        return f"line {k + 1}: " + (_short(lines[k]) if k < len(lines) else "<end>")
+
+    return line(lines_x), line(lines_y)
 
 
 def _short(value, limit: int = 60) -> str:
