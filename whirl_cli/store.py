@@ -32,6 +32,10 @@ Layout (units in a ``units`` attribute on every physical dataset)::
     /runs/<run>                     attrs: status, message, constants, returncode,
                                            wall_seconds, n_points
 
+The groups holding collections (continuations, branches, orbits, sweeps, boundaries, loci,
+polygons, contour lines, runs) track the creation order of their members, so a round trip
+keeps the order of the study and its results; older files list (and read) by name.
+
 The file is built in memory, written to an unnamed file in the output directory (O_TMPFILE)
 and linked into place, so an output path never holds a partial file and an interrupted write
 (even SIGKILL) leaves no temporary file; an existing file is only replaced with ``overwrite``.
@@ -72,6 +76,16 @@ def _strings(values) -> np.ndarray:
     return np.array([str(v) for v in values], dtype=object)
 
 
+def _collection(parent: h5py.Group, name: str) -> h5py.Group:
+    """The group ``name`` of ``parent`` that holds a collection (continuations, branches,
+    orbits, sweeps, boundaries, loci, runs, ...), created tracking the order in which its
+    members are written, so that :func:`read` returns them in that order; HDF5 lists them by
+    name otherwise (``periodic_10`` before ``periodic_2``)."""
+    if name in parent:
+        return parent[name]
+    return parent.create_group(name, track_order=True)
+
+
 def _write_branch(group: h5py.Group, branch: Branch) -> None:
     group.attrs.update(kind=branch.kind, origin=branch.origin, status=branch.status,
                        message=branch.message, run=branch.run, end=branch.end)
@@ -91,7 +105,7 @@ def _write_branch(group: h5py.Group, branch: Branch) -> None:
     else:
         group.create_dataset("eigenvalues", data=branch.eigenvalues).attrs["units"] = "1/s"
     for orbit in branch.orbits:
-        sub = group.create_group(f"orbits/{orbit.label}")
+        sub = _collection(group, "orbits").create_group(str(orbit.label))
         sub.attrs.update(point_type=orbit.point_type, index=orbit.index, period=orbit.period,
                          parameters=orbit.parameters)
         sub.create_dataset("time", data=orbit.time).attrs["units"] = "s"
@@ -147,11 +161,11 @@ def _write_boundary(group: h5py.Group, boundary: Boundary) -> None:
     group.attrs.update(parameters=list(boundary.parameter_names),
                        units=list(boundary.parameter_units), method=boundary.method,
                        slices=np.array(boundary.slices, dtype=float))
-    for name, (kind, curve) in sorted(boundary.loci.items()):
-        data = group.create_dataset(f"loci/{name}", data=curve.reshape(-1, 2))
+    for name, (kind, curve) in boundary.loci.items():
+        data = _collection(group, "loci").create_dataset(name, data=curve.reshape(-1, 2))
         data.attrs["kind"] = kind
     for k, polygon in enumerate(boundary.polygons):
-        group.create_dataset(f"unsafe/polygon_{k}", data=polygon)
+        _collection(group, "unsafe").create_dataset(f"polygon_{k}", data=polygon)
     table = group.create_group("unsafe_intervals")
     rows = boundary.intervals
     for key in ("slice_value", "lower", "upper"):
@@ -162,8 +176,8 @@ def _write_boundary(group: h5py.Group, boundary: Boundary) -> None:
 def _read_boundary(name: str, group: h5py.Group) -> Boundary:
     loci = {key: (_text(data.attrs["kind"]), data[()])
             for key, data in group.get("loci", {}).items()}
-    polygons = tuple(group["unsafe"][key][()] for key in sorted(
-        group.get("unsafe", {}), key=lambda k: int(k.rsplit("_", 1)[1])))
+    polygons = tuple(group["unsafe"][key][()] for key in _members(group.get("unsafe", {}),
+                                                                   _number))
     table = group["unsafe_intervals"]
     intervals = tuple(
         UnsafeInterval(float(v), float(lo), float(hi), _text(c)) for v, lo, hi, c in zip(
@@ -182,13 +196,13 @@ def _write_grid(group: h5py.Group, grid: LinearGrid) -> None:
     group.create_dataset("oscillatory", data=grid.oscillatory)
     for kind in ("flutter", "divergence"):
         for k, line in enumerate(getattr(grid, kind)):
-            group.create_dataset(f"{kind}/line_{k}", data=line)
+            _collection(group, kind).create_dataset(f"line_{k}", data=line)
 
 
 def _read_grid(group: h5py.Group) -> LinearGrid:
     def lines(kind: str) -> tuple[np.ndarray, ...]:
         found = group.get(kind, {})
-        return tuple(found[k][()] for k in sorted(found, key=lambda k: int(k.split("_")[1])))
+        return tuple(found[k][()] for k in _members(found, _number))
 
     return LinearGrid(_text(group.attrs["x_parameter"]), _text(group.attrs["y_parameter"]),
                       _text(group["x"].attrs["units"]), _text(group["y"].attrs["units"]),
@@ -244,24 +258,26 @@ def _image(result: StudyResult) -> bytes:
         handle.attrs["study_name"] = result.study_name
         handle.attrs["model"] = result.model
         for continuation in result.continuations:
-            group = handle.create_group(f"continuations/{continuation.name}")
+            group = _collection(handle, "continuations").create_group(continuation.name)
             group.attrs["kind"] = continuation.kind
             n_states = len(continuation.branches[0].state_names) if continuation.branches \
                 else 0
             for branch in continuation.branches:
-                _write_branch(group.create_group(f"branches/{branch.name}"), branch)
+                _write_branch(_collection(group, "branches").create_group(branch.name), branch)
             _write_special_points(group.create_group("special_points"),
                                   continuation.special_points, n_states)
             if continuation.cross_checks:
                 _write_cross_checks(group.create_group("cross_checks"),
                                     continuation.cross_checks)
         for sweep in result.linear_sweeps:
-            _write_sweep(handle.create_group(f"linear/sweeps/{sweep.parameter}"), sweep)
+            _write_sweep(_collection(handle.require_group("linear"), "sweeps").create_group(
+                sweep.parameter), sweep)
         if result.linear_grid is not None:
             _write_grid(handle.create_group("linear/grid"), result.linear_grid)
         for boundary in result.boundaries:
-            _write_boundary(handle.create_group(f"boundaries/{boundary.name}"), boundary)
-        runs = handle.create_group("runs")
+            _write_boundary(_collection(handle, "boundaries").create_group(boundary.name),
+                            boundary)
+        runs = _collection(handle, "runs")
         for record in result.runs:
             runs.create_group(record.name).attrs.update(
                 status=record.status, message=record.message, constants=record.constants,
@@ -359,13 +375,27 @@ def _texts(values) -> tuple[str, ...]:
     return tuple(_text(v) for v in values)
 
 
+def _members(group, old_order=None) -> list[str]:
+    """Names of the members of ``group`` in the order they were written (files since whirl
+    tracks it, see :func:`_collection`); in older files by name, or sorted by ``old_order``."""
+    names = list(group)  # h5py lists by creation order where it is tracked, else by name
+    tracked = isinstance(group, h5py.Group) and \
+        group.id.get_create_plist().get_link_creation_order() & h5py.h5p.CRT_ORDER_TRACKED
+    return names if tracked or old_order is None else sorted(names, key=old_order)
+
+
+def _number(name: str) -> int:
+    """The number ending a member name: ``polygon_12`` -> 12."""
+    return int(name.rsplit("_", 1)[-1])
+
+
 def _read_branch(name: str, group: h5py.Group) -> Branch:
     params = group["parameters"]
     kind = _text(group.attrs["kind"])
     key = "floquet_multipliers" if kind == BranchKind.PERIODIC else "eigenvalues"
     orbits = []
     if "orbits" in group:
-        for label in sorted(group["orbits"], key=int):
+        for label in _members(group["orbits"], int):
             sub = group["orbits"][label]
             orbits.append(Orbit(int(label), int(sub.attrs["point_type"]),
                                 int(sub.attrs["index"]), np.asarray(sub.attrs["parameters"]),
@@ -460,7 +490,7 @@ def read(path: Path) -> StudyResult:
                               f"(found {schema})")
         continuations = []
         for name, group in handle.get("continuations", {}).items():
-            branches = tuple(_read_branch(b, g) for b, g in group["branches"].items())
+            branches = tuple(_read_branch(b, g) for b, g in group.get("branches", {}).items())
             checks = _read_cross_checks(group["cross_checks"]) if "cross_checks" in group \
                 else ()
             continuations.append(ContinuationResult(
