@@ -252,6 +252,9 @@ def read_branch(outcome: RunOutcome, model: Model, *, name: str, kind: str, orig
         eigen = eigen * model.time_scale  # AUTO's eigenvalues are per unit tau
     on_locus = kind not in (BranchKind.EQUILIBRIUM, BranchKind.PERIODIC)
     parameters = np.column_stack([segment.column(p) for p in parameter_names])
+    # AUTO's flag (the sign of PT) is a verdict only where it had eigenvalues/multipliers:
+    # at the first point of a family from a Hopf point it prints none, yet flags "unstable"
+    known = ~np.isnan(eigen).all(axis=1) & (not on_locus)
     return Branch(
         name=name,
         kind=kind,
@@ -273,6 +276,7 @@ def read_branch(outcome: RunOutcome, model: Model, *, name: str, kind: str, orig
         message=outcome.message,
         run=outcome.name,
         orbits=read_orbits(outcome, model, segment, parameter_names) if periodic else (),
+        stability_known=known,
     )
 
 
@@ -347,7 +351,8 @@ def head(branch: Branch, rows: int) -> Branch:
     """The first ``rows`` points of ``branch`` (with the orbits stored on them)."""
     return replace(branch, **{key: getattr(branch, key)[:rows] for key in (
         "parameters", "state_max", "state_min", "l2_norm", "period", "stable", "point_type",
-        "label", "eigenvalues")}, orbits=tuple(o for o in branch.orbits if o.index < rows))
+        "label", "eigenvalues", "stability_known")},
+        orbits=tuple(o for o in branch.orbits if o.index < rows))
 
 
 def join(first: Branch, second: Branch, name: str) -> Branch:
@@ -356,7 +361,7 @@ def join(first: Branch, second: Branch, name: str) -> Branch:
     shift = len(first)
     stacked = {key: np.concatenate([getattr(first, key), getattr(second, key)[1:]])
                for key in ("parameters", "state_max", "state_min", "l2_norm", "period", "stable",
-                           "point_type", "label", "eigenvalues")}
+                           "point_type", "label", "eigenvalues", "stability_known")}
     moved = tuple(replace(o, index=o.index + shift - 1) for o in second.orbits if o.index > 0)
     return replace(first, name=name, status=second.status, message=second.message,
                    run=f"{first.run}+{second.run}", orbits=first.orbits + moved, **stacked)

@@ -17,7 +17,8 @@ on other machines. Point indices, step counts and provenance are not compared; i
   into stretches where the principal parameter is monotone, and ``state_max``/``state_min``
   of both files are interpolated onto common parameter values of each stretch (tolerance
   ``branch_state``); stability is compared on the same values, ignoring the cells around
-  special points where the flag legitimately flips between neighbouring points;
+  special points where the flag legitimately flips between neighbouring points, and points
+  whose stability is unknown (``Branch.stability_known``);
 * **linear sweeps** directly (relative ``linear``);
 * **boundaries** (``/boundaries``, curves in two parameters), when present, by the distance of
   every point of one curve to the polyline of the other, in axes scaled by their span;
@@ -409,6 +410,7 @@ class _Piece:
     low: np.ndarray  # (m, n) state_min
     stable: np.ndarray  # (m,) bool
     special: np.ndarray  # parameter values of special points on the stretch
+    known: np.ndarray  # (m,) bool: the stability is known (Branch.stability_known)
 
     @classmethod
     def of(cls, branch: Branch, rows: np.ndarray) -> _Piece:
@@ -417,7 +419,8 @@ class _Piece:
         rows = rows[order]
         special = np.array([_is_special(int(t)) for t in branch.point_type[rows]], dtype=bool)
         return cls(x[order], branch.state_max[rows], branch.state_min[rows],
-                   branch.stable[rows].astype(bool), x[order][special])
+                   branch.stable[rows].astype(bool), x[order][special],
+                   branch.stability_known[rows].astype(bool))
 
     def cell(self, at: np.ndarray) -> np.ndarray:
         """Width of the cell (interval between neighbouring points) containing each ``at``."""
@@ -427,12 +430,19 @@ class _Piece:
         return self.x[k + 1] - self.x[k]
 
     def stability(self, at: np.ndarray) -> np.ndarray:
-        """1 stable, 0 unstable, -1 undefined (the cell's two ends disagree)."""
+        """1 stable, 0 unstable, -1 undefined: the two ends of the cell disagree, or ``at``
+        lies outside the points of known stability (points of unknown stability are skipped:
+        the cells are those between the known ones)."""
         if len(self.x) < 2:
-            return np.full(len(at), int(self.stable[0]) if len(self.stable) else -1)
-        k = np.clip(np.searchsorted(self.x, at, side="right") - 1, 0, len(self.x) - 2)
-        left, right = self.stable[k], self.stable[k + 1]
-        return np.where(left == right, left.astype(int), -1)
+            single = len(self.stable) and self.known[0]
+            return np.full(len(at), int(self.stable[0]) if single else -1)
+        x, stable = self.x[self.known], self.stable[self.known]
+        if len(x) < 2:
+            return np.full(len(at), -1)
+        k = np.clip(np.searchsorted(x, at, side="right") - 1, 0, len(x) - 2)
+        left, right = stable[k], stable[k + 1]
+        inside = (at >= x[0]) & (at <= x[-1])
+        return np.where(inside & (left == right), left.astype(int), -1)
 
 
 def _is_special(code: int) -> bool:

@@ -8,7 +8,9 @@ Layout (units in a ``units`` attribute on every physical dataset)::
         branches/<branch>/          attrs: kind, origin, status, message, run
             parameters   (N, P)     attrs: names, units
             state_max, state_min (N, n)  attrs: names, units
-            l2_norm (N,) ; period (N,) [s] ; stable (N,) bool
+            l2_norm (N,) ; period (N,) [s] ; stable (N,) bool (AUTO's flag) ;
+            stability_known (N,) bool (False: no eigenvalues/multipliers, or a locus;
+                                       absent in older files: all known)
             point_type (N,) int (whirl PointType = AUTO TY codes) ; label (N,) int
             eigenvalues (N, n) complex [1/s]   (equilibria)  or
             floquet_multipliers (N, n) complex (periodic orbits)
@@ -98,6 +100,7 @@ def _write_branch(group: h5py.Group, branch: Branch) -> None:
     group.create_dataset("l2_norm", data=branch.l2_norm).attrs["units"] = "1"
     group.create_dataset("period", data=branch.period).attrs["units"] = "s"
     group.create_dataset("stable", data=branch.stable.astype(bool))
+    group.create_dataset("stability_known", data=branch.stability_known.astype(bool))
     group.create_dataset("point_type", data=branch.point_type.astype(np.int64))
     group.create_dataset("label", data=branch.label.astype(np.int64))
     if branch.is_periodic:
@@ -410,6 +413,8 @@ def _read_branch(name: str, group: h5py.Group) -> Branch:
         parameters=params[()], state_max=group["state_max"][()],
         state_min=group["state_min"][()], l2_norm=group["l2_norm"][()],
         period=group["period"][()], stable=group["stable"][()].astype(bool),
+        stability_known=group["stability_known"][()].astype(bool)
+        if "stability_known" in group else None,  # files from before: known everywhere
         point_type=group["point_type"][()], label=group["label"][()],
         eigenvalues=group[key][()], status=_text(group.attrs["status"]),
         message=_text(group.attrs["message"]), run=_text(group.attrs["run"]),
