@@ -40,7 +40,8 @@ keeps the order of the study and its results; older files list (and read) by nam
 
 The file is built in memory, written to an unnamed file in the output directory (O_TMPFILE)
 and linked into place, so an output path never holds a partial file and an interrupted write
-(even SIGKILL) leaves no temporary file; an existing file is only replaced with ``overwrite``.
+(even SIGKILL) leaves no temporary file; an existing file is only replaced with ``overwrite``
+(removed, then the new one linked: see :func:`_link_unnamed` for the trade-off).
 """
 
 from __future__ import annotations
@@ -228,8 +229,10 @@ def write(result: StudyResult, path: Path, overwrite: bool = False) -> Path:
     The file is built in memory and appears at ``path`` complete or not at all: it is written to
     an unnamed file in the output directory (Linux ``O_TMPFILE``) and linked into place, so even
     SIGKILL leaves no partial file and no temporary file behind. Without ``overwrite`` the link
-    fails if ``path`` exists (also if it appeared meanwhile); with it, the new file is renamed
-    over the old one. Where ``O_TMPFILE`` is unavailable a hidden named temporary is used.
+    fails if ``path`` exists (also if it appeared meanwhile); with it, the old file is removed
+    and the new one linked in its place (a SIGKILL in between leaves neither, see
+    :func:`_link_unnamed`). Where ``O_TMPFILE`` is unavailable a hidden named temporary is
+    written and renamed into place (a SIGKILL before the rename leaves it).
     """
     path = Path(path)
     if path.exists() and not overwrite:
@@ -327,22 +330,34 @@ def _exists_error(path: Path) -> OutputError:
     return OutputError(f"{path}: output exists; pass --overwrite to replace it")
 
 
+#: How often an overwriting write removes a file another writer put in its place meanwhile.
+_REPLACE_ATTEMPTS = 100
+
+
 def _link_unnamed(fd: int, path: Path, overwrite: bool, directory: int) -> None:
-    """Give the O_TMPFILE file ``fd`` the name ``path`` (through /proc/self/fd)."""
+    """Give the O_TMPFILE file ``fd`` the name ``path`` (linked through /proc/self/fd).
+
+    Without ``overwrite`` the link fails if ``path`` exists. With it, an existing file is
+    removed and the unnamed one linked in its place, again if another writer's file appeared
+    in between. A link cannot replace a name, and a rename needs the new file to have a name
+    first: a named temporary, which SIGKILL before the rename would leave behind. The
+    trade-off: for the microseconds between the unlink and the link no file is at ``path``
+    (a reader may find none, and a SIGKILL exactly then leaves neither the old file nor the
+    new one), but there is never a partial or a temporary file.
+    """
     source = f"/proc/self/fd/{fd}"
-    if not overwrite:
+    for _ in range(_REPLACE_ATTEMPTS):
         try:
             os.link(source, path.name, dst_dir_fd=directory, follow_symlinks=True)
+            return
         except FileExistsError:
-            raise _exists_error(path) from None
-        return
-    temporary = f".{path.name}.tmp-{os.getpid()}"
-    os.link(source, temporary, dst_dir_fd=directory, follow_symlinks=True)
-    try:
-        os.replace(temporary, path.name, src_dir_fd=directory, dst_dir_fd=directory)
-    except BaseException:
-        os.unlink(temporary, dir_fd=directory)
-        raise
+            if not overwrite:
+                raise _exists_error(path) from None
+        try:
+            os.unlink(path.name, dir_fd=directory)
+        except FileNotFoundError:  # another writer removed it first
+            pass
+    raise OutputError(f"{path}: not replaced: other processes keep writing it")
 
 
 def _publish_named(image: bytes, path: Path, overwrite: bool, directory: int) -> None:
