@@ -6,11 +6,16 @@ between removing the old file and linking the new one, the documented trade-off 
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import textwrap
 
+import pytest
+
 from whirl_cli import store
+from whirl_cli.errors import OutputError
+from whirl_cli.results import StudyResult
 
 CHILD = textwrap.dedent("""
     import os, signal, sys
@@ -68,3 +73,35 @@ def test_sigkill_before_any_step_of_an_overwrite_leaves_old_new_or_nothing(tmp_p
     assert calls[removal + 1] == "link" and "replace" not in calls, calls
     assert outcomes == ["old"] * (removal + 1) + ["none"] + ["new"] * (k - removal - 2), \
         list(zip(calls, outcomes, strict=False))
+
+
+def small_result() -> StudyResult:
+    return StudyResult(study_name="mine", model="m", continuations=(), linear_sweeps=(),
+                       runs=(), attributes={"study_yaml": "name: mine\n"})
+
+
+def test_an_overwrite_replaces_a_file_another_writer_links_in_between(tmp_path, monkeypatch):
+    path = tmp_path / "r.h5"
+    path.write_bytes(b"old")
+    real_unlink, removed = os.unlink, []
+
+    def unlink(name, *args, **kwargs):  # another writer links its file right after ours went
+        real_unlink(name, *args, **kwargs)
+        removed.append(name)
+        if len(removed) < 3:
+            path.write_bytes(b"another writer's")
+    monkeypatch.setattr(store.os, "unlink", unlink)
+    store.write(small_result(), path, overwrite=True)
+    assert removed == ["r.h5"] * 3
+    assert store.read(path).study_name == "mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.h5"]
+
+    # a writer that keeps losing the race gives up with a message, leaving the other's file
+    def always(name, *args, **kwargs):
+        real_unlink(name, *args, **kwargs)
+        path.write_bytes(b"another writer's")
+    monkeypatch.setattr(store.os, "unlink", always)
+    with pytest.raises(OutputError, match="r.h5: not replaced: other processes keep writing"):
+        store.write(small_result(), path, overwrite=True)
+    assert path.read_bytes() == b"another writer's"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.h5"]
