@@ -133,7 +133,8 @@ def unsafe_from_branches(branches: tuple[Branch, ...], stable: list[Interval], v
         if not len(branch):
             continue
         extent = (float(branch.parameters[:, 0].min()), float(branch.parameters[:, 0].max()))
-        if branch.kind == BranchKind.PERIODIC and branch.stable[1:-1].any():
+        if branch.kind == BranchKind.PERIODIC and (branch.stable
+                                                   & branch.stability_known)[1:-1].any():
             flutter.append(extent)
         elif (branch.kind == BranchKind.EQUILIBRIUM and branch.origin.startswith("BP at")
               and np.any(branch.point_type == 2)):

@@ -228,6 +228,14 @@ def read_branch(outcome: RunOutcome, model: Model, *, name: str, kind: str, orig
     """The branch one AUTO run wrote, in SI units (see :mod:`whirl_cli.results`)."""
     segments = parse_b(outcome.file("b").read_text(errors="replace"))
     segment = segments[0] if len(segments) == 1 else _concatenate(segments)
+    needed = [*parameter_names, "L2-NORM",
+              *(f"{m}_{s}" for m in ("max", "min") for s in model.state_names)]
+    missing = [c for c in needed if c not in segment.columns]
+    if missing:
+        return _unreadable_branch(outcome, model, name, kind, origin, parameter_names,
+                                  f"AUTO's b-file lacks column(s) {', '.join(missing)}"
+                                  + (f" in some of its {len(segments)} segments"
+                                     if len(segments) > 1 else ""))
     scale = np.asarray(model.state_scale, dtype=float)
     n = model.n_states
     state_max = np.column_stack([segment.column(f"max_{s}") for s in model.state_names]) * scale
@@ -244,6 +252,9 @@ def read_branch(outcome: RunOutcome, model: Model, *, name: str, kind: str, orig
         eigen = eigen * model.time_scale  # AUTO's eigenvalues are per unit tau
     on_locus = kind not in (BranchKind.EQUILIBRIUM, BranchKind.PERIODIC)
     parameters = np.column_stack([segment.column(p) for p in parameter_names])
+    # AUTO's flag (the sign of PT) is a verdict only where it had eigenvalues/multipliers:
+    # at the first point of a family from a Hopf point it prints none, yet flags "unstable"
+    known = ~np.isnan(eigen).all(axis=1) & (not on_locus)
     return Branch(
         name=name,
         kind=kind,
@@ -265,7 +276,23 @@ def read_branch(outcome: RunOutcome, model: Model, *, name: str, kind: str, orig
         message=outcome.message,
         run=outcome.name,
         orbits=read_orbits(outcome, model, segment, parameter_names) if periodic else (),
+        stability_known=known,
     )
+
+
+def _unreadable_branch(outcome: RunOutcome, model: Model, name: str, kind: str, origin: str,
+                       parameter_names: tuple[str, ...], message: str) -> Branch:
+    """An empty branch with status "error": AUTO's output lacks what whirl reads."""
+    n, p = model.n_states, len(parameter_names)
+    return Branch(
+        name=name, kind=kind, origin=origin, parameter_names=tuple(parameter_names),
+        parameter_units=tuple(model.parameter(x).unit for x in parameter_names),
+        state_names=model.state_names, state_units=tuple(s.unit for s in model.states),
+        parameters=np.empty((0, p)), state_max=np.empty((0, n)), state_min=np.empty((0, n)),
+        l2_norm=np.empty(0), period=np.empty(0), stable=np.empty(0, dtype=bool),
+        point_type=np.empty(0, dtype=np.int64), label=np.empty(0, dtype=np.int64),
+        eigenvalues=np.empty((0, n), dtype=complex), status="error", message=message,
+        run=outcome.name)
 
 
 def _hopf_periods(outcome: RunOutcome, segment: BSegment) -> np.ndarray:
@@ -307,18 +334,25 @@ def read_orbits(outcome: RunOutcome, model: Model, segment: BSegment,
 
 
 def _concatenate(segments: list[BSegment]) -> BSegment:
+    """The rows of every segment of a b-file, in file order, with the columns all segments
+    have (by name, in the first segment's order). No row is dropped: a column only some
+    segments print is left out, and :func:`read_branch` fails the branch with a message if it
+    needed that column."""
     first = segments[0]
-    same = [s for s in segments if s.columns == first.columns]
-    return BSegment(first.columns, first.active,
-                    *(np.concatenate([getattr(s, f) for s in same]) for f in
-                      ("br", "pt", "ty", "lab", "values")))
+    shared = tuple(c for c in first.columns if all(c in s.columns for s in segments[1:]))
+    values = [s.values[:, [s.columns.index(c) for c in shared]] for s in segments]
+    return BSegment(shared, first.active,
+                    *(np.concatenate([getattr(s, f) for s in segments]) for f in
+                      ("br", "pt", "ty", "lab")),
+                    np.concatenate(values).reshape(-1, len(shared)))
 
 
 def head(branch: Branch, rows: int) -> Branch:
     """The first ``rows`` points of ``branch`` (with the orbits stored on them)."""
     return replace(branch, **{key: getattr(branch, key)[:rows] for key in (
         "parameters", "state_max", "state_min", "l2_norm", "period", "stable", "point_type",
-        "label", "eigenvalues")}, orbits=tuple(o for o in branch.orbits if o.index < rows))
+        "label", "eigenvalues", "stability_known")},
+        orbits=tuple(o for o in branch.orbits if o.index < rows))
 
 
 def join(first: Branch, second: Branch, name: str) -> Branch:
@@ -327,7 +361,7 @@ def join(first: Branch, second: Branch, name: str) -> Branch:
     shift = len(first)
     stacked = {key: np.concatenate([getattr(first, key), getattr(second, key)[1:]])
                for key in ("parameters", "state_max", "state_min", "l2_norm", "period", "stable",
-                           "point_type", "label", "eigenvalues")}
+                           "point_type", "label", "eigenvalues", "stability_known")}
     moved = tuple(replace(o, index=o.index + shift - 1) for o in second.orbits if o.index > 0)
     return replace(first, name=name, status=second.status, message=second.message,
                    run=f"{first.run}+{second.run}", orbits=first.orbits + moved, **stacked)

@@ -122,13 +122,22 @@ def check(result_file: Path) -> None:
     result = store.read(result_file)
     study = validate_text(str(result.attributes.get("study_yaml", "")), result_file.name)
     model, parameters = study.variant(), study.parameter_values()
+    unit = model.states[model.state_names.index(model.dof)].unit
+
+    def compared(x) -> str:  # what expected and simulated are (results.CrossCheck)
+        if x.kind == "equilibrium":
+            return (f"perturbation {x.expected:.6g} rad, final deviation {x.simulated:.6g} "
+                    "rad")
+        return f"max {model.dof} AUTO {x.expected:.6g} {unit}, simulation {x.simulated:.6g} " \
+            f"{unit}"
+
     wrong = 0
     for continuation in result.continuations:
         for x in simulate.cross_check(model, parameters, continuation.branches):
             mark = "ok  " if x.passed else "FAIL"
             click.echo(f"{mark} {continuation.name}/{x.branch}[{x.index}] {x.kind:<11} "
                        f"{continuation.branches[0].parameter_names[0]} = {x.parameter:.6g}: "
-                       f"AUTO {x.expected:.6g}, simulation {x.simulated:.6g}")
+                       f"{compared(x)}")
             wrong += not x.passed
     if wrong:
         raise WhirlError(f"{wrong} cross-check(s) failed")
@@ -193,7 +202,11 @@ def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None) -> 
 
     result = store.read(result_file)
     output_dir = output_dir or result_file.parent
-    output_dir.mkdir(parents=True, exist_ok=True)
+    try:
+        output_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise OutputError(f"{output_dir}: cannot create the output directory "
+                          f"({error.strerror or error})") from None
     kinds = kinds or ("bifurcation", "linear", "period", "boundary")
     for path in save_study_plots(result, kinds, output_dir, result_file.stem):
         click.echo(f"wrote {path}")
@@ -286,17 +299,24 @@ def sweep(paths: tuple[Path, ...], out_dir: Path, jobs: int, dask_address: str |
                    "[default: 1e-6, 1e-5].")
 @click.option("--limit", type=click.IntRange(1), default=20, show_default=True,
               help="Differences printed at most.")
+@click.option("--strict", is_flag=True,
+              help="Count differences of the study text and its hash (study_yaml, "
+                   "study_sha256) as drift [default: print them as notes].")
 def compare(file_a: Path, file_b: Path, rtol: float | None, atol: float | None,
-            limit: int) -> None:
+            limit: int, strict: bool) -> None:
     """Compare two result files on physics (special points, branches along the parameter,
     stability, linear sweeps, boundaries), not point indices. Exit 1 on drift."""
-    from .compare import Tolerances, compare_files
+    from .compare import Tolerances
+    from .compare import compare as compare_results
 
-    differences = compare_files(file_a, file_b, Tolerances.from_options(rtol, atol))
+    found = compare_results(file_a, file_b, Tolerances.from_options(rtol, atol), strict)
+    differences = found.differences
     for difference in differences[:limit]:
         click.echo(str(difference))
     if len(differences) > limit:
         click.echo(f"... and {len(differences) - limit} more")
+    for note in found.notes:
+        click.echo(f"note: {note}")
     if differences:
         raise WhirlError(f"{file_a} and {file_b} differ ({len(differences)} difference(s))")
     click.echo(f"{file_a} and {file_b} agree")

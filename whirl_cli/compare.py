@@ -3,8 +3,11 @@
 ``whirl compare A.h5 B.h5`` is the drift check of CI (``tests/regression``) and of sweeps run
 on other machines. Point indices, step counts and provenance are not compared; instead:
 
-* **root**: study name, model, study text and hash (``created``, ``git_describe``,
-  ``whirl_version``, ``auto_version`` are ignored: they legitimately change);
+* **root**: study name and model (``created``, ``git_describe``, ``whirl_version``,
+  ``auto_version`` are ignored: they legitimately change). The study text and its hash
+  (``study_yaml``, ``study_sha256``) are provenance: a difference there (a comment, the plots
+  asked for, a timeout) is reported as a note, not as drift, unless ``strict``; what the
+  study changes in the physics shows up in the results themselves;
 * **special points** of each continuation, matched by (type, kind of their branch) with an
   optimal assignment on parameter and state, then compared on the parameter values (tolerance
   ``parameter`` x the span of that parameter over the continuation), the state (``state``, SI
@@ -14,7 +17,8 @@ on other machines. Point indices, step counts and provenance are not compared; i
   into stretches where the principal parameter is monotone, and ``state_max``/``state_min``
   of both files are interpolated onto common parameter values of each stretch (tolerance
   ``branch_state``); stability is compared on the same values, ignoring the cells around
-  special points where the flag legitimately flips between neighbouring points;
+  special points where the flag legitimately flips between neighbouring points, and points
+  whose stability is unknown (``Branch.stability_known``);
 * **linear sweeps** directly (relative ``linear``);
 * **boundaries** (``/boundaries``, curves in two parameters), when present, by the distance of
   every point of one curve to the polyline of the other, in axes scaled by their span;
@@ -26,7 +30,7 @@ Files are read with :func:`whirl_cli.store.read`; ``/boundaries`` (not part of
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import h5py
@@ -38,6 +42,9 @@ from .results import Branch, ContinuationResult, LinearSweep, PointType, Special
 #: Root attributes that change from run to run without any physical meaning.
 IGNORED_ATTRIBUTES = frozenset({"created", "git_describe", "whirl_version", "whirl_code_sha256",
                                 "auto_version", "plots"})
+#: Root attributes that say where a result came from: differences are notes, drift only when
+#: comparing ``strict``ly. (``study_name`` and ``model`` say what was computed: always drift.)
+PROVENANCE_ATTRIBUTES = frozenset({"study_yaml", "study_sha256"})
 
 
 @dataclass(frozen=True)
@@ -86,20 +93,40 @@ class Difference:
         return f"{self.path}: {self.a} vs {self.b}" + (f"  ({self.note})" if self.note else "")
 
 
+@dataclass(frozen=True)
+class Comparison:
+    """What :func:`compare` found: ``differences`` (drift) and ``notes`` (differences of
+    provenance, :data:`PROVENANCE_ATTRIBUTES`, that are not drift; empty when ``strict``)."""
+
+    differences: list[Difference]
+    notes: list[Difference]
+
+
 # ------------------------------------------------------------------------------ entry points
-def compare_files(a: Path, b: Path, tolerances: Tolerances | None = None) -> list[Difference]:
-    """All differences between the result files ``a`` and ``b`` (empty: they agree)."""
+def compare(a: Path, b: Path, tolerances: Tolerances | None = None, strict: bool = False
+            ) -> Comparison:
+    """Drift and provenance notes between the result files ``a`` and ``b``; with ``strict``
+    a difference of study text or hash is drift too."""
     tolerances = tolerances or Tolerances()
-    differences = compare_results(store.read(a), store.read(b), tolerances)
+    result_a, result_b = store.read(a), store.read(b)
+    differences = compare_results(result_a, result_b, tolerances, strict)
     differences += compare_boundaries(a, b, tolerances)
-    return differences
+    return Comparison(differences, [] if strict else provenance_notes(result_a, result_b))
 
 
-def compare_results(a: StudyResult, b: StudyResult, tolerances: Tolerances | None = None
-                    ) -> list[Difference]:
-    """Differences between two results in memory (everything but ``/boundaries``)."""
+def compare_files(a: Path, b: Path, tolerances: Tolerances | None = None, strict: bool = False
+                  ) -> list[Difference]:
+    """All drift between the result files ``a`` and ``b`` (empty: they agree)."""
+    return compare(a, b, tolerances, strict).differences
+
+
+def compare_results(a: StudyResult, b: StudyResult, tolerances: Tolerances | None = None,
+                    strict: bool = False) -> list[Difference]:
+    """Drift between two results in memory (everything but ``/boundaries``); study text and
+    hash count only if ``strict`` (else see :func:`provenance_notes`)."""
     tolerances = tolerances or Tolerances()
-    found = _compare_root(a, b)
+    found = _compare_root(a, b, IGNORED_ATTRIBUTES if strict
+                          else IGNORED_ATTRIBUTES | PROVENANCE_ATTRIBUTES)
     found += _compare_named(
         "/continuations", {c.name: c for c in a.continuations},
         {c.name: c for c in b.continuations},
@@ -125,15 +152,37 @@ def _compare_named(prefix: str, a: dict, b: dict, compare) -> list[Difference]:
     return found
 
 
-def _compare_root(a: StudyResult, b: StudyResult) -> list[Difference]:
+def _compare_root(a: StudyResult, b: StudyResult, skip: frozenset[str]) -> list[Difference]:
     found = []
     pairs = {"study_name": (a.study_name, b.study_name), "model": (a.model, b.model)}
-    for key in sorted((set(a.attributes) | set(b.attributes)) - IGNORED_ATTRIBUTES):
+    for key in sorted((set(a.attributes) | set(b.attributes)) - skip):
         pairs[key] = (a.attributes.get(key, "<missing>"), b.attributes.get(key, "<missing>"))
     for key, (x, y) in pairs.items():
         if str(x) != str(y):
-            found.append(Difference(f"/@{key}", _short(x), _short(y), "root attribute"))
+            shown = _first_different_line(x, y) if key == "study_yaml" and isinstance(
+                x, str) and isinstance(y, str) else (_short(x), _short(y))
+            found.append(Difference(f"/@{key}", *shown, "root attribute"))
     return found
+
+
+def provenance_notes(a: StudyResult, b: StudyResult) -> list[Difference]:
+    """Differences of study text and hash (:data:`PROVENANCE_ATTRIBUTES`): not drift."""
+    paths = {f"/@{key}" for key in PROVENANCE_ATTRIBUTES}
+    return [replace(d, note="provenance, not drift; --strict counts it")
+            for d in _compare_root(a, b, IGNORED_ATTRIBUTES) if d.path in paths]
+
+
+def _first_different_line(x: str, y: str) -> tuple[str, str]:
+    """The first line where two texts differ, as ``line <k>: <text>`` (``<end>`` past the
+    last line of the shorter text)."""
+    lines_x, lines_y = x.splitlines(), y.splitlines()
+    k = next((k for k, (p, q) in enumerate(zip(lines_x, lines_y, strict=False)) if p != q),
+             min(len(lines_x), len(lines_y)))
+
+    def line(lines: list[str]) -> str:
+        return f"line {k + 1}: " + (_short(lines[k]) if k < len(lines) else "<end>")
+
+    return line(lines_x), line(lines_y)
 
 
 def _short(value, limit: int = 60) -> str:
@@ -362,6 +411,7 @@ class _Piece:
     low: np.ndarray  # (m, n) state_min
     stable: np.ndarray  # (m,) bool
     special: np.ndarray  # parameter values of special points on the stretch
+    known: np.ndarray  # (m,) bool: the stability is known (Branch.stability_known)
 
     @classmethod
     def of(cls, branch: Branch, rows: np.ndarray) -> _Piece:
@@ -370,7 +420,8 @@ class _Piece:
         rows = rows[order]
         special = np.array([_is_special(int(t)) for t in branch.point_type[rows]], dtype=bool)
         return cls(x[order], branch.state_max[rows], branch.state_min[rows],
-                   branch.stable[rows].astype(bool), x[order][special])
+                   branch.stable[rows].astype(bool), x[order][special],
+                   branch.stability_known[rows].astype(bool))
 
     def cell(self, at: np.ndarray) -> np.ndarray:
         """Width of the cell (interval between neighbouring points) containing each ``at``."""
@@ -380,12 +431,19 @@ class _Piece:
         return self.x[k + 1] - self.x[k]
 
     def stability(self, at: np.ndarray) -> np.ndarray:
-        """1 stable, 0 unstable, -1 undefined (the cell's two ends disagree)."""
+        """1 stable, 0 unstable, -1 undefined: the two ends of the cell disagree, or ``at``
+        lies outside the points of known stability (points of unknown stability are skipped:
+        the cells are those between the known ones)."""
         if len(self.x) < 2:
-            return np.full(len(at), int(self.stable[0]) if len(self.stable) else -1)
-        k = np.clip(np.searchsorted(self.x, at, side="right") - 1, 0, len(self.x) - 2)
-        left, right = self.stable[k], self.stable[k + 1]
-        return np.where(left == right, left.astype(int), -1)
+            single = len(self.stable) and self.known[0]
+            return np.full(len(at), int(self.stable[0]) if single else -1)
+        x, stable = self.x[self.known], self.stable[self.known]
+        if len(x) < 2:
+            return np.full(len(at), -1)
+        k = np.clip(np.searchsorted(x, at, side="right") - 1, 0, len(x) - 2)
+        left, right = stable[k], stable[k + 1]
+        inside = (at >= x[0]) & (at <= x[-1])
+        return np.where(inside & (left == right), left.astype(int), -1)
 
 
 def _is_special(code: int) -> bool:
@@ -595,7 +653,7 @@ def _datasets(path: Path, roots: tuple[str, ...]) -> dict[str, np.ndarray]:
                               for v in value.ravel()]).reshape(value.shape)
         return value
 
-    with h5py.File(path, "r") as handle:
+    with store.opened(path) as handle:
         for root in roots:
             if root not in handle:
                 continue

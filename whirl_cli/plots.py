@@ -129,12 +129,17 @@ def branch_style(kind: str, stable: bool) -> str:
     return f"{'stable' if stable else 'unstable'}_{family}"
 
 
-def stability_segments(x: np.ndarray, y: np.ndarray, stable: np.ndarray
+def stability_segments(x: np.ndarray, y: np.ndarray, stable: np.ndarray,
+                       known: np.ndarray | None = None
                        ) -> list[tuple[np.ndarray, np.ndarray, bool]]:
     """Split a curve into runs of equal stability, ``[(x_i, y_i, stable_i), ...]`` in order.
 
     The first point of each new run (the switching point) also ends the previous run, so drawn
-    pieces join without gaps. Units are those of ``x`` and ``y``; empty input gives ``[]``.
+    pieces join without gaps. Points whose stability is not ``known`` (e.g. the first point of
+    a periodic family, where AUTO printed no multipliers) have none of their own: each joins
+    the run before it (leading ones the run after), so they never make a stub of their own;
+    with no point known, ``stable`` is drawn as it is. Units are those of ``x`` and ``y``;
+    empty input gives ``[]``.
     """
     x = np.asarray(x)
     y = np.asarray(y)
@@ -144,6 +149,15 @@ def stability_segments(x: np.ndarray, y: np.ndarray, stable: np.ndarray
                          f"{x.shape}, {y.shape}, {stable.shape}")
     if len(x) == 0:
         return []
+    if known is not None and np.asarray(known, dtype=bool).any():
+        known = np.asarray(known, dtype=bool)
+        if known.shape != stable.shape:
+            raise ValueError(f"known must have the shape of stable {stable.shape}, got "
+                             f"{known.shape}")
+        # the stability of the nearest known point before (the first known one for leading
+        # unknown points)
+        last_known = np.maximum.accumulate(np.where(known, np.arange(len(x)), -1))
+        stable = stable[np.where(last_known >= 0, last_known, np.flatnonzero(known)[0])]
     starts = np.concatenate(([0], np.flatnonzero(stable[1:] != stable[:-1]) + 1))
     ends = np.append(starts[1:] + 1, len(x))  # inclusive of the next run's first point
     return [(x[a:b], y[a:b], bool(stable[a])) for a, b in zip(starts, ends, strict=True)]
@@ -269,7 +283,8 @@ def period_plot(continuation: ContinuationResult) -> Figure:
     first: dict[str, object] = {}
     for branch in periodic:
         x = branch.parameters[:, 0]
-        for xs, ys, stable in stability_segments(x, branch.period, branch.stable):
+        for xs, ys, stable in stability_segments(x, branch.period, branch.stable,
+                                                 branch.stability_known):
             _plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)
     periods = np.concatenate([b.period for b in periodic]) if periodic else np.array([])
     periods = periods[np.isfinite(periods) & (periods > 0)]
@@ -337,8 +352,9 @@ def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str = "t
 
     All of ``branch.orbits`` if ``labels`` is None, else those with these AUTO labels (in the
     order given). Each curve is closed (its first point repeated at the end unless already
-    equal), drawn solid if the branch is stable at the orbit's row and dotted if not, in the
-    default colour cycle, and labelled ``"<parameter> = <value> (stable|unstable)"`` with the
+    equal), drawn solid if the branch is stable at the orbit's row, dotted if not and dashed
+    where its stability is unknown, in the default colour cycle, and labelled
+    ``"<parameter> = <value> (stable|unstable|stability unknown)"`` with the
     principal parameter (4 significant digits). Angles in degrees, rates in deg/s unless
     ``degrees`` is False; equal aspect when both axes have the same unit. Draws on ``ax`` if
     given, else on a new figure; returns the figure. The title is the branch's name.
@@ -366,10 +382,11 @@ def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str = "t
         states = np.asarray(orbit.states, dtype=float)
         if len(states) and not np.array_equal(states[0], states[-1]):
             states = np.vstack([states, states[:1]])
-        stable = bool(branch.stable[orbit.index]) if 0 <= orbit.index < len(branch) else None
+        stable = bool(branch.stable[orbit.index]) if 0 <= orbit.index < len(branch) \
+            and branch.stability_known[orbit.index] else None
         status = {True: "stable", False: "unstable", None: "stability unknown"}[stable]
         ax.plot(states[:, ix] * fx, states[:, iy] * fy, color=colour,
-                linestyle="-" if stable else ":",
+                linestyle={True: "-", False: ":", None: "--"}[stable],
                 label=f"{branch.parameter_names[0]} = {orbit.parameters[0]:.4g} ({status})")
     ax.set_xlabel(axis_label(x, unit_x))
     ax.set_ylabel(axis_label(y, unit_y))
@@ -409,7 +426,8 @@ def _draw_branch(ax: Axes, branch: Branch, state: str, which: tuple[str, ...], d
     tables = [w for w in ("max", "min") if w in which] if branch.is_periodic else [which[0]]
     for table in tables:
         y = branch.state(state, table) * factor
-        for xs, ys, stable in stability_segments(x, y, branch.stable):
+        for xs, ys, stable in stability_segments(x, y, branch.stable,
+                                                 branch.stability_known):
             _plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)
 
 

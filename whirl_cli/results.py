@@ -109,7 +109,8 @@ class Branch:
     state_max, state_min : (N, n) max and min of each state over the orbit (equilibria: equal).
     l2_norm : (N,) AUTO's L2 norm of its (non-dimensional) solution.
     period : (N,) s, NaN for equilibria.
-    stable : (N,) bool, from AUTO's stability flag (False on loci, where it is undefined).
+    stable : (N,) bool, AUTO's stability flag (the sign of PT in its b-file); a verdict only
+        where ``stability_known``.
     point_type : (N,) int, :class:`PointType` codes; label : (N,) int AUTO label (0 = none).
     eigenvalues : (N, n) complex: Jacobian eigenvalues in 1/s for equilibria, Floquet multipliers
         for periodic orbits (NaN where AUTO printed none).
@@ -117,6 +118,10 @@ class Branch:
     orbits : stored profiles of labelled solutions.
     end : why the branch ends (range, amplitude bound, return to a Hopf point, period blow-up,
         step limit, no convergence).
+    stability_known : (N,) bool, False where the stability is unknown: AUTO printed no (or only
+        NaN) eigenvalues or Floquet multipliers there (typically the first point of a periodic
+        family started at a Hopf point), and everywhere on loci, where it is undefined. None
+        (the default) means known everywhere.
     """
 
     name: str
@@ -140,6 +145,11 @@ class Branch:
     run: str = ""
     orbits: tuple[Orbit, ...] = field(default=())
     end: str = ""  # how the branch ends, e.g. "range", "returns to HB at K1 = 0.0807"
+    stability_known: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.stability_known is None:  # frozen: set through object
+            object.__setattr__(self, "stability_known", np.ones(len(self.stable), dtype=bool))
 
     def __len__(self) -> int:
         return len(self.point_type)

@@ -85,10 +85,11 @@ def check_equilibrium(model: Model, overrides: dict[str, float], branch: Branch,
 
 
 def _interior_stable(branch: Branch, index: int) -> bool:
-    """Stable, and so are both neighbours (away from bifurcations)."""
+    """Known to be stable, and so are both neighbours (away from bifurcations)."""
     lo, hi = max(index - 1, 0), min(index + 2, len(branch))
     special = branch.point_type[lo:hi]
-    return bool(branch.stable[lo:hi].all()) and not np.isin(
+    stable = branch.stable[lo:hi] & branch.stability_known[lo:hi]
+    return bool(stable.all()) and not np.isin(
         special, [PointType.LPC, PointType.BPC, PointType.PD, PointType.TR, PointType.HB,
                   PointType.BP, PointType.LP]).any()
 

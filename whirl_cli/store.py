@@ -8,7 +8,9 @@ Layout (units in a ``units`` attribute on every physical dataset)::
         branches/<branch>/          attrs: kind, origin, status, message, run
             parameters   (N, P)     attrs: names, units
             state_max, state_min (N, n)  attrs: names, units
-            l2_norm (N,) ; period (N,) [s] ; stable (N,) bool
+            l2_norm (N,) ; period (N,) [s] ; stable (N,) bool (AUTO's flag) ;
+            stability_known (N,) bool (False: no eigenvalues/multipliers, or a locus;
+                                       absent in older files: all known)
             point_type (N,) int (whirl PointType = AUTO TY codes) ; label (N,) int
             eigenvalues (N, n) complex [1/s]   (equilibria)  or
             floquet_multipliers (N, n) complex (periodic orbits)
@@ -32,14 +34,22 @@ Layout (units in a ``units`` attribute on every physical dataset)::
     /runs/<run>                     attrs: status, message, constants, returncode,
                                            wall_seconds, n_points
 
+The groups holding collections (continuations, branches, orbits, sweeps, boundaries, loci,
+polygons, contour lines, runs) track the creation order of their members, so a round trip
+keeps the order of the study and its results; older files list (and read) by name.
+
 The file is built in memory, written to an unnamed file in the output directory (O_TMPFILE)
 and linked into place, so an output path never holds a partial file and an interrupted write
-(even SIGKILL) leaves no temporary file; an existing file is only replaced with ``overwrite``.
+(even SIGKILL) leaves no temporary file; an existing file is only replaced with ``overwrite``
+(removed, then the new one linked: see :func:`_link_unnamed` for the trade-off).
 """
 
 from __future__ import annotations
 
 import os
+import re
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import h5py
@@ -69,6 +79,16 @@ def _strings(values) -> np.ndarray:
     return np.array([str(v) for v in values], dtype=object)
 
 
+def _collection(parent: h5py.Group, name: str) -> h5py.Group:
+    """The group ``name`` of ``parent`` that holds a collection (continuations, branches,
+    orbits, sweeps, boundaries, loci, runs, ...), created tracking the order in which its
+    members are written, so that :func:`read` returns them in that order; HDF5 lists them by
+    name otherwise (``periodic_10`` before ``periodic_2``)."""
+    if name in parent:
+        return parent[name]
+    return parent.create_group(name, track_order=True)
+
+
 def _write_branch(group: h5py.Group, branch: Branch) -> None:
     group.attrs.update(kind=branch.kind, origin=branch.origin, status=branch.status,
                        message=branch.message, run=branch.run, end=branch.end)
@@ -81,6 +101,7 @@ def _write_branch(group: h5py.Group, branch: Branch) -> None:
     group.create_dataset("l2_norm", data=branch.l2_norm).attrs["units"] = "1"
     group.create_dataset("period", data=branch.period).attrs["units"] = "s"
     group.create_dataset("stable", data=branch.stable.astype(bool))
+    group.create_dataset("stability_known", data=branch.stability_known.astype(bool))
     group.create_dataset("point_type", data=branch.point_type.astype(np.int64))
     group.create_dataset("label", data=branch.label.astype(np.int64))
     if branch.is_periodic:
@@ -88,7 +109,7 @@ def _write_branch(group: h5py.Group, branch: Branch) -> None:
     else:
         group.create_dataset("eigenvalues", data=branch.eigenvalues).attrs["units"] = "1/s"
     for orbit in branch.orbits:
-        sub = group.create_group(f"orbits/{orbit.label}")
+        sub = _collection(group, "orbits").create_group(str(orbit.label))
         sub.attrs.update(point_type=orbit.point_type, index=orbit.index, period=orbit.period,
                          parameters=orbit.parameters)
         sub.create_dataset("time", data=orbit.time).attrs["units"] = "s"
@@ -144,11 +165,11 @@ def _write_boundary(group: h5py.Group, boundary: Boundary) -> None:
     group.attrs.update(parameters=list(boundary.parameter_names),
                        units=list(boundary.parameter_units), method=boundary.method,
                        slices=np.array(boundary.slices, dtype=float))
-    for name, (kind, curve) in sorted(boundary.loci.items()):
-        data = group.create_dataset(f"loci/{name}", data=curve.reshape(-1, 2))
+    for name, (kind, curve) in boundary.loci.items():
+        data = _collection(group, "loci").create_dataset(name, data=curve.reshape(-1, 2))
         data.attrs["kind"] = kind
     for k, polygon in enumerate(boundary.polygons):
-        group.create_dataset(f"unsafe/polygon_{k}", data=polygon)
+        _collection(group, "unsafe").create_dataset(f"polygon_{k}", data=polygon)
     table = group.create_group("unsafe_intervals")
     rows = boundary.intervals
     for key in ("slice_value", "lower", "upper"):
@@ -159,8 +180,8 @@ def _write_boundary(group: h5py.Group, boundary: Boundary) -> None:
 def _read_boundary(name: str, group: h5py.Group) -> Boundary:
     loci = {key: (_text(data.attrs["kind"]), data[()])
             for key, data in group.get("loci", {}).items()}
-    polygons = tuple(group["unsafe"][key][()] for key in sorted(
-        group.get("unsafe", {}), key=lambda k: int(k.rsplit("_", 1)[1])))
+    polygons = tuple(group["unsafe"][key][()] for key in _members(group.get("unsafe", {}),
+                                                                   _number))
     table = group["unsafe_intervals"]
     intervals = tuple(
         UnsafeInterval(float(v), float(lo), float(hi), _text(c)) for v, lo, hi, c in zip(
@@ -179,13 +200,13 @@ def _write_grid(group: h5py.Group, grid: LinearGrid) -> None:
     group.create_dataset("oscillatory", data=grid.oscillatory)
     for kind in ("flutter", "divergence"):
         for k, line in enumerate(getattr(grid, kind)):
-            group.create_dataset(f"{kind}/line_{k}", data=line)
+            _collection(group, kind).create_dataset(f"line_{k}", data=line)
 
 
 def _read_grid(group: h5py.Group) -> LinearGrid:
     def lines(kind: str) -> tuple[np.ndarray, ...]:
         found = group.get(kind, {})
-        return tuple(found[k][()] for k in sorted(found, key=lambda k: int(k.split("_")[1])))
+        return tuple(found[k][()] for k in _members(found, _number))
 
     return LinearGrid(_text(group.attrs["x_parameter"]), _text(group.attrs["y_parameter"]),
                       _text(group["x"].attrs["units"]), _text(group["y"].attrs["units"]),
@@ -208,8 +229,10 @@ def write(result: StudyResult, path: Path, overwrite: bool = False) -> Path:
     The file is built in memory and appears at ``path`` complete or not at all: it is written to
     an unnamed file in the output directory (Linux ``O_TMPFILE``) and linked into place, so even
     SIGKILL leaves no partial file and no temporary file behind. Without ``overwrite`` the link
-    fails if ``path`` exists (also if it appeared meanwhile); with it, the new file is renamed
-    over the old one. Where ``O_TMPFILE`` is unavailable a hidden named temporary is used.
+    fails if ``path`` exists (also if it appeared meanwhile); with it, the old file is removed
+    and the new one linked in its place (a SIGKILL in between leaves neither, see
+    :func:`_link_unnamed`). Where ``O_TMPFILE`` is unavailable a hidden named temporary is
+    written and renamed into place (a SIGKILL before the rename leaves it).
     """
     path = Path(path)
     if path.exists() and not overwrite:
@@ -241,24 +264,26 @@ def _image(result: StudyResult) -> bytes:
         handle.attrs["study_name"] = result.study_name
         handle.attrs["model"] = result.model
         for continuation in result.continuations:
-            group = handle.create_group(f"continuations/{continuation.name}")
+            group = _collection(handle, "continuations").create_group(continuation.name)
             group.attrs["kind"] = continuation.kind
             n_states = len(continuation.branches[0].state_names) if continuation.branches \
                 else 0
             for branch in continuation.branches:
-                _write_branch(group.create_group(f"branches/{branch.name}"), branch)
+                _write_branch(_collection(group, "branches").create_group(branch.name), branch)
             _write_special_points(group.create_group("special_points"),
                                   continuation.special_points, n_states)
             if continuation.cross_checks:
                 _write_cross_checks(group.create_group("cross_checks"),
                                     continuation.cross_checks)
         for sweep in result.linear_sweeps:
-            _write_sweep(handle.create_group(f"linear/sweeps/{sweep.parameter}"), sweep)
+            _write_sweep(_collection(handle.require_group("linear"), "sweeps").create_group(
+                sweep.parameter), sweep)
         if result.linear_grid is not None:
             _write_grid(handle.create_group("linear/grid"), result.linear_grid)
         for boundary in result.boundaries:
-            _write_boundary(handle.create_group(f"boundaries/{boundary.name}"), boundary)
-        runs = handle.create_group("runs")
+            _write_boundary(_collection(handle, "boundaries").create_group(boundary.name),
+                            boundary)
+        runs = _collection(handle, "runs")
         for record in result.runs:
             runs.create_group(record.name).attrs.update(
                 status=record.status, message=record.message, constants=record.constants,
@@ -305,22 +330,34 @@ def _exists_error(path: Path) -> OutputError:
     return OutputError(f"{path}: output exists; pass --overwrite to replace it")
 
 
+#: How often an overwriting write removes a file another writer put in its place meanwhile.
+_REPLACE_ATTEMPTS = 100
+
+
 def _link_unnamed(fd: int, path: Path, overwrite: bool, directory: int) -> None:
-    """Give the O_TMPFILE file ``fd`` the name ``path`` (through /proc/self/fd)."""
+    """Give the O_TMPFILE file ``fd`` the name ``path`` (linked through /proc/self/fd).
+
+    Without ``overwrite`` the link fails if ``path`` exists. With it, an existing file is
+    removed and the unnamed one linked in its place, again if another writer's file appeared
+    in between. A link cannot replace a name, and a rename needs the new file to have a name
+    first: a named temporary, which SIGKILL before the rename would leave behind. The
+    trade-off: for the microseconds between the unlink and the link no file is at ``path``
+    (a reader may find none, and a SIGKILL exactly then leaves neither the old file nor the
+    new one), but there is never a partial or a temporary file.
+    """
     source = f"/proc/self/fd/{fd}"
-    if not overwrite:
+    for _ in range(_REPLACE_ATTEMPTS):
         try:
             os.link(source, path.name, dst_dir_fd=directory, follow_symlinks=True)
+            return
         except FileExistsError:
-            raise _exists_error(path) from None
-        return
-    temporary = f".{path.name}.tmp-{os.getpid()}"
-    os.link(source, temporary, dst_dir_fd=directory, follow_symlinks=True)
-    try:
-        os.replace(temporary, path.name, src_dir_fd=directory, dst_dir_fd=directory)
-    except BaseException:
-        os.unlink(temporary, dir_fd=directory)
-        raise
+            if not overwrite:
+                raise _exists_error(path) from None
+        try:
+            os.unlink(path.name, dir_fd=directory)
+        except FileNotFoundError:  # another writer removed it first
+            pass
+    raise OutputError(f"{path}: not replaced: other processes keep writing it")
 
 
 def _publish_named(image: bytes, path: Path, overwrite: bool, directory: int) -> None:
@@ -356,13 +393,27 @@ def _texts(values) -> tuple[str, ...]:
     return tuple(_text(v) for v in values)
 
 
+def _members(group, old_order=None) -> list[str]:
+    """Names of the members of ``group`` in the order they were written (files since whirl
+    tracks it, see :func:`_collection`); in older files by name, or sorted by ``old_order``."""
+    names = list(group)  # h5py lists by creation order where it is tracked, else by name
+    tracked = isinstance(group, h5py.Group) and \
+        group.id.get_create_plist().get_link_creation_order() & h5py.h5p.CRT_ORDER_TRACKED
+    return names if tracked or old_order is None else sorted(names, key=old_order)
+
+
+def _number(name: str) -> int:
+    """The number ending a member name: ``polygon_12`` -> 12."""
+    return int(name.rsplit("_", 1)[-1])
+
+
 def _read_branch(name: str, group: h5py.Group) -> Branch:
     params = group["parameters"]
     kind = _text(group.attrs["kind"])
     key = "floquet_multipliers" if kind == BranchKind.PERIODIC else "eigenvalues"
     orbits = []
     if "orbits" in group:
-        for label in sorted(group["orbits"], key=int):
+        for label in _members(group["orbits"], int):
             sub = group["orbits"][label]
             orbits.append(Orbit(int(label), int(sub.attrs["point_type"]),
                                 int(sub.attrs["index"]), np.asarray(sub.attrs["parameters"]),
@@ -377,6 +428,8 @@ def _read_branch(name: str, group: h5py.Group) -> Branch:
         parameters=params[()], state_max=group["state_max"][()],
         state_min=group["state_min"][()], l2_norm=group["l2_norm"][()],
         period=group["period"][()], stable=group["stable"][()].astype(bool),
+        stability_known=group["stability_known"][()].astype(bool)
+        if "stability_known" in group else None,  # files from before: known everywhere
         point_type=group["point_type"][()], label=group["label"][()],
         eigenvalues=group[key][()], status=_text(group.attrs["status"]),
         message=_text(group.attrs["message"]), run=_text(group.attrs["run"]),
@@ -399,16 +452,65 @@ def _read_special_points(group: h5py.Group) -> tuple[SpecialPoint, ...]:
         for k in range(len(columns["index"])))
 
 
+#: What reading a file that does not hold what a whirl result file holds can raise (h5py
+#: raises KeyError for a missing group or attribute, OSError for unreadable data, ValueError,
+#: TypeError or IndexError for data of the wrong type or shape).
+_DAMAGED = (KeyError, OSError, ValueError, TypeError, IndexError)
+
+
+@contextmanager
+def opened(path: Path) -> Iterator[h5py.File]:
+    """``path`` opened with h5py for reading, for the readers of result files (:func:`read`,
+    :mod:`whirl_cli.compare`). A file that is not HDF5, a truncated or unreadable one, and one
+    missing what its reader looks up inside the ``with`` block raise :class:`OutputError` as
+    one line ``<path>: <reason>``, never an h5py traceback."""
+    try:
+        handle = h5py.File(path, "r")
+    except OSError as error:
+        raise OutputError(f"{path}: {_open_failure(error)}") from None
+    try:
+        with handle:
+            yield handle
+    except _DAMAGED as error:
+        raise OutputError(f"{path}: not a complete whirl result file "
+                          f"({_reason(error)})") from None
+
+
+def _reason(error: Exception) -> str:
+    """h5py's reason of an error: the text in its ``Unable to ... (reason)`` message."""
+    text = str(error.args[0]) if isinstance(error, KeyError) and error.args else str(error)
+    found = re.search(r"\((.*)\)\s*$", text)
+    return found.group(1) if found else text
+
+
+def _open_failure(error: OSError) -> str:
+    """Why h5py could not open a file, in words."""
+    reason = _reason(error)
+    if "file signature not found" in reason:
+        return "not an HDF5 file"
+    truncated = re.search(r"truncated file: eof = (\d+).*stored_eof = (\d+)", reason)
+    if truncated:
+        return (f"truncated HDF5 file ({truncated.group(1)} of its {truncated.group(2)} "
+                "bytes)")
+    if "Permission denied" in reason or "errno = 13" in reason:
+        return "cannot read the file (permission denied)"
+    return f"cannot read as HDF5 ({reason})"
+
+
 def read(path: Path) -> StudyResult:
-    """The :class:`StudyResult` stored in a whirl HDF5 file."""
-    with h5py.File(path, "r") as handle:
-        schema = int(handle.attrs.get("whirl_schema", -1))
+    """The :class:`StudyResult` stored in a whirl HDF5 file; :class:`OutputError` (one line
+    naming the file) for a file that is not HDF5, not a whirl file, truncated or damaged."""
+    with opened(path) as handle:
+        if "whirl_schema" not in handle.attrs:
+            raise OutputError(f"{path}: an HDF5 file but not a whirl result file (no "
+                              "whirl_schema attribute)")
+        schema = int(handle.attrs["whirl_schema"])
         if schema != SCHEMA:
             raise OutputError(f"{path}: not a whirl result file of schema {SCHEMA} "
                               f"(found {schema})")
         continuations = []
         for name, group in handle.get("continuations", {}).items():
-            branches = tuple(_read_branch(b, g) for b, g in group["branches"].items())
+            branches = tuple(_read_branch(b, g) for b, g in group.get("branches", {}).items())
             checks = _read_cross_checks(group["cross_checks"]) if "cross_checks" in group \
                 else ()
             continuations.append(ContinuationResult(

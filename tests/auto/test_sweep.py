@@ -81,7 +81,7 @@ def test_plan_decides_run_skip_and_invalid(tmp_path):
     assert {i.source.name: (i.action, i.reason) for i in plan([first], out, plots=False)} == {
         "linear_case2.yaml": (SKIP, "up to date")}
     # with plots, the fake file's result cannot be read to find the plots it should have
-    assert plan([first], out)[0].reason == "unreadable output (KeyError)"
+    assert plan([first], out)[0].reason == "unreadable output (OutputError)"
     fake_output(out / "linear-case2.h5", study.sha256, code="0" * 64)
     assert plan([first], out, plots=False)[0].reason == "whirl's code changed"
     assert plan([first], out, force=True)[0].action == RUN

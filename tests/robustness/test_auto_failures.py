@@ -112,12 +112,15 @@ def test_a_hanging_run_times_out_and_keeps_its_points(tmp_path):
         assert run_record["returncode"] == -1 and 1.0 <= run_record["wall_seconds"] < 5
 
 
-def test_nan_from_the_equations_is_an_error_with_an_empty_branch(tmp_path):
-    """A continuation in the inertia I_y from 0: 1/I_y is infinite at the start point, LAPACK
-    refuses the Jacobian. The failed branch is stored empty, and the plots still work."""
+def test_nan_from_the_equations_is_an_error_with_an_empty_branch(tmp_path, monkeypatch):
+    """The inertia I_y set to 0 in one run (testing hook; a study cannot ask for it, I_y > 0
+    is its bound): 1/I_y is infinite, LAPACK refuses the Jacobian. The failed branch is stored
+    empty, and the plots still work."""
+    monkeypatch.setenv("WHIRL_AUTO_EXTRA_CONSTANTS",
+                       json.dumps({"bad.main_up": {"PAR": {"I_y": 0.0}}}))
     body = ("continuations:\n" + GOOD
-            + "  - {name: bad, type: one-parameter, parameter: I_y, start: 0.0, "
-              "range: [0.0, 0.001]}\nplots: [bifurcation]\n")
+            + "  - {name: bad, type: one-parameter, parameter: V, start: 0.0, "
+              "range: [0.0, 10.0]}\nplots: [bifurcation]\n")
     result, output = run(tmp_path, body)
     failed = {"bad.main_up": ("error", "NaN or Inf in the equations")}
     check_exit(result, failed)
@@ -125,7 +128,7 @@ def test_nan_from_the_equations_is_an_error_with_an_empty_branch(tmp_path):
     with h5py.File(output) as handle:
         branch = handle["continuations/bad/branches/main_up"]
         assert branch["parameters"].shape == (0, 1) and branch["state_max"].shape == (0, 4)
-        assert branch["parameters"].attrs["names"].tolist() == ["I_y"]
+        assert branch["parameters"].attrs["names"].tolist() == ["V"]
     assert (output.parent / "failing_good_bifurcation.png").exists()
 
 

@@ -94,8 +94,27 @@ def test_sigkill_at_random_moments_never_leaves_a_partial_file(tmp_path):
         process.wait(timeout=30)
         assert wait_for_no_auto(cache) == [], f"AUTO left running after SIGKILL at {delay:.2f} s"
         written += check_output_dir(out, plot_temporaries=plot_temporaries)
+    # --overwrite over a complete older output: afterwards the old file, the new one, or
+    # (killed between removing the old and linking the new) none; never a temporary
+    old, overwrite_kills = (tmp_path / "ref.h5").read_bytes(), 6
+    found = {"old": 0, "new": 0, "none": 0}
+    for k in range(overwrite_kills):
+        out = tmp_path / f"overwrite{k}"
+        out.mkdir()
+        (out / "r.h5").write_bytes(old)
+        process = subprocess.Popen([str(WHIRL), "run", str(study), "-o", str(out / "r.h5"),
+                                    "--overwrite"], env=env, stdout=subprocess.DEVNULL,
+                                   stderr=subprocess.DEVNULL)
+        time.sleep(rng.uniform(0, duration))
+        process.kill()
+        process.wait(timeout=30)
+        assert wait_for_no_auto(cache) == [], "AUTO left running after SIGKILL"
+        exists = check_output_dir(out, plot_temporaries=plot_temporaries)
+        found["none" if not exists else "old" if (out / "r.h5").read_bytes() == old
+              else "new"] += 1
     print(f"\n  {KILLS} SIGKILLs in [0, {duration:.2f}] s: {written} complete outputs, "
-          f"{KILLS - written} none; no partial HDF5 file, no temporary of it"
+          f"{KILLS - written} none; {overwrite_kills} overwriting runs: {found['old']} old, "
+          f"{found['new']} new, {found['none']} none; no partial HDF5 file, no temporary of it"
           + (f"; plot temporaries left by plots.py: {plot_temporaries}" if plot_temporaries
              else ""))
 
@@ -115,10 +134,12 @@ def explode(*args, **kwargs):
 
 
 @pytest.mark.parametrize("tmpfile", [True, False], ids=["O_TMPFILE", "named"])
-@pytest.mark.parametrize("step", ["write", "link", "replace"])
+@pytest.mark.parametrize("step", ["write", "link", "replace", "unlink", "relink"])
 @pytest.mark.parametrize("overwrite", [False, True])
 def test_a_write_that_fails_at_any_step_leaves_the_old_file_or_nothing(
         tmp_path, monkeypatch, tmpfile, step, overwrite):
+    """Steps: writing the data, linking it (every link), renaming it into place, removing
+    the old file (O_TMPFILE with overwrite), linking again after that removal (ditto)."""
     if not tmpfile:
         monkeypatch.delattr(os, "O_TMPFILE")
     path = tmp_path / "r.h5"
@@ -132,23 +153,45 @@ def test_a_write_that_fails_at_any_step_leaves_the_old_file_or_nothing(
         monkeypatch.setattr(store, "_write_all", half)
     elif step == "link":
         monkeypatch.setattr(store.os, "link", explode)
-    else:
+    elif step == "replace":
         monkeypatch.setattr(store.os, "replace", explode)
-    failed = step != "replace" or overwrite  # without overwrite nothing is replaced
-    if step == "link" and overwrite and not tmpfile:
-        failed = False  # the named fallback replaces instead of linking
-    if failed:
+    elif step == "unlink":  # the old file (temporaries may still be removed)
+        real_unlink = os.unlink
+
+        def unlink(name, *args, **kwargs):
+            if name == path.name:
+                raise Boom
+            return real_unlink(name, *args, **kwargs)
+        monkeypatch.setattr(store.os, "unlink", unlink)
+    else:  # a link after the old file was removed: the second link of one write
+        real_link, calls = os.link, []
+
+        def link(*args, **kwargs):
+            calls.append(args)
+            if len(calls) > 1:
+                raise Boom
+            return real_link(*args, **kwargs)
+        monkeypatch.setattr(store.os, "link", link)
+    # what is at ``path`` afterwards: "old" (the write failed), "none" (it failed), "new"
+    replacing = tmpfile and overwrite  # the O_TMPFILE path removes the old file, then links
+    outcome = {
+        "write": "old" if overwrite else "none",
+        "link": "new" if overwrite and not tmpfile  # the named fallback renames instead
+        else "old" if overwrite else "none",
+        "replace": "old" if overwrite and not tmpfile else "new",
+        "unlink": "old" if replacing else "new",
+        "relink": "none" if replacing else "new",  # the trade-off of store._link_unnamed
+    }[step]
+    if outcome == "new":
+        store.write(small_result(), path, overwrite=overwrite)
+    else:
         with pytest.raises(Boom):
             store.write(small_result(), path, overwrite=overwrite)
-    else:
-        store.write(small_result(), path, overwrite=overwrite)
     names = sorted(p.name for p in tmp_path.iterdir())
-    if failed:
-        assert names == (["r.h5"] if overwrite else []), names
-        if overwrite:
-            assert path.read_bytes() == old
-    else:
-        assert names == ["r.h5"]
+    assert names == ([] if outcome == "none" else ["r.h5"]), names
+    if outcome == "old":
+        assert path.read_bytes() == old
+    elif outcome == "new":
         assert store.read(path).study_name == "s"
 
 

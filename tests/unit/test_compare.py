@@ -119,7 +119,8 @@ def test_provenance_that_changes_legitimately_is_ignored():
                             auto_version="1.0", git_describe="abc-dirty")
     assert compare_results(make_result(), other) == []
     other.attributes["study_sha256"] = "def"
-    assert paths(compare_results(make_result(), other)) == ["/@study_sha256"]
+    assert compare_results(make_result(), other) == []  # provenance: a note, not drift
+    assert paths(compare_results(make_result(), other, strict=True)) == ["/@study_sha256"]
 
 
 def test_moved_hopf_point_is_named_by_path():
@@ -330,6 +331,6 @@ def test_cli_prints_at_most_the_limit(tmp_path):
                                            damping_ratio=sweep.damping_ratio + 1,
                                            frequency=sweep.frequency + 1),))
     a, b = store.write(base, tmp_path / "a.h5"), store.write(other, tmp_path / "b.h5")
-    result = CliRunner().invoke(cli, ["compare", str(a), str(b), "--limit", "3"])
+    result = CliRunner().invoke(cli, ["compare", str(a), str(b), "--limit", "3", "--strict"])
     assert result.exit_code == 1
     assert "... and 5 more" in result.output

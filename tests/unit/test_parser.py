@@ -106,3 +106,58 @@ def test_parse_d_takes_the_last_block_and_late_stable_lines():
     assert mult.kind == "multipliers" and mult.n_stable == 2 and (mult.br, mult.pt) == (-2, -5)
     np.testing.assert_allclose(mult.values, [1.0, 0.4])  # the accepted (last) block
     assert notes == ["NOTE:Multiplier inaccurate"]
+
+
+# --------------------------------------------------------------- segments of unequal columns
+STATE_COLUMNS = [f"{m}_{s}" for m in ("max", "min") for s in ("theta", "psi", "dtheta", "dpsi")]
+
+
+def b_segment(br: int, columns: list[str], rows: list[tuple[int, float]]) -> str:
+    """A b-file segment in AUTO's layout (title: 20 characters, then 19 per column); each row
+    (PT, K1) has the value k/1000 in the k-th column after K1 and L2-NORM = 0.5."""
+    title = "   0    PT  TY  LAB " + "".join(f"{c:>14}     " for c in columns)
+    lines = ["   0   NDIM=   4   IPS =   1   IRS =   0   ILP =   1",
+             "   0   Active continuation parameter:   'K1'", title]
+    for pt, k1 in rows:
+        values = {"K1": k1, "L2-NORM": 0.5, **{c: (k + 1) / 1000 for k, c in enumerate(
+            c for c in columns if c not in ("K1", "L2-NORM"))}}
+        lines.append(f"{br:4d}{pt:6d}   0    0" + "".join(f"  {values[c]:.10E}"
+                                                        for c in columns))
+    return "\n".join(lines) + "\n"
+
+
+def read_fragment(tmp_path, text: str):
+    from whirl_cli.auto import RunOutcome
+    from whirl_cli.branches import read_branch
+    from whirl_cli.models import get_model
+
+    (tmp_path / "b.k1.main").write_text(text)
+    outcome = RunOutcome("k1.main", "ok", "ok", tmp_path, "", 0, 0.1, text.count("\n"))
+    return read_branch(outcome, get_model("classical"), name="main", kind="equilibrium",
+                       origin="start", parameter_names=("K1",))
+
+
+def test_segments_with_different_columns_keep_every_row(tmp_path):
+    """A second segment with one more column (and its columns in another order): all rows
+    are read, each shared column by its name."""
+    first = b_segment(1, ["K1", "L2-NORM", *STATE_COLUMNS], [(-1, 0.4), (-2, 0.39)])
+    second = b_segment(2, ["K1", "L2-NORM", "PERIOD", *reversed(STATE_COLUMNS)],
+                       [(3, 0.2), (4, 0.1), (5, 0.0)])
+    (a, b) = parse_b(first + second)
+    assert a.columns != b.columns
+    branch = read_fragment(tmp_path, first + second)
+    assert branch.status == "ok" and len(branch) == 5
+    np.testing.assert_allclose(branch.parameter("K1"), [0.4, 0.39, 0.2, 0.1, 0.0])
+    assert list(branch.stable) == [True, True, False, False, False]
+    # max_theta is the 1st state column of the first segment, the 9th of the second
+    np.testing.assert_allclose(branch.state("theta"), [0.001, 0.001, 0.009, 0.009, 0.009])
+    np.testing.assert_allclose(branch.state("dpsi", "min"),  # rates: 40 rad/s per unit
+                               40 * np.array([0.008, 0.008, 0.002, 0.002, 0.002]))
+
+
+def test_a_segment_without_a_column_whirl_needs_fails_the_branch_with_a_message(tmp_path):
+    first = b_segment(1, ["K1", "L2-NORM", *STATE_COLUMNS], [(-1, 0.4), (-2, 0.39)])
+    second = b_segment(2, ["K1", "L2-NORM", *STATE_COLUMNS[:-1]], [(3, 0.2)])
+    branch = read_fragment(tmp_path, first + second)
+    assert branch.status == "error" and len(branch) == 0
+    assert branch.message == "AUTO's b-file lacks column(s) min_dpsi in some of its 2 segments"

@@ -1,0 +1,35 @@
+"""``whirl check`` says what it compares: for an equilibrium the initial perturbation and the
+final deviation (not "AUTO" and "simulation"), for an orbit AUTO's and the simulated maximum
+of the stiffness law's degree of freedom."""
+
+from __future__ import annotations
+
+import re
+
+from click.testing import CliRunner
+
+from whirl_cli.cli import cli
+
+from ..conftest import ROOT
+
+REFERENCE = ROOT / "tests" / "regression" / "references" / "hardening_case2.h5"
+NUMBER = r"-?\d[\d.e+-]*"
+
+
+def test_check_labels_each_kind_of_cross_check_truthfully():
+    result = CliRunner().invoke(cli, ["check", str(REFERENCE)])
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    equilibria = [line for line in lines if " equilibrium " in line]
+    orbits = [line for line in lines if " orbit " in line]
+    assert len(equilibria) == 6 and len(orbits) == 6 and len(lines) == 12, result.output
+    for line in equilibria:
+        assert re.fullmatch(rf"ok   k1/\w+\[\d+\] equilibrium K1 = {NUMBER}: perturbation "
+                            rf"{NUMBER} rad, final deviation {NUMBER} rad", line), line
+    for line in orbits:
+        assert re.fullmatch(rf"ok   k1/periodic_\d+\[\d+\] orbit +K1 = {NUMBER}: max theta "
+                            rf"AUTO {NUMBER} rad, simulation {NUMBER} rad", line), line
+    assert "AUTO" not in "".join(equilibria)
+    # the perturbation of main_down[1] is whirl's 1e-3 rad, decayed by orders of magnitude
+    first = re.search(rf"perturbation ({NUMBER}) rad, final deviation ({NUMBER})", lines[0])
+    assert float(first.group(1)) == 1e-3 and float(first.group(2)) < 1e-5
