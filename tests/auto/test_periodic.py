@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from whirl_cli import simulate
+from whirl_cli import linear, simulate
 from whirl_cli.models import get_model
 from whirl_cli.pipeline import run_study
 from whirl_cli.results import BranchKind, PointType
@@ -31,14 +31,28 @@ def _hopf(result, value, branch="main_down"):
     return point
 
 
+def _pitch_amplitude(branch):
+    """(N,) half the peak-to-peak pitch of each orbit, rad."""
+    return (branch.state_max[:, 0] - branch.state_min[:, 0]) / 2
+
+
 def test_hardening_case2_flutter_branch_joins_the_two_hopf_points(run_thesis):
     result = run_thesis("hardening_case2")
     main = [b for b in _periodic(result) if b.origin.endswith("on main_down")]
     assert len(main) == 1  # reached from both Hopf points, stored once
     (flutter,) = main
-    assert flutter.parameter("K1")[0] == pytest.approx(0.2888, abs=1e-3)
-    assert flutter.end.startswith("returns to HB at K1 = 0.08068")
-    assert flutter.parameter("K1")[-1] == pytest.approx(0.0807, abs=1e-3)
+    # both ends at the Hopf points of the eigenvalues (models.md 4: 0.0807 and 0.2888)
+    left, right = (c.value for c in linear.critical_points(
+        get_model("classical"), {"K_psi": 0.3}, "K1", -0.3, 0.5) if c.kind == "hopf")
+    k1, amplitude = flutter.parameter("K1"), _pitch_amplitude(flutter)
+    assert k1[0] == pytest.approx(right, abs=1e-6) and amplitude[0] < 1e-9
+    # the other end: the orbit has shrunk onto the left Hopf point; with the Hopf normal form
+    # (K1 - K1_H proportional to the squared amplitude) the last two orbits extrapolate to it
+    assert amplitude[-1] < 0.05 * amplitude.max()
+    assert k1[-1] == pytest.approx(left, abs=5e-4)
+    squared = amplitude[-2:] ** 2
+    at_zero = k1[-1] - squared[-1] * (k1[-1] - k1[-2]) / (squared[-1] - squared[-2])
+    assert at_zero == pytest.approx(left, abs=3e-5), (at_zero, left)
     # a fold of cycles left of the left Hopf point, and an unstable part there
     folds = [p for p in _points(result, PointType.LPC) if p.branch == flutter.name]
     assert any(p.parameters[0] < 0.0807 - 0.01 for p in folds)
