@@ -97,15 +97,47 @@ def softening_at_04(tmp_path_factory):
     return study, run_study(study, tmp_path_factory.mktemp("soft"), jobs=2)
 
 
-def test_softening_case2_overhang(softening_at_04):
+def _fold_of_cycles_by_simulation(model, overrides, family, fold, d, periods):
+    """Bracket the fold of cycles ``fold`` of ``family`` by time simulation: start on AUTO's
+    orbit at the fold (its point of largest pitch, enlarged 1 %) at ``d`` on the side where
+    the family's stable cycles lie and at ``d`` beyond, simulate ``periods`` periods and
+    return the largest pitch over the last ten periods relative to the start's, for both."""
+    name = family.parameter_names[0]
+    orbit = next(o for o in family.orbits if o.index == fold.index)
+    start = 1.01 * orbit.states[int(np.argmax(orbit.states[:, 0]))]
+    k, value = fold.index, float(fold.parameters[0])
+    assert family.stable[k + 2] and not family.stable[k - 2]
+    lco_side = float(np.sign(family.parameters[k + 2, 0] - value))
+    left = []
+    for side in (lco_side, -lco_side):
+        params = model.parameter_vector({**overrides, name: value + side * d})
+        _, states = simulate.integrate(model, params, start, periods * orbit.period,
+                                       samples=periods * 40)
+        left.append(float(np.abs(states[-400:, 0]).max() / abs(start[0])))
+    return lco_side, left[0], left[1]
+
+
+def test_softening_case2_overhang(softening_at_04, capsys):
     """The flutter branch leaves the right Hopf unstable and turns stable at a fold of cycles
-    to the right of that Hopf point (thesis reads ~0.42 off its figure)."""
-    _, result = softening_at_04
+    to the right of that Hopf point (thesis reads ~0.42 off its figure). The fold, by time
+    simulation: 1e-3 of the K1 range (8e-4) on its stable side a start on AUTO's fold orbit
+    stays on a cycle for 150 periods; as far beyond it, it decays to the origin (in about 40
+    periods: the ghost of the vanished cycles)."""
+    study, result = softening_at_04
     (flutter,) = [b for b in _periodic(result) if b.origin.endswith("main_down")
                   and "0.288" in b.origin]
     assert not flutter.stable[1:6].any()
     (fold,) = [p for p in _points(result, PointType.LPC) if p.branch == flutter.name]
-    assert 0.2888 < fold.parameters[0] < 0.5
+    d = 1e-3 * 0.8
+    side, inside, beyond = _fold_of_cycles_by_simulation(
+        get_model("classical"), study.parameter_values(), flutter, fold, d, periods=150)
+    with capsys.disabled():
+        print(f"\nsoftening case 2 fold of cycles: AUTO K1 = {fold.parameters[0]:.6f}; by "
+              f"simulation in [{fold.parameters[0] - d:.6f}, {fold.parameters[0] + d:.6f}]: "
+              f"pitch left after 150 periods {inside:.3f} (stable side) and {beyond:.1e} "
+              "(beyond) of the start's")
+    assert side == -1.0  # the stable cycles overhang to lower K1
+    assert inside > 0.9 and beyond < 0.01
     row = fold.index
     assert not flutter.stable[row - 2] and flutter.stable[row + 2]
     assert _hopf(result, 0.2888).criticality == "subcritical"
@@ -269,12 +301,25 @@ def test_homoclinic_orbit_located_by_homcont_and_by_simulation(run_thesis):
     assert at < 0.01 * min(left, right), (at, left, right)
 
 
-def test_airspeed_continuation_overhang(run_thesis):
+def test_airspeed_continuation_overhang(run_thesis, capsys):
     """Combined variant at datum in airspeed (thesis fig. 3.30): the flutter branch from the
     linear onset bends back to lower airspeed (a fold of cycles below 7.76 m/s)."""
     result = run_thesis("combined_airspeed")
     hopf = _hopf(result, 7.764, branch="main_up")
     assert hopf.criticality == "subcritical"
     (fold,) = _points(result, PointType.LPC)
-    assert 6.7 < fold.parameters[0] < 7.764
+    assert fold.parameters[0] < hopf.parameters[0]
+    # the fold by simulation: 2e-3 of the airspeed range (2.6e-3 m/s) above it a start on
+    # AUTO's fold orbit stays on a cycle for 600 periods; as far below it, it decays (the
+    # ghost of the cycles holds it for about 400 periods there)
+    family = next(b for b in result.continuations[0].branches if b.name == fold.branch)
+    d = 2e-3 * 1.3
+    side, inside, beyond = _fold_of_cycles_by_simulation(
+        get_model("classical"), {"K2": -10.0, "K3": 350.0}, family, fold, d, periods=600)
+    with capsys.disabled():
+        print(f"\ncombined airspeed fold of cycles: AUTO V = {fold.parameters[0]:.5f} m/s; by "
+              f"simulation in [{fold.parameters[0] - d:.5f}, {fold.parameters[0] + d:.5f}]: "
+              f"pitch left after 600 periods {inside:.3f} (stable side) and {beyond:.1e} "
+              "(beyond) of the start's")
+    assert side == 1.0 and inside > 0.9 and beyond < 0.01
     assert all(c.passed for c in result.continuations[0].cross_checks)
