@@ -3,6 +3,8 @@ of the equilibria they hang off, eigenvalue-based Hopf criticality, and time sim
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -10,7 +12,7 @@ from whirl_cli import linear, simulate
 from whirl_cli.models import get_model
 from whirl_cli.pipeline import run_study
 from whirl_cli.results import BranchKind, PointType
-from whirl_cli.study import validate_text
+from whirl_cli.study import load_study, validate_text
 
 from ..conftest import STUDIES
 
@@ -29,6 +31,18 @@ def _hopf(result, value, branch="main_down"):
     (point,) = [p for p in _points(result, PointType.HB)
                 if p.branch == branch and abs(p.parameters[0] - value) < 2e-3]
     return point
+
+
+def _equilibrium(model, params, guess):
+    """The equilibrium nearest ``guess`` by Newton's method on the numpy right-hand side."""
+    state = np.asarray(guess, dtype=float)
+    for _ in range(50):
+        step = np.linalg.solve(model.jacobian_numpy(state, params), model.rhs_numpy(state, params))
+        state = state - step
+        if np.abs(step).max() < 1e-15:
+            break
+    assert np.abs(model.rhs_numpy(state, params)).max() < 1e-10, state
+    return state
 
 
 def _pitch_amplitude(branch):
@@ -191,19 +205,82 @@ def test_cross_checks_pass_on_every_stable_periodic_branch(run_thesis, case):
         (b.name, b.message) for b in continuation.branches if b.status != "ok"]
 
 
+_ORIGIN = re.compile(r"HB at (\S+) = (\S+) on (\S+)")
+
+
+def _family_sides(hopf, families, scale):
+    """The sides of the parameter (+1/-1) on which the periodic families at ``hopf`` lie:
+    families that start there (their origin names it) and families whose last orbit has
+    shrunk onto it: small (pitch amplitude below 0.01 rad and falling), centred on its
+    equilibrium (non-dimensional states, ``scale``) and extrapolating to zero amplitude within
+    1e-3 of it, with K1 - K1_H proportional to the squared amplitude (Hopf normal form)."""
+    value, sides = float(hopf.parameters[0]), []
+    for family in families:
+        named = _ORIGIN.fullmatch(family.origin)
+        if named and named[3] == hopf.branch and abs(float(named[2]) - value) <= 5e-6 * abs(
+                value):  # the origin gives 6 significant digits
+            sides.append(float(np.sign(family.parameters[1, 0] - value)))
+        amplitude, k1 = _pitch_amplitude(family), family.parameters[:, 0]
+        if len(family) < 4 or not 0 < amplitude[-1] < min(amplitude[-2], 0.01):
+            continue
+        squared = amplitude[-2:] ** 2
+        at_zero = k1[-1] - squared[1] * (k1[-1] - k1[-2]) / (squared[1] - squared[0])
+        centre = (family.state_max[-1] + family.state_min[-1]) / 2
+        if abs(at_zero - value) < 1e-3 and np.allclose(
+                centre / scale, hopf.state / scale, rtol=0, atol=1e-3 + 2 * amplitude[-1]):
+            sides.append(float(np.sign(k1[-1] - value)))
+    return sides
+
+
+def _growth_direction(model, overrides, name, hopf, delta=1e-6):
+    """Sign of d(Re lambda)/dp of the critical pair: numpy eigenvalues of the Jacobian at the
+    equilibrium (re-solved by Newton from the Hopf state) at p -/+ delta; the pair is the one
+    nearest i omega_H."""
+    omega, value = 2 * np.pi / hopf.period, float(hopf.parameters[0])
+
+    def critical(p):
+        params = model.parameter_vector({**overrides, name: p})
+        state = _equilibrium(model, params, hopf.state)
+        eigenvalues = np.linalg.eigvals(model.jacobian_numpy(state, params))
+        return float(eigenvalues[np.argmin(np.abs(eigenvalues - 1j * omega))].real)
+
+    low, at, high = critical(value - delta), critical(value), critical(value + delta)
+    assert abs(at) < 1e-6 * omega  # the pair is on the imaginary axis at the Hopf point
+    assert np.sign(high - at) == np.sign(at - low) != 0
+    return float(np.sign(high - low))
+
+
 @pytest.mark.parametrize("case", NONLINEAR)
-def test_criticality_from_the_family_agrees_with_the_lyapunov_coefficient(run_thesis, case):
-    """Two independent verdicts on every Hopf point: the side the AUTO periodic family leaves
-    on, and the sign of the first Lyapunov coefficient from the symbolic model."""
+def test_criticality_from_the_family_agrees_with_the_lyapunov_coefficient(run_thesis, case,
+                                                                           capsys):
+    """Two independent verdicts on every Hopf point. The family's, computed here: the side of
+    the parameter its periodic family lies on (starting or ending there), against the side
+    where the equilibrium is unstable (the critical pair's real part grows towards it, by numpy
+    eigenvalues at the re-solved equilibrium): supercritical iff the same. The normal form's:
+    the sign of the first Lyapunov coefficient (l1 < 0 supercritical). Every Hopf point of the
+    chapter-3 cases has a family, so every one gets both verdicts, and whirl's label agrees."""
     result = run_thesis(case)
+    model = get_model("classical")
+    overrides = load_study(STUDIES / f"{case}.yaml").parameter_values()
+    families = _periodic(result)
     hopfs = _points(result, PointType.HB)
-    labelled = [h for h in hopfs if h.criticality]
-    assert labelled or not hopfs
+    verdicts = []
     for hopf in hopfs:
         assert np.isfinite(hopf.lyapunov) and hopf.lyapunov != 0, hopf
-    disagreeing = [(h.branch, h.parameters[0], h.criticality, h.lyapunov) for h in labelled
-                   if h.criticality != ("supercritical" if h.lyapunov < 0 else "subcritical")]
-    assert disagreeing == []
+        sides = _family_sides(hopf, families, np.asarray(model.state_scale))
+        if not sides:
+            continue
+        assert len(set(sides)) == 1, (hopf, sides)
+        growth = _growth_direction(model, overrides, hopf.parameter_names[0], hopf)
+        family = "supercritical" if sides[0] == growth else "subcritical"
+        lyapunov = "supercritical" if hopf.lyapunov < 0 else "subcritical"
+        verdicts.append((hopf.branch, round(float(hopf.parameters[0]), 6), family, lyapunov,
+                         hopf.criticality))
+    with capsys.disabled():
+        print(f"\n{case}: {len(verdicts)} of {len(hopfs)} Hopf points with a family: "
+              + ", ".join(f"{v[1]:g} {v[2][:3]}" for v in verdicts))
+    assert len(verdicts) == len(hopfs)
+    assert [v for v in verdicts if not v[2] == v[3] == v[4]] == []
 
 
 def test_lyapunov_coefficient_without_periodic_branches(tmp_path):
