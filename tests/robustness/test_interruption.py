@@ -45,19 +45,13 @@ def wait_for_no_auto(cache: Path, seconds: float = 5.0) -> list[int]:
     return left
 
 
-def check_output_dir(directory: Path, name: str = "r.h5", plot_temporaries: list | None = None
-                     ) -> bool:
-    """The output is absent or a complete whirl file, with no temporary file of it and nothing
-    else but its plots. Returns whether the output exists. Temporary files of plots (plots.py,
-    not atomic under SIGKILL) are collected in ``plot_temporaries`` if given, else refused."""
+def check_output_dir(directory: Path, name: str = "r.h5") -> bool:
+    """The output is absent or a complete whirl file, with no temporary file (of it or of a
+    plot: both are published atomically, ``store.publish``) and nothing else but its plots.
+    Returns whether the output exists."""
     names = sorted(p.name for p in directory.iterdir()) if directory.exists() else []
     hidden = [n for n in names if n.startswith(".") or "tmp" in n]
-    assert not [n for n in hidden if name in n or ".png." not in n], names
-    if plot_temporaries is None:
-        assert not hidden, names
-    else:
-        plot_temporaries += hidden
-    names = [n for n in names if n not in hidden]
+    assert not hidden, names
     assert set(names) <= {name} | {n for n in names if n.startswith(Path(name).stem + "_")
                                    and n.endswith(".png")}, names
     if name not in names:
@@ -83,7 +77,7 @@ def test_sigkill_at_random_moments_never_leaves_a_partial_file(tmp_path):
     assert reference.returncode == 0, reference.stderr
     rng = random.Random(SEED)
     delays = sorted(rng.uniform(0, duration) for _ in range(KILLS))
-    written, plot_temporaries = 0, []
+    written = 0
     for k, delay in enumerate(delays):
         out = tmp_path / f"kill{k}"
         process = subprocess.Popen([str(WHIRL), "run", str(study), "-o", str(out / "r.h5")],
@@ -93,7 +87,7 @@ def test_sigkill_at_random_moments_never_leaves_a_partial_file(tmp_path):
         process.kill()
         process.wait(timeout=30)
         assert wait_for_no_auto(cache) == [], f"AUTO left running after SIGKILL at {delay:.2f} s"
-        written += check_output_dir(out, plot_temporaries=plot_temporaries)
+        written += check_output_dir(out)
     # --overwrite over a complete older output: afterwards the old file, the new one, or
     # (killed between removing the old and linking the new) none; never a temporary
     old, overwrite_kills = (tmp_path / "ref.h5").read_bytes(), 6
@@ -109,14 +103,13 @@ def test_sigkill_at_random_moments_never_leaves_a_partial_file(tmp_path):
         process.kill()
         process.wait(timeout=30)
         assert wait_for_no_auto(cache) == [], "AUTO left running after SIGKILL"
-        exists = check_output_dir(out, plot_temporaries=plot_temporaries)
+        exists = check_output_dir(out)
         found["none" if not exists else "old" if (out / "r.h5").read_bytes() == old
               else "new"] += 1
     print(f"\n  {KILLS} SIGKILLs in [0, {duration:.2f}] s: {written} complete outputs, "
           f"{KILLS - written} none; {overwrite_kills} overwriting runs: {found['old']} old, "
-          f"{found['new']} new, {found['none']} none; no partial HDF5 file, no temporary of it"
-          + (f"; plot temporaries left by plots.py: {plot_temporaries}" if plot_temporaries
-             else ""))
+          f"{found['new']} new, {found['none']} none; no partial HDF5 file, no temporary file of "
+          "it or of a plot")
 
 
 # ------------------------------------------------------------------------------ the writer

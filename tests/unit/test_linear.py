@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from numpy.polynomial import polynomial as P
+from scipy.optimize import brentq
 
 from whirl_cli import linear
 from whirl_cli.models import get_model
@@ -49,20 +51,88 @@ def test_backward_whirl_has_theta_in_phase_with_psi_dot(model):
     assert labels[k] == "BW"
 
 
-@pytest.mark.parametrize(("k_psi", "expected"), [
+# --- an independent linear analysis: models.md 2.2 closed forms and 2.3 matrices, by hand ----
+# datum of models.md table 3 (thesis Table 3.1), SI units
+R, OMEGA, BLADES, CHORD, LIFT_SLOPE, V = 0.152, 40.0, 4, 0.026, 2 * np.pi, 6.7
+A, I_X, I_Y, DAMPING, RHO = 0.25, 0.000103, 0.000178, 0.001, 1.225
+
+
+def aerodynamic_coefficients(v: float = V) -> tuple[float, float, float]:
+    """(k_d, k_c, c_a) from the closed-form radial integrals of models.md 2.2."""
+    mu = v / (OMEGA * R)
+    ratio, arsinh, root = CHORD / R, np.arcsinh(1 / mu), np.sqrt(1 + mu * mu)
+    a1 = ratio * mu * mu * arsinh
+    a2 = ratio * mu / 2 * (root - mu * mu * arsinh)
+    a3 = ratio * ((2 - 3 * mu * mu) * root + 3 * mu ** 4 * arsinh) / 8
+    q = BLADES * RHO * LIFT_SLOPE * R ** 5 * OMEGA ** 2 / 4
+    return q * A * mu * a1, q * mu * a2, q * (a3 + A * A * a1) / OMEGA
+
+
+K_D, K_C, C_A = aerodynamic_coefficients()
+
+
+def quartic(k_theta: float, k_psi: float) -> np.ndarray:
+    """(a4, a3, a2, a1, 1): det(M s^2 + C s + K) / (I_y I_z) of models.md 2.3, lowest power
+    first, with M = diag(I_y, I_z), C = [[C_t + c_a, -I_x W], [I_x W, C_p + c_a]],
+    K = [[K_t - k_d, k_c], [-k_c, K_p - k_d]]."""
+    pitch = [k_theta - K_D, DAMPING + C_A, I_Y]
+    yaw = [k_psi - K_D, DAMPING + C_A, I_Y]
+    coupling = [-K_C, I_X * OMEGA]  # the off-diagonal product is -(I_x W s - k_c)^2
+    coefficients = P.polyadd(P.polymul(pitch, yaw), P.polymul(coupling, coupling))
+    return coefficients / coefficients[-1]
+
+
+def hurwitz(k_theta: float, k_psi: float) -> float:
+    """a1 a2 a3 - a3^2 - a1^2 a4: zero where the quartic has a root pair on the imaginary
+    axis (then it factors as (s^2 + a3/a1)(s^2 + a1 s + a1 a4/a3))."""
+    a4, a3, a2, a1, _ = quartic(k_theta, k_psi)
+    return a1 * a2 * a3 - a3 * a3 - a1 * a1 * a4
+
+
+def independent_critical_points(k_psi: float, lower: float = -0.3, upper: float = 0.5
+                                ) -> list[tuple[str, float, float]]:
+    """(kind, K_theta, frequency) in order: the branch point from the closed form of models.md
+    2.4 and the Hopf points from the Routh-Hurwitz condition, solved with brentq."""
+    found = []
+    branch_point = K_D - K_C ** 2 / (k_psi - K_D)
+    if lower <= branch_point <= upper:
+        found.append(("branch_point", branch_point, 0.0))
+    grid = np.linspace(lower, upper, 801)
+    values = np.array([hurwitz(k, k_psi) for k in grid])
+    for k in np.flatnonzero(np.sign(values[:-1]) != np.sign(values[1:])):
+        root = brentq(hurwitz, grid[k], grid[k + 1], args=(k_psi,), xtol=1e-14)
+        a4, a3, a2, a1, _ = quartic(root, k_psi)
+        if a3 / a1 > 0:  # else a real pair +/- sqrt(-a3/a1): no Hopf point
+            found.append(("hopf", root, float(np.sqrt(a3 / a1))))
+    return sorted(found, key=lambda point: point[1])
+
+
+def test_independent_coefficients_match_models_md():
+    """models.md 4: k_d, k_c, c_a = 0.046567 / 0.051795 / 0.0008826 at the datum."""
+    assert (K_D, K_C, C_A) == pytest.approx((0.046567, 0.051795, 0.0008826), abs=1e-6)
+
+
+@pytest.mark.parametrize(("k_psi", "reference"), [
     (0.3, [("branch_point", 0.03598), ("hopf", 0.0807), ("hopf", 0.2888)]),
     (0.4, [("branch_point", 0.0390)]),
     # a real pair turning into an unstable complex pair (K1 ~ 0.030) is not a Hopf point
-    (0.2, [("branch_point", 0.02908), ("hopf", 0.3233)]),
-    (0.037, [("hopf", 0.2852), ("branch_point", 0.3270)]),
+    (0.2, [("branch_point", None), ("hopf", None)]),
+    (0.037, [("hopf", None), ("branch_point", None)]),
 ])
-def test_stiffness_sweep_critical_points(model, k_psi, expected):
-    """models.md 4: K_psi = 0.3 -> BP 0.03598, HB 0.0807, HB 0.2888; K_psi = 0.4 -> 0.0390;
-    cases 3 and 5 as AUTO finds them."""
+def test_stiffness_sweep_critical_points(model, k_psi, reference):
+    """Eigenvalues of whirl's symbolic model against the independent characteristic
+    polynomial above (all four cases, to 1e-9) and, for K_psi = 0.3 and 0.4, against models.md
+    4 (BP 0.03598, HB 0.0807, HB 0.2888; unstable below 0.0390)."""
     found = linear.critical_points(model, {"K_psi": k_psi}, "K_theta", -0.3, 0.5)
-    assert [c.kind for c in found] == [kind for kind, _ in expected]
-    for point, (_, value) in zip(found, expected, strict=True):
-        assert point.value == pytest.approx(value, abs=5e-4)
+    independent = independent_critical_points(k_psi)
+    assert [c.kind for c in found] == [kind for kind, _ in reference]
+    assert [kind for kind, _, _ in independent] == [kind for kind, _ in reference]
+    for point, (_, value, frequency), (_, quoted) in zip(found, independent, reference,
+                                                        strict=True):
+        assert point.value == pytest.approx(value, abs=1e-9)
+        assert point.frequency == pytest.approx(frequency, rel=1e-7, abs=1e-9)
+        if quoted is not None:
+            assert point.value == pytest.approx(quoted, abs=5e-4)
 
 
 def test_divergence_matches_closed_form(model):
