@@ -8,7 +8,10 @@ its last stored orbit profile this module
   (symmetric model) -> heteroclinic;
 * estimates p* with the saddle scaling law T = C - ln|p - p*| / lambda_u (lambda_u: the saddle's
   unstable eigenvalue, 1/s) and with the simpler fit T = A / |p* - p| + B, each by a scan of p*
-  (the other coefficients are linear) over the last points with T > 2 T_Hopf;
+  (the other coefficients are linear) over the last points with T > 2 T_Hopf; or, where the
+  parameter turns there (snaking near a saddle-focus; the family is continued until it has
+  turned :data:`BRACKET_TURNS` times), brackets p* by the last two turns and estimates it by
+  Aitken's delta-squared extrapolation of the last three;
 * returns a special point of type HOMOCLINIC or HETEROCLINIC with status "bracketed": the
   estimate, the bracket [last computed value, estimate] and the relative rms fit residual.
 """
@@ -43,6 +46,54 @@ def in_blowup(family: Branch, hopf_period: float) -> bool:
     """True if the family's period has grown beyond BLOWUP_FACTOR times the Hopf period."""
     periods = family.period[np.isfinite(family.period)]
     return bool(len(periods)) and periods.max() > BLOWUP_FACTOR * hopf_period
+
+
+#: A family in blow-up is continued (fold by fold) until its parameter has turned this often
+#: there: the extremes of a snaking approach alternate around p*, so the last two bracket it.
+BRACKET_TURNS = 5
+
+
+def blowup_turns(parameter: np.ndarray, period: np.ndarray, hopf_period: float) -> int:
+    """How often the parameter reverses direction where the period exceeds twice the Hopf
+    period (the turns of a snaking approach to a global bifurcation)."""
+    return len(_turning_rows(parameter, period, hopf_period))
+
+
+def _turning_rows(parameter: np.ndarray, period: np.ndarray, hopf_period: float) -> np.ndarray:
+    """Rows where the parameter reverses direction, within the blow-up stretch (the last
+    stretch with the period above twice the Hopf period)."""
+    stretch = _stretch(period, hopf_period)
+    p = parameter[stretch]
+    steps = np.diff(p)
+    moving = np.flatnonzero(steps != 0)
+    if len(moving) < 2:
+        return np.empty(0, dtype=int)
+    signs = np.sign(steps[moving])
+    flips = np.flatnonzero(signs[1:] != signs[:-1])
+    return stretch.start + moving[flips] + 1
+
+
+def _stretch(period: np.ndarray, hopf_period: float) -> slice:
+    """The last stretch of rows with the period above twice the Hopf period."""
+    above = np.isfinite(period) & (period > 2 * hopf_period)
+    if not above.any():
+        return slice(0, 0)
+    end = int(np.flatnonzero(above)[-1]) + 1
+    start = end
+    while start > 0 and above[start - 1]:
+        start -= 1
+    return slice(start, end)
+
+
+def _extrapolated(extremes: np.ndarray) -> float:
+    """The limit of the alternating, decaying extremes of a snaking approach by Aitken's
+    delta-squared (exact for p* + A q^k (-1)^k); NaN if they do not alternate and decay."""
+    if len(extremes) < 3:
+        return float("nan")
+    first, second = np.diff(extremes[-3:])
+    if first * second >= 0 or abs(second) >= abs(first):
+        return float("nan")
+    return float(extremes[-1] - second**2 / (second - first))
 
 
 def _tail(period: np.ndarray, hopf_period: float) -> slice:
@@ -83,13 +134,18 @@ def fit_blowup(parameter: np.ndarray, period: np.ndarray, unstable_rate: float |
     p, t = parameter[tail], period[tail]
     if len(p) < 4:
         return None
-    steps = np.diff(p)
-    if np.any(steps[1:] * steps[:-1] < 0):  # the parameter oscillates: a snaking approach
-        turns = p[1:-1][steps[1:] * steps[:-1] < 0][-2:]
-        if len(turns) == 1:
-            turns = np.array([turns[0], p[-1]])
-        return BlowupFit(float(turns.mean()), float(turns.mean()), float("nan"), len(p),
-                         (float(turns.min()), float(turns.max())))
+    turns = _turning_rows(parameter, period, hopf_period)
+    if len(turns):  # the parameter oscillates: a snaking approach (saddle-focus)
+        extremes = parameter[turns]
+        if len(extremes) == 1:  # one turn (AUTO stopped early): the last point stands in
+            extremes = np.append(extremes, parameter[_stretch(period, hopf_period).stop - 1])
+        low, high = sorted(float(x) for x in extremes[-2:])
+        estimate = _extrapolated(extremes[-3:])
+        if not low <= estimate <= high:
+            estimate = 0.5 * (low + high)
+        stretch = _stretch(period, hopf_period)
+        return BlowupFit(estimate, estimate, float("nan"), stretch.stop - stretch.start,
+                         (low, high))
     reach = max(2 * np.ptp(p), 1e-9 * width)
     rate = unstable_rate if unstable_rate and unstable_rate > 0 else 1.0
 

@@ -583,13 +583,22 @@ def _next_segment(family: _Family, model: Model, hopfs: list[SpecialPoint],
     elif last != PointType.LPC or _first_return(piece, hopfs, width, scale) is not None or \
             _hopf_at(piece, len(piece) - 1, hopfs, width, scale) is not None:
         return None  # an end (range, amplitude, period, steps) or back at a Hopf point
-    if global_bifurcations.in_blowup(piece, family.hopf.period):
+    if global_bifurcations.in_blowup(piece, family.hopf.period) and \
+            global_bifurcations.blowup_turns(*_columns(family), family.hopf.period) \
+            >= global_bifurcations.BRACKET_TURNS:
         return None
     constants = dict(family.spec.constants, STOP=["LP1"])
     constants["UZSTOP"] = {k: v for k, v in constants["UZSTOP"].items() if k != AMPLITUDE}
     return replace(family.spec, name=f"{family.spec.name.rsplit('.', 1)[0]}."
                    f"{len(family.pieces)}", constants=constants,
                    restart=(piece.run, int(piece.label[-1])))
+
+
+def _columns(family: _Family) -> tuple[np.ndarray, np.ndarray]:
+    """(principal parameter, period) along the family's pieces so far (a restart repeats the
+    point it starts from: a zero step, which counts as no turn)."""
+    return (np.concatenate([p.parameters[:, 0] for p in family.pieces]),
+            np.concatenate([p.period for p in family.pieces]))
 
 
 def _retry(family: _Family, piece: Branch) -> RunSpec | None:
