@@ -1,0 +1,184 @@
+"""Models as data: what a model family declares, and nothing derived from it.
+
+A :class:`Family` is a model as its author writes it down: its degrees of freedom (with a
+typical amplitude that scales every amplitude threshold whirl uses), its parameters (datum,
+unit, description, physical bounds), the structural stiffness term of each degree of freedom
+that a stiffness law may replace, and its equations of motion in second-order form
+
+    M(p) q'' = G(q, q', p) - S(q, p),     S_i = K_i q_i   (or a law's restoring force),
+
+with M the (possibly full) mass matrix, G every other generalised force (aerodynamic,
+gyroscopic, damping) and S the structural stiffness. Building the first-order system, its
+derivatives, the AUTO Fortran and the numeric functions is whirl's job
+(:mod:`whirl_cli.models.symbolic`), done ahead of any run.
+
+This module imports no sympy: a declaration is read (names, units, bounds) by every command,
+and only the ``equations`` function, called when code is generated, builds expressions.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+#: Largest magnitude whirl accepts for any parameter, in its SI unit: far beyond any rotor,
+#: and far enough below the double-precision limit that the equations cannot overflow.
+MAGNITUDE_LIMIT = 1e9
+#: AUTO names (``unames``/``parnames``) are CHARACTER(13) in AUTO-07p 0.9.2.
+AUTO_NAME_LENGTH = 13
+NAME_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+#: Names a model may not use: the arguments and locals of the generated Fortran routines.
+RESERVED_NAMES = frozenset(
+    n.lower()
+    for n in (
+        "NDIM U ICP PAR IJAC F DFDU DFDP T GETP I NBC NINT FB DBC U0 U1 UOLD UDOT UPOLD FI DINT"
+        " FS".split()
+    )
+)
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """The physical range of a parameter's value: ``lower`` <= value <= ``upper`` (strict where
+    ``*_open``), a whole number if ``integer``. Both ends are finite (at most
+    :data:`MAGNITUDE_LIMIT` in size)."""
+
+    lower: float = -MAGNITUDE_LIMIT
+    upper: float = MAGNITUDE_LIMIT
+    lower_open: bool = False
+    upper_open: bool = False
+    integer: bool = False
+
+    def contains(self, value: float) -> bool:
+        low = value > self.lower if self.lower_open else value >= self.lower
+        high = value < self.upper if self.upper_open else value <= self.upper
+        return low and high and (not self.integer or float(value).is_integer())
+
+    def text(self, unit: str = "") -> str:
+        """E.g. "> 0 kg m^2", "an integer >= 3", "in [-1e+09, 1e+09] N m/rad"."""
+        unit = f" {unit}" if unit and unit != "1" else ""
+        if self.upper == MAGNITUDE_LIMIT and not self.upper_open and \
+                self.lower > -MAGNITUDE_LIMIT:
+            text = f"{'>' if self.lower_open else '>='} {self.lower:g}{unit}"
+        else:
+            text = (f"in {'(' if self.lower_open else '['}{self.lower:g}, {self.upper:g}"
+                    f"{')' if self.upper_open else ']'}{unit}")
+        return f"an integer {text}" if self.integer else text
+
+
+POSITIVE = Bounds(lower=0.0, lower_open=True)
+NON_NEGATIVE = Bounds(lower=0.0)
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A model parameter: travels to AUTO through PAR, never compiled in. ``bounds``: its
+    physical range (a study value outside it is refused)."""
+
+    name: str
+    default: float
+    unit: str
+    description: str
+    aliases: tuple[str, ...] = ()
+    bounds: Bounds = Bounds()
+
+    def __post_init__(self) -> None:
+        if not self.bounds.contains(self.default):
+            raise ValueError(f"parameter {self.name}: datum {self.default!r} outside its bounds "
+                             f"{self.bounds.text()}")
+
+
+@dataclass(frozen=True)
+class State:
+    """One state of the first-order system, with the unit of its physical (SI) value."""
+
+    name: str
+    unit: str
+    description: str
+
+
+@dataclass(frozen=True)
+class Dof:
+    """A degree of freedom q_i and its rate.
+
+    ``amplitude``: a typical amplitude of its motion, in ``unit``: the scale of every amplitude
+    threshold whirl applies to it (a family has grown, shrunk back onto a Hopf point, ...) and
+    of AUTO's non-dimensional state (q / amplitude). ``stiffness``: the parameter of its linear
+    structural stiffness K_i; the term K_i q_i is what a stiffness law on this dof replaces,
+    with K_i as the law's linear coefficient.
+    """
+
+    name: str
+    rate: str
+    unit: str
+    description: str
+    amplitude: float
+    stiffness: str
+
+    @property
+    def rate_unit(self) -> str:
+        return f"{self.unit}/s"
+
+
+#: The equations of a family: given a symbol for every dof (``q[name]``), rate (``v[name]``)
+#: and parameter (``p[name]``), return (M, G): the mass matrix (n x n, parameters only) and
+#: the generalised forces other than the structural stiffness (n x 1), as sympy matrices in
+#: dof order.
+Equations = Callable[[dict, dict, dict], tuple]
+
+
+@dataclass(frozen=True)
+class Family:
+    """A model family as declared (see the module doc).
+
+    ``time_scale``: a reference frequency in rad/s (AUTO's time is tau = time_scale * t).
+    ``hub``: the hub displacement normal to the spin axis (+x), components (y, z), each a
+    combination ((state index, factor), ...) of the first-order states: it tells forward from
+    backward whirl. ``symmetric``: the equations are invariant under y -> -y (equilibria and
+    secondary branches come in +/- pairs). ``linear``: apart from the stiffness laws, the
+    equations are linear in the states (so a study without nonlinear law coefficients is a
+    linear system). ``provisional``: whirl's own derivation, not yet checked against the
+    published model.
+    """
+
+    name: str
+    description: str
+    dofs: tuple[Dof, ...]
+    parameters: tuple[Parameter, ...]
+    equations: Equations = field(repr=False, compare=False)
+    time_scale: float = 1.0
+    hub: tuple[tuple[tuple[int, float], ...], tuple[tuple[int, float], ...]] = ((), ())
+    symmetric: bool = True
+    linear: bool = True
+    provisional: bool = False
+    notes: str = ""
+
+    def __post_init__(self) -> None:
+        names = [d.name for d in self.dofs] + [d.rate for d in self.dofs]
+        names += [p.name for p in self.parameters]
+        aliases = [a for p in self.parameters for a in p.aliases]
+        lowered = [n.lower() for n in names + aliases]
+        if len(set(lowered)) != len(lowered):
+            raise ValueError(f"model {self.name}: names must be unique ignoring case: {names}")
+        for n in names + aliases:
+            if not NAME_RE.match(n) or n.lower() in RESERVED_NAMES or n.lower().startswith("w_"):
+                raise ValueError(f"model {self.name}: {n!r} is not a usable Fortran name")
+        for d in self.dofs:
+            if len(f"max_{d.rate}") > AUTO_NAME_LENGTH:
+                raise ValueError(f"model {self.name}: state name {d.rate!r} too long for AUTO")
+            if d.stiffness not in {p.name for p in self.parameters}:
+                raise ValueError(f"model {self.name}: dof {d.name}: no parameter {d.stiffness}")
+            if not (math.isfinite(d.amplitude) and d.amplitude > 0):
+                raise ValueError(f"model {self.name}: dof {d.name}: amplitude must be > 0")
+        for p in self.parameters:
+            if len(p.name) > AUTO_NAME_LENGTH:
+                raise ValueError(f"model {self.name}: parameter name {p.name!r} too long")
+
+    @property
+    def dof_names(self) -> tuple[str, ...]:
+        return tuple(d.name for d in self.dofs)
+
+    def dof(self, name: str) -> Dof:
+        return next(d for d in self.dofs if d.name == name)

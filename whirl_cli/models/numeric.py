@@ -1,0 +1,286 @@
+"""The numeric right-hand side, Jacobian and derivative tensors of a variant, generated ahead.
+
+:func:`numeric_source` prints a variant's sympy expressions (:mod:`whirl_cli.models.symbolic`)
+as a plain Python module of numpy code; :func:`load` generates it once per variant and code
+version into the cache (:mod:`whirl_cli.cache`) and afterwards only reads it, so a run never
+imports sympy. The generated module holds, for R = G - S (the forces of the mass equation
+M(p) v' = R):
+
+* ``prepare(p)``: the parameter values and every subexpression that depends on parameters
+  only (aerodynamic coefficients, ...), computed once per parameter set;
+* ``residual(y, c)``, ``residual_jacobian(y, c)``: R and dR/dy from the state and
+  ``c = prepare(p)``; ``residual_tensors(y, p)``: the non-zero second and third derivatives;
+* ``mass(p)``: the entries of M, and ``DIAGONAL_MASS``.
+
+:class:`Numeric` adds the generic part: q' = v, and the solve with M (a division where M is
+diagonal), vectorised over points.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+
+from ..cache import cache_dir, write_atomically
+
+PACKAGE = Path(__file__).resolve().parent
+
+
+@cache
+def code_key() -> str:
+    """sha256 over the source of the models package (declarations, laws, generators): a
+    change to any of it regenerates every variant's code."""
+    digest = hashlib.sha256()
+    for path in sorted(PACKAGE.rglob("*.py")):
+        digest.update(path.relative_to(PACKAGE).as_posix().encode() + b"\0")
+        digest.update(path.read_bytes() + b"\0")
+    return digest.hexdigest()
+
+
+def variant_key(model) -> str:
+    """Identifies everything generated for ``model`` without generating it."""
+    return hashlib.sha256(f"{code_key()}:{model.name}:{model.laws}".encode()).hexdigest()
+
+
+# ------------------------------------------------------------------------------ generation
+def numeric_source(model) -> str:
+    """The generated module for ``model`` (deterministic text)."""
+    import sympy as sp
+    from sympy.printing.numpy import NumPyPrinter
+
+    from .symbolic import Symbolic
+
+    symbolic = Symbolic(model)
+    printer = NumPyPrinter({"fully_qualified_modules": True, "allow_unknown_functions": False})
+    states = [str(s) for s in symbolic.states]
+    params = [str(s) for s in symbolic.parameters]
+    n_dof, n = len(symbolic.q), len(symbolic.states)
+
+    residual = [_by_state(e, symbolic.states) for e in symbolic.residual]
+    jacobian = [_by_state(e, symbolic.states) for e in symbolic.residual_jacobian]
+    temporaries, reduced = sp.cse(residual + jacobian, symbols=sp.numbered_symbols("w_"),
+                                  order="canonical")
+    parameter_only: list[tuple[sp.Symbol, sp.Expr]] = []
+    known = set(symbolic.parameters)
+    state_dependent = []
+    for symbol, expression in temporaries:
+        if expression.free_symbols <= known:
+            parameter_only.append((symbol, expression))
+            known.add(symbol)
+        else:
+            state_dependent.append((symbol, expression))
+    prepared = params + [str(s) for s, _ in parameter_only]
+    forces, slopes = reduced[:n_dof], reduced[n_dof:]
+
+    # M^-1 as prepared numbers (field_at: fixed parameters): 1/M_ii, or a numeric inverse
+    inverse = [[sp.Symbol(f"m_{i}_{j}") for j in range(n_dof)] for i in range(n_dof)]
+    structure = [[i == j or not symbolic.diagonal_mass for j in range(n_dof)]
+                 for i in range(n_dof)]
+    if symbolic.diagonal_mass:
+        inverse_lines = [f"    m_{i}_{i} = 1.0 / ({printer.doprint(symbolic.mass[i, i])})"
+                         for i in range(n_dof)]
+    else:
+        inverse_lines = [f"    ({', '.join(str(s) for row in inverse for s in row)},) = "
+                         f"numpy.linalg.inv(numpy.array(mass(p), dtype=float).reshape("
+                         f"{n_dof}, {n_dof})).ravel()"]
+    field_constants = prepared + [str(inverse[i][j]) for i in range(n_dof)
+                                  for j in range(n_dof) if structure[i][j]]
+    accelerations = [sp.Add(*[inverse[i][j] * forces[j] for j in range(n_dof)
+                              if structure[i][j]]) for i in range(n_dof)]
+    lower = [sp.Add(*[inverse[i][j] * slopes[j * n + k] for j in range(n_dof)
+                      if structure[i][j]]) for i in range(n_dof) for k in range(n)]
+    upper = [sp.S.One if k == n_dof + i else sp.S.Zero for i in range(n_dof) for k in range(n)]
+
+    def body(assignments, results, unpack) -> list[str]:
+        lines = [f"    {line}" for line in unpack]
+        lines += [f"    {s} = {printer.doprint(e)}" for s, e in assignments]
+        lines.append("    return [" + ", ".join(printer.doprint(e) for e in results) + "]")
+        return lines
+
+    def unpack(names: list[str], source: str) -> str:
+        return f"({', '.join(names)},) = {source}"
+
+    def used(results):
+        return [a for a in state_dependent if a[0] in _needed(results, state_dependent)]
+
+    nonzero, tensors = symbolic.residual_tensors
+    tensor_temps, tensor_reduced = sp.cse(tensors, symbols=sp.numbered_symbols("t_"),
+                                          order="canonical") if tensors else ([], [])
+    laws = ", ".join(f"{law} on {dof}" for law, dof in zip(model.laws, model.family.dof_names,
+                                                          strict=True))
+    lines = [
+        f'"""Generated by whirl from the symbolic model {model.name}; do not edit.',
+        "",
+        f"Laws: {laws}.",
+        f"States: {', '.join(states)}.",
+        f"Parameters: {', '.join(params)}.",
+        '"""',
+        "",
+        "import numpy",
+        "",
+        f"N_DOF = {n_dof}",
+        f"N_STATES = {n}",
+        f"DIAGONAL_MASS = {symbolic.diagonal_mass}",
+        f"TENSOR_INDEX = {list(nonzero)}",
+        "",
+        "",
+        "def prepare(p):",
+        *body(parameter_only, [sp.Symbol(name) for name in prepared], [unpack(params, "p")]),
+        "",
+        "",
+        "def residual(y, c):",
+        *body(used(forces), forces, [unpack(states, "y"), unpack(prepared, "c")]),
+        "",
+        "",
+        "def residual_jacobian(y, c):",
+        *body(used(slopes), slopes, [unpack(states, "y"), unpack(prepared, "c")]),
+        "",
+        "",
+        "def residual_tensors(y, p):",
+        *body(tensor_temps, tensor_reduced, [unpack(states, "y"), unpack(params, "p")]),
+        "",
+        "",
+        "def mass(p):",
+        *body([], list(symbolic.mass), [unpack(params, "p")]),
+        "",
+        "",
+        "def prepare_field(p):",
+        f"    ({', '.join(params)},) = p",
+        *inverse_lines,
+        "    return prepare(p) + [" + ", ".join(field_constants[len(prepared):]) + "]",
+        "",
+        "",
+        "def field(y, f):",
+        *body(used(forces), list(symbolic.v) + accelerations,
+              [unpack(states, "y"), unpack(field_constants, "f")]),
+        "",
+        "",
+        "def field_jacobian(y, f):",
+        *body(used(slopes), upper + lower, [unpack(states, "y"), unpack(field_constants, "f")]),
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def _by_state(expression, states):
+    """``expression`` as a sum of (parameter-only coefficient) x (state factor), the terms
+    with equal state factors summed: common subexpression elimination then finds the
+    coefficients, which ``prepare`` computes once per parameter set."""
+    import sympy as sp
+
+    grouped: dict = {}
+    for term in sp.Add.make_args(expression):
+        coefficient, factor = term.as_independent(*states, as_Add=False)
+        grouped[factor] = grouped.get(factor, 0) + coefficient
+    return sp.Add(*[coefficient * factor for factor, coefficient in grouped.items()])
+
+
+def _needed(results, assignments) -> set:
+    """The temporaries of ``assignments`` that ``results`` use, directly or through others."""
+    definitions = dict(assignments)
+    needed: set = set()
+    todo = [s for e in results for s in getattr(e, "free_symbols", ()) if s in definitions]
+    while todo:
+        symbol = todo.pop()
+        if symbol not in needed:
+            needed.add(symbol)
+            todo += [s for s in definitions[symbol].free_symbols if s in definitions]
+    return needed
+
+
+# ------------------------------------------------------------------------------ loading
+def load(model) -> Numeric:
+    """The numeric functions of ``model``: the cached module, generated first if needed."""
+    path = cache_dir() / "models" / f"{model.name}-{variant_key(model)[:24]}.py"
+    try:
+        text = path.read_text()
+    except FileNotFoundError:
+        text = numeric_source(model)
+        write_atomically(path, text)
+    namespace: dict = {}
+    exec(compile(text, str(path), "exec"), namespace)  # noqa: S102 - whirl's own generated code
+    return Numeric(model.n_states, namespace)
+
+
+def _stack(values, axis: int) -> np.ndarray:
+    return np.stack(np.broadcast_arrays(*values), axis=axis)
+
+
+class Numeric:
+    """dy/dt = [v, M^-1 R], its Jacobian and derivative tensors from a generated module."""
+
+    def __init__(self, n_states: int, module: dict) -> None:
+        self.n = n_states
+        self.n_dof = n_states // 2
+        self.prepare = module["prepare"]
+        self.residual = module["residual"]
+        self.residual_jacobian = module["residual_jacobian"]
+        self.residual_tensors = module["residual_tensors"]
+        self.mass = module["mass"]
+        self.prepare_field, self.field = module["prepare_field"], module["field"]
+        self.field_jacobian = module["field_jacobian"]
+        self.diagonal = bool(module["DIAGONAL_MASS"])
+        self.tensor_index = np.asarray(module["TENSOR_INDEX"], dtype=int)
+
+    def _mass(self, params) -> np.ndarray:
+        """M with the points first: (..., n_dof, n_dof)."""
+        entries = _stack(self.mass(tuple(params)), axis=-1)
+        return entries.reshape(entries.shape[:-1] + (self.n_dof, self.n_dof))
+
+    def _solved(self, mass: np.ndarray, right: np.ndarray) -> np.ndarray:
+        """M^-1 right, points first: ``right`` (..., n_dof, k) -> (..., n_dof, k)."""
+        if self.diagonal:
+            return right / np.diagonal(mass, axis1=-2, axis2=-1)[..., None]
+        batch = np.broadcast_shapes(mass.shape[:-2], right.shape[:-2])
+        return np.linalg.solve(np.broadcast_to(mass, batch + mass.shape[-2:]),
+                               np.broadcast_to(right, batch + right.shape[-2:]))
+
+    def rhs(self, y, params) -> np.ndarray:
+        """dy/dt: (n,) or (n, M), like ``y``/``params`` (P,) or (P, M)."""
+        y = tuple(y)
+        forces = _stack(self.residual(y, self.prepare(tuple(params))), axis=-1)
+        mass = self._mass(params)
+        acceleration = self._solved(mass, forces[..., None])[..., 0]  # (..., n_dof)
+        values = list(y[self.n_dof:]) + [acceleration[..., i] for i in range(self.n_dof)]
+        return _stack(values, axis=0)
+
+    def jacobian(self, y, params) -> np.ndarray:
+        """df/dy: (n, n), or (M, n, n) with M points."""
+        y = tuple(y)
+        entries = _stack(self.residual_jacobian(y, self.prepare(tuple(params))), axis=-1)
+        lower = entries.reshape(entries.shape[:-1] + (self.n_dof, self.n))
+        lower = self._solved(self._mass(params), lower)
+        upper = np.zeros(lower.shape[:-2] + (self.n_dof, self.n))
+        upper[..., np.arange(self.n_dof), self.n_dof + np.arange(self.n_dof)] = 1.0
+        return np.concatenate([upper, lower], axis=-2)
+
+    def tensors(self, y, params) -> tuple[np.ndarray, np.ndarray]:
+        """(d2f/dy2 (n, n, n), d3f/dy3 (n, n, n, n)) at one point."""
+        n, k = self.n, self.n_dof
+        flat = np.zeros(k * n**2 + k * n**3)
+        if len(self.tensor_index):
+            flat[self.tensor_index] = np.array(
+                self.residual_tensors(tuple(y), tuple(params)), dtype=float)
+        inverse = np.linalg.inv(self._mass(params))
+        second = np.zeros((n, n, n))
+        third = np.zeros((n, n, n, n))
+        second[k:] = np.einsum("ij,j...->i...", inverse, flat[:k * n**2].reshape(k, n, n))
+        third[k:] = np.einsum("ij,j...->i...", inverse, flat[k * n**2:].reshape(k, n, n, n))
+        return second, third
+
+    def field_at(self, params):
+        """(f(y), J(y)) for fixed ``params`` (for time integration): the parameter-only work
+        and M^-1 are done once here."""
+        constants = self.prepare_field(tuple(float(v) for v in params))
+        field, field_jacobian, n = self.field, self.field_jacobian, self.n
+
+        def f(y: np.ndarray) -> np.ndarray:
+            return np.array(field(y, constants), dtype=float)
+
+        def jacobian(y: np.ndarray) -> np.ndarray:
+            return np.array(field_jacobian(y, constants), dtype=float).reshape(n, n)
+
+        return f, jacobian

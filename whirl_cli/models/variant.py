@@ -1,0 +1,222 @@
+"""A model variant: a family with a stiffness law on each degree of freedom, as whirl runs it.
+
+Everything here is data and numbers: names, units, bounds, datum values, scales, and the
+numeric right-hand side, Jacobian and derivative tensors, which come from a generated Python
+module (:mod:`whirl_cli.models.numeric`, built from the sympy equations once and cached), so
+that running a study never imports sympy.
+
+Conventions
+-----------
+* The state is y = [q, v]: the dofs in declaration order, then their rates, in SI units; the
+  physical system is dy/dt = f(y, p) with time in seconds.
+* AUTO integrates a non-dimensional version: tau = ``time_scale`` * t and y* = y /
+  ``state_scale``, with each dof scaled by its typical amplitude and each rate by that times
+  ``time_scale``. Hence dy*/dtau = f(S y*, p) / (S * time_scale). Periods from AUTO divide by
+  ``time_scale`` to give seconds; eigenvalues multiply by it to give 1/s; Floquet multipliers
+  are unchanged. Amplitude thresholds are set in these units, so they scale with each dof's
+  typical amplitude.
+* Parameters: the family's, then each law's coefficients named by dof (``K2_theta``), in dof
+  order; all of them travel to AUTO through PAR.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from .declaration import Dof, Family, Parameter, State
+from .laws import LAWS, Law
+
+
+@dataclass(frozen=True)
+class Model:
+    """One variant: ``family`` with the law named ``laws[i]`` on its i-th dof."""
+
+    family: Family
+    laws: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        if len(self.laws) != len(self.family.dofs) or not set(self.laws) <= set(LAWS):
+            raise ValueError(f"model {self.family.name}: one law of {sorted(LAWS)} per dof "
+                             f"{self.family.dof_names}, got {self.laws}")
+        names = [p.name for p in self.parameters]
+        if len(set(names)) != len(names):
+            raise ValueError(f"model {self.name}: law coefficients collide with parameters")
+
+    # ------------------------------------------------------------------ what it is
+    @cached_property
+    def name(self) -> str:
+        """The variant's name, also the AUTO equation name: ``classical_poly`` (one law on
+        every dof) or ``<family>_<law>_<dof>_...``."""
+        shorts = [law.short for law in self.law_objects]
+        if len(set(shorts)) == 1:
+            return f"{self.family.name}_{shorts[0]}"
+        return "_".join([self.family.name, *(f"{s}_{d}" for s, d in
+                                             zip(shorts, self.family.dof_names, strict=True))])
+
+    @property
+    def description(self) -> str:
+        laws = ", ".join(f"{law} on {dof}" for law, dof in zip(self.laws, self.family.dof_names,
+                                                               strict=True))
+        return f"{self.family.description}; {laws}"
+
+    @property
+    def notes(self) -> str:
+        return self.family.notes
+
+    @property
+    def law_objects(self) -> tuple[Law, ...]:
+        return tuple(LAWS[name] for name in self.laws)
+
+    @property
+    def dofs(self) -> tuple[Dof, ...]:
+        return self.family.dofs
+
+    @property
+    def time_scale(self) -> float:
+        return self.family.time_scale
+
+    @property
+    def symmetric(self) -> bool:
+        return self.family.symmetric
+
+    @cached_property
+    def states(self) -> tuple[State, ...]:
+        dofs = self.family.dofs
+        return (tuple(State(d.name, d.unit, d.description) for d in dofs)
+                + tuple(State(d.rate, d.rate_unit, f"rate of {d.name}") for d in dofs))
+
+    @cached_property
+    def state_scale(self) -> tuple[float, ...]:
+        """Physical state = state_scale * AUTO state (see the module doc)."""
+        amplitudes = tuple(float(d.amplitude) for d in self.family.dofs)
+        return amplitudes + tuple(a * self.time_scale for a in amplitudes)
+
+    @cached_property
+    def parameters(self) -> tuple[Parameter, ...]:
+        declared = {p.name: p for p in self.family.parameters}
+        coefficients = tuple(p for dof, law in zip(self.family.dofs, self.law_objects, strict=True)
+                             for p in law.parameters(dof, declared[dof.stiffness]))
+        return self.family.parameters + coefficients
+
+    @cached_property
+    def hub_matrix(self) -> np.ndarray:
+        """(2, n): the hub displacement (y, z) normal to the spin axis is hub_matrix @ state."""
+        matrix = np.zeros((2, self.n_states))
+        for row, terms in enumerate(self.family.hub):
+            for index, factor in terms:
+                matrix[row, index] = factor
+        return matrix
+
+    # ------------------------------------------------------------------ names and lookup
+    @property
+    def n_states(self) -> int:
+        return 2 * len(self.family.dofs)
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        return tuple(s.name for s in self.states)
+
+    @property
+    def parameter_names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.parameters)
+
+    @cached_property
+    def _alias_map(self) -> dict[str, str]:
+        table = {p.name: p.name for p in self.parameters}
+        for p in self.parameters:
+            for a in p.aliases:
+                table[a] = p.name
+        return table
+
+    def canonical(self, name: str) -> str:
+        """Parameter name for ``name`` or one of its aliases; KeyError if unknown."""
+        return self._alias_map[name]
+
+    def known_parameter_names(self) -> tuple[str, ...]:
+        """Every accepted spelling: parameter names and their aliases."""
+        return tuple(sorted(self._alias_map))
+
+    def parameter(self, name: str) -> Parameter:
+        canonical = self.canonical(name)
+        return next(p for p in self.parameters if p.name == canonical)
+
+    def law_on(self, dof: str) -> Law:
+        return self.law_objects[self.family.dof_names.index(dof)]
+
+    def coefficient_names(self, dof: str) -> dict[str, str]:
+        """The law on ``dof``: its study keys and the parameters they become (K2 -> K2_theta)."""
+        law = self.law_on(dof)
+        return {c.key: law.parameter_name(c.key, dof) for c in law.coefficients}
+
+    def law_parameter_names(self) -> frozenset[str]:
+        """Every law coefficient parameter (set in a study's law blocks, not ``parameters``)."""
+        return frozenset(n for d in self.family.dof_names
+                         for n in self.coefficient_names(d).values())
+
+    def defaults(self) -> dict[str, float]:
+        return {p.name: float(p.default) for p in self.parameters}
+
+    def parameter_vector(self, overrides: dict[str, float] | None = None) -> np.ndarray:
+        """Parameter values in declaration order: defaults with ``overrides`` applied."""
+        values = self.defaults()
+        for key, value in (overrides or {}).items():
+            values[self.canonical(key)] = float(value)
+        return np.array([values[p.name] for p in self.parameters], dtype=float)
+
+    def is_linear(self, values: dict[str, float]) -> bool:
+        """True if the equations are linear in the states for these parameter values (canonical
+        names; unset ones at their datum): the family's own terms are, and every law is K x."""
+        if not self.family.linear:
+            return False
+        full = {**self.defaults(), **values}
+        return all(law.is_linear({key: full[name] for key, name in
+                                  self.coefficient_names(dof).items()})
+                   for dof, law in zip(self.family.dof_names, self.law_objects, strict=True))
+
+    # ------------------------------------------------------------------ numbers
+    @cached_property
+    def numeric(self):
+        """The generated numeric functions (:class:`whirl_cli.models.numeric.Numeric`)."""
+        from .numeric import load
+
+        return load(self)
+
+    def rhs_numpy(self, y: np.ndarray, params: np.ndarray) -> np.ndarray:
+        """dy/dt in SI units. ``y``: (n,) or (n, M); ``params``: (P,) or (P, M)."""
+        return self.numeric.rhs(y, params)
+
+    def jacobian_numpy(self, y: np.ndarray, params: np.ndarray) -> np.ndarray:
+        """df/dy in 1/s; (n, n), or (M, n, n) for inputs with a trailing axis of M points."""
+        return self.numeric.jacobian(y, params)
+
+    def derivative_tensors(self, y: np.ndarray, params: np.ndarray
+                           ) -> tuple[np.ndarray, np.ndarray]:
+        """(d2f/dy2, d3f/dy3) at one point, shapes (n, n, n) and (n, n, n, n), SI units:
+        entry [i, j, k(, m)] is the derivative of dy_i/dt by y_j, y_k (and y_m)."""
+        return self.numeric.tensors(y, params)
+
+    def field_at(self, params: np.ndarray):
+        """(f, J): dy/dt (SI) and its Jacobian as fast functions of the state alone, for fixed
+        parameter values (for time integration)."""
+        return self.numeric.field_at(params)
+
+    def describe(self) -> str:
+        """Human-readable summary: states, parameters with defaults, units and bounds."""
+        lines = [f"{self.name}: {self.description}"
+                 + (" [provisional: whirl's own derivation]" if self.family.provisional else "")]
+        lines.append(f"  time scale: tau = {self.time_scale:g} rad/s * t")
+        lines.append("  degrees of freedom: " + ", ".join(
+            f"{d.name} [{d.unit}] (typical amplitude {d.amplitude:g} {d.unit}, stiffness "
+            f"{d.stiffness})" for d in self.family.dofs))
+        lines.append("  states: " + ", ".join(f"{s.name} [{s.unit}]" for s in self.states))
+        lines.append("  parameters:")
+        for p in self.parameters:
+            alias = f" (alias {', '.join(p.aliases)})" if p.aliases else ""
+            lines.append(f"    {p.name:<10} {p.default:<12.6g} {p.unit:<14} {p.description}{alias}"
+                         f"; {p.bounds.text()}")
+        if self.notes:
+            lines.append("  notes: " + self.notes)
+        return "\n".join(lines)
