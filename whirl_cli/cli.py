@@ -116,7 +116,8 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 def check(result_file: Path) -> None:
     """Check the stable orbits and equilibria of a result file by time simulation."""
-    from . import simulate, store
+    from . import store
+    from .analysis import simulate
     from .study import validate_text
 
     result = store.read(result_file)

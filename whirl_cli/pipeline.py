@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import boundaries, linear, simulate
+from .analysis import boundaries, linear, simulate
 from .auto import RunOutcome, interruptible
 from .provenance import provenance
 from .recipes import Engine, Numerics, one_parameter, two_parameter

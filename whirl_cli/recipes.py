@@ -20,11 +20,12 @@ from pathlib import Path
 
 import numpy as np
 
-from . import auto, global_bifurcations
+from . import auto
+from .analysis import global_bifurcations
+from .analysis.normal_form import criticality_of, hopf_lyapunov_coefficient
 from .branches import amplitude, head, join, parse_b, read_branch
 from .codegen import AMPLITUDE, base_constants, fortran_source, par_layout, source_key
 from .models import Model
-from .normal_form import criticality_of, hopf_lyapunov_coefficient
 from .results import Branch, BranchKind, ContinuationResult, PointType, RunRecord, SpecialPoint
 
 #: How deep branch switching recurses (main -> secondary -> tertiary).

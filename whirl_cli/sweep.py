@@ -363,7 +363,8 @@ def prepare_workers(items: Sequence[SweepItem]) -> None:
     imports and sympy work (harmless with other start methods)."""
     import numpy as np
 
-    from . import pipeline, simulate  # noqa: F401  (imported for the workers to inherit)
+    from . import pipeline  # noqa: F401  (imported for the workers to inherit)
+    from .analysis import simulate  # noqa: F401  (imported for the workers to inherit)
 
     for item in items:
         if item.action == RUN and item.study is not None:

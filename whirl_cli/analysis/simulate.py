@@ -15,10 +15,10 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
+from ..interrupts import end_processes, quiet_worker
+from ..models import Model
+from ..results import Branch, BranchKind, CrossCheck, Orbit, PointType
 from .global_bifurcations import BLOWUP_FACTOR
-from .interrupts import end_processes, quiet_worker
-from .models import Model
-from .results import Branch, BranchKind, CrossCheck, Orbit, PointType
 
 #: Relative tolerance on the amplitude for "the simulation stays on the orbit".
 ORBIT_TOLERANCE = 0.01
