@@ -220,26 +220,26 @@ def report_sweeps(figures: SweepFigures, env: dict[str, str]) -> None:
 
 def recompilations_in_process() -> int:
     """``Executable.compiled`` count of a second in-process run of one study (warm cache)."""
-    from whirl_cli import auto
+    from whirl_cli.auto import toolchain
     from whirl_cli.pipeline import run_study
     from whirl_cli.study import load_study
 
     compiled = []
-    original = auto.compile_equations
+    original = toolchain.compile_equations
 
     def counting(*args, **kwargs):
         executable = original(*args, **kwargs)
         compiled.append(executable.compiled)
         return executable
 
-    auto.compile_equations = counting
+    toolchain.compile_equations = counting
     try:
         study = load_study(CHAPTER3 / "linear_case2.yaml")
         for _ in range(2):
             with tempfile.TemporaryDirectory() as work:
                 run_study(study, Path(work))
     finally:
-        auto.compile_equations = original
+        toolchain.compile_equations = original
     return sum(compiled[1:])
 
 

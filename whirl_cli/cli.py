@@ -164,7 +164,7 @@ def validate(study_file: Path) -> None:
               help="Where the generated AUTO files live.")
 def generate(check: bool, directory: Path) -> None:
     """(Re)write the AUTO-07p equation and constants files of every model variant."""
-    from .codegen import drifted, write_generated
+    from .auto.equation_files import drifted, write_generated
 
     if check:
         stale = drifted(directory)
@@ -217,31 +217,31 @@ def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None) -> 
 @cli.command()
 def doctor() -> None:
     """Check gfortran and AUTO-07p: find them, compile a model, run AUTO once."""
-    from . import auto
-    from .codegen import fortran_source
+    from .auto import runner, toolchain
+    from .auto.codegen import fortran_source
     from .models import get_model
     from .recipes import Numerics, equilibrium_constants
 
     problems = []
     click.echo(f"whirl {__version__}, Python {sys.version.split()[0]}")
     try:
-        click.echo(f"gfortran: {auto.gfortran()}")
+        click.echo(f"gfortran: {toolchain.gfortran()}")
     except WhirlError as error:
         problems.append(error.message)
     try:
-        click.echo(f"AUTO-07p: {auto.AUTO_DIR} ({len(auto.runtime_objects())} runtime objects, "
-                   f"package {auto.auto_version()})")
+        click.echo(f"AUTO-07p: {toolchain.AUTO_DIR} ({len(toolchain.runtime_objects())} runtime "
+                   f"objects, package {toolchain.auto_version()})")
     except WhirlError as error:
         problems.append(error.message)
     if not problems:
         model = get_model("classical")
         try:
-            executable = auto.compile_equations(fortran_source(model), model.name)
+            executable = toolchain.compile_equations(fortran_source(model), model.name)
             click.echo(f"compile: ok ({executable.path})")
             constants = equilibrium_constants(model, Numerics(), model.parameters[0].name,
                                               (0.0, 0.5), -1)
             with tempfile.TemporaryDirectory(prefix="whirl-doctor-") as scratch:
-                outcome = auto.run(executable.path, constants, Path(scratch) / "run", "doctor",
+                outcome = runner.run(executable.path, constants, Path(scratch) / "run", "doctor",
                                    timeout=60)
             if outcome.success:
                 click.echo(f"AUTO run: ok ({outcome.n_points} points, "

@@ -127,7 +127,7 @@ def missing_plots(output: Path, kinds: Sequence[str]) -> list[str]:
 def held_signals() -> Iterator[None]:
     """SIGINT and SIGTERM are held back while inside (main thread only; elsewhere a no-op):
     one that arrives is recorded, and raised again on leaving, so that the handler that was
-    in place (Python's KeyboardInterrupt, :func:`whirl_cli.auto.interruptible`'s, or the
+    in place (Python's KeyboardInterrupt, :func:`whirl_cli.auto.runner.interruptible`'s, or the
     default action) deals with it then. (Blocking the signals would not do: the kernel hands
     a process-directed signal to any thread that does not block it.)"""
     if threading.current_thread() is not threading.main_thread():

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from .analysis import boundaries, linear, simulate
-from .auto import RunOutcome, interruptible
+from .auto.runner import RunOutcome, interruptible
 from .provenance import provenance
 from .recipes import Engine, Numerics, one_parameter, two_parameter
 from .results import Boundary, ContinuationResult, StudyResult
@@ -25,7 +25,8 @@ def run_study(study: Study, workroot: Path, jobs: int = 1,
     """Run every continuation and linear sweep of ``study``; AUTO works under ``workroot``.
 
     In the main thread, SIGINT and SIGTERM kill the running AUTO processes at once and raise
-    :class:`whirl_cli.auto.Interrupted` (a KeyboardInterrupt), see :func:`auto.interruptible`.
+    :class:`whirl_cli.interrupts.Interrupted` (a KeyboardInterrupt), see
+    :func:`whirl_cli.auto.runner.interruptible`.
     """
     with interruptible():
         return _run_study(study, workroot, jobs, on_run)

@@ -32,7 +32,7 @@ def code_sha256() -> str:
 def provenance(study) -> dict[str, str]:
     """Root attributes of a result file: versions, the code fingerprint, the study text and
     its hash, the time of creation (UTC) and ``git describe`` where available."""
-    from .auto import auto_version
+    from .auto.toolchain import auto_version
 
     attributes = {
         "whirl_version": __version__,

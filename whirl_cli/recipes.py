@@ -20,11 +20,13 @@ from pathlib import Path
 
 import numpy as np
 
-from . import auto
 from .analysis import global_bifurcations
 from .analysis.normal_form import criticality_of, hopf_lyapunov_coefficient
-from .branches import amplitude, head, join, parse_b, read_branch
-from .codegen import AMPLITUDE, base_constants, fortran_source, par_layout, source_key
+from .auto import runner, toolchain
+from .auto.codegen import fortran_source, source_key
+from .auto.constants import AMPLITUDE, base_constants, par_layout
+from .auto.parse import parse_b, read_branch
+from .continuation.branches import amplitude, head, join
 from .models import Model
 from .results import Branch, BranchKind, ContinuationResult, PointType, RunRecord, SpecialPoint
 
@@ -82,30 +84,30 @@ class Engine:
     """Runs AUTO jobs of one model: compiles once, one directory per run, ``jobs`` in parallel."""
 
     def __init__(self, model: Model, workroot: Path, jobs: int = 1, timeout: float = 120.0,
-                 on_run: Callable[[auto.RunOutcome], None] | None = None) -> None:
+                 on_run: Callable[[runner.RunOutcome], None] | None = None) -> None:
         self.model = model
         self.workroot = Path(workroot)
         self.jobs = max(1, jobs)
         self.timeout = timeout
         self.on_run = on_run
-        self.executable = auto.compile_equations(lambda: fortran_source(model), model.name,
+        self.executable = toolchain.compile_equations(lambda: fortran_source(model), model.name,
                                                  source_key=source_key(model))
-        self.outcomes: dict[str, auto.RunOutcome] = {}
+        self.outcomes: dict[str, runner.RunOutcome] = {}
 
-    def run_many(self, specs: Sequence[RunSpec]) -> list[auto.RunOutcome]:
+    def run_many(self, specs: Sequence[RunSpec]) -> list[runner.RunOutcome]:
         """Execute ``specs`` (independent of each other) and return outcomes in spec order."""
         with ThreadPoolExecutor(max_workers=self.jobs) as pool:
             outcomes = list(pool.map(self._execute, specs))
         return outcomes
 
-    def _execute(self, spec: RunSpec) -> auto.RunOutcome:
+    def _execute(self, spec: RunSpec) -> runner.RunOutcome:
         constants = dict(spec.constants)
         restart_file = None
         if spec.restart is not None:
             source, label = spec.restart
             restart_file = self.outcomes[source].file("s")
             constants["IRS"] = label
-        outcome = auto.run(self.executable.path, constants, self.workroot / spec.name,
+        outcome = runner.run(self.executable.path, constants, self.workroot / spec.name,
                            spec.name.replace("/", "."), restart=restart_file,
                            timeout=self.timeout)
         self.outcomes[outcome.name] = outcome
@@ -288,7 +290,7 @@ def _run_branches(engine: Engine, specs: list[RunSpec], branches: list[Branch],
     return new_points
 
 
-def _failed_branch(model: Model, spec: RunSpec, outcome: auto.RunOutcome) -> Branch:
+def _failed_branch(model: Model, spec: RunSpec, outcome: runner.RunOutcome) -> Branch:
     """An empty branch that records a failed run (status and message kept for the HDF5)."""
     n, p = model.n_states, len(spec.parameter_names)
     return Branch(
@@ -491,7 +493,7 @@ def _homoclinic_run(engine: Engine, name: str, family: Branch, point: SpecialPoi
                    restart=(engine.run_with_label(family.run, label), label))
 
 
-def _homoclinic_verdict(outcome: auto.RunOutcome, point: SpecialPoint, parameter: str,
+def _homoclinic_verdict(outcome: runner.RunOutcome, point: SpecialPoint, parameter: str,
                         bounds: tuple[float, float], time_scale: float) -> SpecialPoint:
     """The special point after a HomCont run: located if the parameter converged."""
     width = bounds[1] - bounds[0]
@@ -621,7 +623,7 @@ def _retry(family: _Family, piece: Branch) -> RunSpec | None:
                    restart=(piece.run.rsplit("+", 1)[-1], int(piece.label[row])))
 
 
-def _read(engine: Engine, spec: RunSpec, outcome: auto.RunOutcome) -> Branch:
+def _read(engine: Engine, spec: RunSpec, outcome: runner.RunOutcome) -> Branch:
     if not outcome.has_output:
         return _failed_branch(engine.model, spec, outcome)
     return read_branch(outcome, engine.model, name=spec.name.split("/", 1)[-1], kind=spec.kind,
@@ -850,7 +852,7 @@ def _trace(engine: Engine, name: str, pair: tuple[str, str],
                                         origin, pair, restart=(source, point.label))))
     outcomes = engine.run_many([spec for _, spec in specs])
     second_stage = []
-    final: list[tuple[int, RunSpec, auto.RunOutcome]] = []
+    final: list[tuple[int, RunSpec, runner.RunOutcome]] = []
     for (kind, spec), outcome in zip(specs, outcomes, strict=True):
         if kind == PointType.LPC and outcome.has_output:
             constants = dict(spec.constants, NMX=min(LOCUS_CHUNK, numerics.max_steps))

@@ -40,7 +40,7 @@ from pathlib import Path
 import h5py
 
 from . import __version__
-from .auto import interruptible
+from .auto.runner import interruptible
 from .errors import StudyError, WhirlError
 from .interrupts import quiet_worker
 from .outputs import missing_plots, publish_plots, publish_study
@@ -191,7 +191,7 @@ _CANCELLED = None
 
 
 def _init_worker(cancelled) -> None:
-    """Initializer of local worker processes: :func:`whirl_cli.auto.quiet_worker` (SIGINT
+    """Initializer of local worker processes: :func:`whirl_cli.interrupts.quiet_worker` (SIGINT
     ignored except inside :func:`whirl_cli.pipeline.run_study`, whose own handler kills the
     running AUTO processes and raises; SIGTERM default; death with the sweep process), and
     ``cancelled`` (an Event) makes tasks still queued return at once."""

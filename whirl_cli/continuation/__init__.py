@@ -1,0 +1,1 @@
+"""Continuation recipes: which AUTO runs to make, in what order, with which constants."""
