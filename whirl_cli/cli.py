@@ -219,8 +219,9 @@ def doctor() -> None:
     """Check gfortran and AUTO-07p: find them, compile a model, run AUTO once."""
     from .auto import runner, toolchain
     from .auto.codegen import fortran_source
+    from .continuation.engine import Numerics
+    from .continuation.equilibria import equilibrium_constants
     from .models import get_model
-    from .recipes import Numerics, equilibrium_constants
 
     problems = []
     click.echo(f"whirl {__version__}, Python {sys.version.split()[0]}")

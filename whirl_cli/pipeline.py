@@ -14,8 +14,10 @@ import numpy as np
 
 from .analysis import boundaries, linear, simulate
 from .auto.runner import RunOutcome, interruptible
+from .continuation.engine import Engine, Numerics
+from .continuation.loci import two_parameter
+from .continuation.one_parameter import one_parameter
 from .provenance import provenance
-from .recipes import Engine, Numerics, one_parameter, two_parameter
 from .results import Boundary, ContinuationResult, StudyResult
 from .study import Study
 

@@ -17,8 +17,10 @@ from scipy.integrate import solve_ivp
 
 from whirl_cli.auto.constants import AMPLITUDE, PERIOD_INDEX, par_layout
 from whirl_cli.auto.parse import parse_b, parse_d, parse_s, read_branch
+from whirl_cli.continuation.engine import Engine, Numerics, RunSpec
+from whirl_cli.continuation.equilibria import equilibrium_constants
+from whirl_cli.continuation.periodic import periodic_constants
 from whirl_cli.models import get_model
-from whirl_cli.recipes import Engine, Numerics, RunSpec, equilibrium_constants, periodic_constants
 from whirl_cli.results import BranchKind, PointType
 
 CASE = {"K2": 10.0, "K3": 0.0, "K_psi": 0.3}

@@ -9,8 +9,9 @@ import pytest
 from whirl_cli.auto import codegen, runner, toolchain
 from whirl_cli.auto.constants import par_layout
 from whirl_cli.auto.parse import parse_b, parse_d, parse_s
+from whirl_cli.continuation.engine import Numerics
+from whirl_cli.continuation.equilibria import equilibrium_constants
 from whirl_cli.models import get_model
-from whirl_cli.recipes import Numerics, equilibrium_constants
 
 
 @pytest.fixture(scope="module")

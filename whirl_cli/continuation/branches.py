@@ -1,4 +1,5 @@
-"""Operations on branches: their first rows, two runs joined into one, the orbit amplitude.
+"""Operations on branches: their first rows, two runs joined into one, the orbit amplitude, the
+special points on them; and notes joined (shared by the recipes).
 """
 
 from __future__ import annotations
@@ -8,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..models import Model
-from ..results import Branch
+from ..results import Branch, PointType, SpecialPoint
 
 
 def head(branch: Branch, rows: int) -> Branch:
@@ -36,4 +37,28 @@ def amplitude(branch: Branch, model: Model) -> np.ndarray:
     non-dimensional units (the PVLS ``amplitude`` output); 0 on equilibria."""
     scale = np.asarray(model.state_scale, dtype=float)
     return ((branch.state_max - branch.state_min) / (2 * scale)).max(axis=1)
+
+
+def special_points(branch: Branch, skip_first: bool = False) -> list[SpecialPoint]:
+    """The bifurcations on ``branch`` (HB, BP, LP, LPC, PD, TR, codim-2 ...)."""
+    found = []
+    for index in range(len(branch)):
+        kind = PointType(int(branch.point_type[index]))
+        if not kind.is_special or (skip_first and index == 0):
+            continue
+        found.append(SpecialPoint(
+            branch=branch.name, index=index, point_type=int(kind),
+            parameter_names=branch.parameter_names, parameters=branch.parameters[index].copy(),
+            state=branch.state_max[index].copy(), period=float(branch.period[index]),
+            stable=bool(branch.stable[index]), label=int(branch.label[index])))
+    return found
+
+
+def _same_point(a: SpecialPoint, b: SpecialPoint, width: float) -> bool:
+    return (abs(a.parameters[0] - b.parameters[0]) <= 1e-5 * width
+            and np.allclose(a.state, b.state, atol=1e-5, rtol=1e-4))
+
+
+def _joined(*notes: str) -> str:
+    return "; ".join(n for n in notes if n)
 
