@@ -181,7 +181,7 @@ def startup_seconds(env: dict[str, str]) -> tuple[float, float]:
     """(``whirl --version``, importing what a worker needs) wall times [s], best of 3."""
     cli = best_of(lambda: run(WHIRL + ["--version"], env))
     imports = best_of(lambda: run([sys.executable, "-c", "import whirl_cli.pipeline, "
-                                   "whirl_cli.analysis.simulate, whirl_cli.store"], env))
+                                   "whirl_cli.analysis.simulate, whirl_cli.output.store"], env))
     return cli, imports
 
 

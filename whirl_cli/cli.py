@@ -93,7 +93,7 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     finally:
         if not keep_runs:
             shutil.rmtree(workroot, ignore_errors=True)
-    from .outputs import publish_study
+    from .output.study_files import publish_study
     from .verdict import verdict
 
     published = publish_study(result, output, study.plots if plots else (), overwrite)
@@ -116,8 +116,8 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 def check(result_file: Path) -> None:
     """Check the stable orbits and equilibria of a result file by time simulation."""
-    from . import store
     from .analysis import simulate
+    from .output import store
     from .study import validate_text
 
     result = store.read(result_file)
@@ -198,7 +198,7 @@ def models() -> None:
               help="Directory for the PNG files [default: next to RESULT_FILE].")
 def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None) -> None:
     """Draw the plots of a whirl result file."""
-    from . import store
+    from .output import store
     from .plots import save_study_plots
 
     result = store.read(result_file)
@@ -308,8 +308,8 @@ def compare(file_a: Path, file_b: Path, rtol: float | None, atol: float | None,
             limit: int, strict: bool) -> None:
     """Compare two result files on physics (special points, branches along the parameter,
     stability, linear sweeps, boundaries), not point indices. Exit 1 on drift."""
-    from .compare import Tolerances
-    from .compare import compare as compare_results
+    from .output.compare import Tolerances
+    from .output.compare import compare as compare_results
 
     found = compare_results(file_a, file_b, Tolerances.from_options(rtol, atol), strict)
     differences = found.differences

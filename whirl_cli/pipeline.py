@@ -1,7 +1,7 @@
 """A whole study, end to end: Study -> model -> AUTO runs + linear analysis -> StudyResult.
 
 ``run_study`` is what ``whirl run`` calls; it does not write files other than AUTO's working
-directories under ``workroot`` (the caller stores the result with :mod:`whirl_cli.store`).
+directories under ``workroot`` (the caller stores the result with :mod:`whirl_cli.output.store`).
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from .auto.runner import RunOutcome, interruptible
 from .continuation.engine import Engine, Numerics
 from .continuation.loci import two_parameter
 from .continuation.one_parameter import one_parameter
-from .provenance import provenance
+from .output.provenance import provenance
 from .results import Boundary, ContinuationResult, StudyResult
 from .study import Study
 

@@ -776,7 +776,7 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
     Names are made filesystem-safe; repeats get ``_2``, ``_3``, ... (:func:`plot_names`).
     Each file is rendered in memory and published complete or not at all (an existing file
     of the same name is replaced). ``whirl run`` and ``whirl sweep`` publish a study's plots
-    together with its HDF5 file instead (:mod:`whirl_cli.outputs`).
+    together with its HDF5 file instead (:mod:`whirl_cli.output.study_files`).
     """
     out_dir = Path(out_dir)
     rendered = render_study_plots(result, kinds, stem, state, dpi)
@@ -784,7 +784,7 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"cannot create plot directory {out_dir}: {exc}") from exc
-    from .store import publish
+    from .output.atomic import publish
 
     return sorted(publish(data, out_dir / name, overwrite=True, what="the plot")
                   for name, data in rendered)

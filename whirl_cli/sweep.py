@@ -13,12 +13,12 @@
   dataclasses, picklable) and writes nothing else.
 * :func:`execute`: submits the planned studies to any ``concurrent.futures.Executor`` (a local
   process pool, or Dask's ``Client.get_executor()``) and, as each finishes, writes its HDF5
-  file and plots as one unit (:func:`whirl_cli.outputs.publish_study`) **in the parent
+  file and plots as one unit (:func:`whirl_cli.output.study_files.publish_study`) **in the parent
   process only**.
 
 Interrupting (Ctrl-C) cancels the studies not started yet, interrupts the running ones (their
 AUTO processes are killed and their working directories removed) and keeps every output
-already written; a study's outputs are never half a set (see :mod:`whirl_cli.outputs`).
+already written; a study's outputs are never half a set (see :mod:`whirl_cli.output.study_files`).
 """
 
 from __future__ import annotations
@@ -43,8 +43,8 @@ from . import __version__
 from .auto.runner import interruptible
 from .errors import StudyError, WhirlError
 from .interrupts import quiet_worker
-from .outputs import missing_plots, publish_plots, publish_study
-from .provenance import code_sha256
+from .output.provenance import code_sha256
+from .output.study_files import missing_plots, publish_plots, publish_study
 from .results import StudyResult
 from .study import Study, load_study
 from .verdict import is_problem, verdict

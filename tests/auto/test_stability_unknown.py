@@ -12,10 +12,11 @@ import h5py
 import numpy as np
 import pytest
 
-from whirl_cli import plots, store
+from whirl_cli import plots
 from whirl_cli.analysis import simulate
 from whirl_cli.analysis.boundaries import unsafe_from_branches
-from whirl_cli.compare import compare_results
+from whirl_cli.output import store
+from whirl_cli.output.compare import compare_results
 from whirl_cli.results import BranchKind
 
 from ..conftest import ROOT
