@@ -199,7 +199,7 @@ def models() -> None:
 def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None) -> None:
     """Draw the plots of a whirl result file."""
     from .output import store
-    from .plots import save_study_plots
+    from .plots.files import save_study_plots
 
     result = store.read(result_file)
     output_dir = output_dir or result_file.parent

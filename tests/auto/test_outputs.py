@@ -104,12 +104,12 @@ def test_a_file_appearing_meanwhile_leaves_no_plots_behind(airspeed, tmp_path, m
 
 
 def test_a_drawing_error_keeps_the_result_and_is_a_problem(tmp_path, monkeypatch):
-    from whirl_cli import plots
+    from whirl_cli.plots import files
 
     def broken(*args, **kwargs):
         raise ZeroDivisionError("a bug in a plot")
 
-    monkeypatch.setattr(plots, "render_study_plots", broken)
+    monkeypatch.setattr(files, "render_study_plots", broken)
     failed = run(AIRSPEED, "-o", tmp_path / "r.h5")
     assert failed.exit_code == 1
     assert "plots: ZeroDivisionError: a bug in a plot" in failed.output

@@ -2,7 +2,7 @@
 
 :func:`publish_study` is how ``whirl run`` and ``whirl sweep`` write a finished study:
 
-1. every plot is rendered in memory first (:func:`whirl_cli.plots.render_study_plots`); if
+1. every plot is rendered in memory first (:func:`whirl_cli.plots.files.render_study_plots`); if
    drawing fails (a bug), the HDF5 file is still published, alone, and the error reported
    (the result is not lost, and a sweep draws the missing plots again next time);
 2. without ``overwrite`` nothing is written if the HDF5 file or any of the plot files exists
@@ -52,7 +52,7 @@ def publish_study(result: StudyResult, output: Path, kinds: Sequence[str],
     output = Path(output)
     plots, plot_error = [], ""
     if kinds:
-        from ..plots import render_study_plots
+        from ..plots.files import render_study_plots
 
         try:
             plots = render_study_plots(result, tuple(kinds), output.stem)
@@ -86,7 +86,7 @@ def publish_study(result: StudyResult, output: Path, kinds: Sequence[str],
 def publish_plots(output: Path, kinds: Sequence[str]) -> tuple[Path, ...]:
     """Draw the plots of ``kinds`` of the existing result ``output`` next to it (replacing
     files of the same names): how a sweep completes an up-to-date study's plots."""
-    from ..plots import render_study_plots
+    from ..plots.files import render_study_plots
 
     rendered = render_study_plots(store.read(output), tuple(kinds), Path(output).stem)
     with held_signals():
@@ -117,7 +117,7 @@ def missing_plots(output: Path, kinds: Sequence[str]) -> list[str]:
         return []
     names = recorded_plots(output)
     if not names:
-        from ..plots import plot_names
+        from ..plots.files import plot_names
 
         names = tuple(plot_names(store.read(output), tuple(kinds), Path(output).stem))
     return [name for name in names if not (Path(output).parent / name).exists()]
