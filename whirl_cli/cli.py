@@ -277,7 +277,7 @@ def sweep(paths: tuple[Path, ...], out_dir: Path, jobs: int, dask_address: str |
     Resumable: a study whose output has the same study_sha256 and whirl_version is skipped.
     Exit 1 if any study failed (the others still run), 130 on Ctrl-C, 143 on SIGTERM.
     """
-    from .sweep import run_sweep
+    from .sweep.run import run_sweep
 
     try:
         tally = run_sweep(paths, out_dir, jobs=jobs, dask_address=dask_address, force=force,

@@ -13,7 +13,7 @@ from click.testing import CliRunner
 from whirl_cli.cli import cli
 from whirl_cli.errors import OutputError
 from whirl_cli.output import atomic, store, study_files
-from whirl_cli.sweep import PLOT, SKIP, plan
+from whirl_cli.sweep.plan import PLOT, SKIP, plan
 
 from ..conftest import STUDIES
 
