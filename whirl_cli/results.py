@@ -2,8 +2,8 @@
 
 All are frozen dataclasses holding numpy columns (one array per quantity, one row per point), in
 SI units with physical time: angles in rad, rates in rad/s, periods in s, eigenvalues in 1/s.
-``branches.py`` builds them from AUTO's files, ``store.py`` writes and reads them, ``plots.py``
-draws them; none of those modules change them.
+``auto/parse.py`` builds them from AUTO's files, ``output/store.py`` writes and reads them,
+``plots/`` draws them; none of those modules change them.
 """
 
 from __future__ import annotations
