@@ -7,8 +7,8 @@
 (b) parallel sweep: the same sweep (``--no-plots``) with 1 and 2 worker processes.
 (c) recompilations: a cold compile cache, then a ``--force`` re-run: new cache entries
     (compiled executables, ``Executable.compiled``) on the re-run.
-(d) linear analysis: ``whirl_cli.linear.sweep`` over 2000 airspeeds at once against a Python
-    loop calling it point by point, and ``linear.grid`` over 400 x 400 (K_theta, K_psi)
+(d) linear analysis: ``whirl_cli.analysis.linear.sweep`` over 2000 airspeeds at once against a
+    Python loop calling it point by point, and ``linear.grid`` over 400 x 400 (K_theta, K_psi)
     against a per-point loop.
 (e) ``whirl run`` wall time of every chapter-3 case (plots and cross-checks as the studies
     ask), warm cache.
@@ -19,7 +19,7 @@
     fold K1_LPC and not above it, where the origin is the only attractor nearby. A test at K1
     starts on the stable LCO found at the last K1 known to have one (its point of maximum
     pitch; in max-pitch terms just inside the stable orbit at K1, which grows towards the
-    fold) and integrates with ``whirl_cli.simulate.integrate`` (LSODA, rtol 1e-8) in chunks
+    fold) and integrates with ``whirl_cli.analysis.simulate.integrate`` (LSODA, rtol 1e-8) in chunks
     of 10 periods: "decays" as soon as the pitch amplitude over a chunk falls below half the
     start's, "ends on an LCO" if it survives ``D`` periods. Near the fold the decay lingers in
     the ghost of the vanished cycles (150 periods at 1e-4 above it), so ``D`` bounds the
@@ -181,7 +181,7 @@ def startup_seconds(env: dict[str, str]) -> tuple[float, float]:
     """(``whirl --version``, importing what a worker needs) wall times [s], best of 3."""
     cli = best_of(lambda: run(WHIRL + ["--version"], env))
     imports = best_of(lambda: run([sys.executable, "-c", "import whirl_cli.pipeline, "
-                                   "whirl_cli.simulate, whirl_cli.store"], env))
+                                   "whirl_cli.analysis.simulate, whirl_cli.output.store"], env))
     return cli, imports
 
 
@@ -220,32 +220,32 @@ def report_sweeps(figures: SweepFigures, env: dict[str, str]) -> None:
 
 def recompilations_in_process() -> int:
     """``Executable.compiled`` count of a second in-process run of one study (warm cache)."""
-    from whirl_cli import auto
+    from whirl_cli.auto import toolchain
     from whirl_cli.pipeline import run_study
     from whirl_cli.study import load_study
 
     compiled = []
-    original = auto.compile_equations
+    original = toolchain.compile_equations
 
     def counting(*args, **kwargs):
         executable = original(*args, **kwargs)
         compiled.append(executable.compiled)
         return executable
 
-    auto.compile_equations = counting
+    toolchain.compile_equations = counting
     try:
         study = load_study(CHAPTER3 / "linear_case2.yaml")
         for _ in range(2):
             with tempfile.TemporaryDirectory() as work:
                 run_study(study, Path(work))
     finally:
-        auto.compile_equations = original
+        toolchain.compile_equations = original
     return sum(compiled[1:])
 
 
 # ------------------------------------------------------------------------------ (d)
 def linear_figures(points: int = 2000) -> None:
-    from whirl_cli import linear
+    from whirl_cli.analysis import linear
     from whirl_cli.study import load_study
 
     heading(f"(d) linear analysis over {points} airspeeds: vectorised vs a per-point loop")
@@ -264,7 +264,7 @@ def grid_figures(model, overrides, size: int = 400) -> None:
     """``linear.grid`` (max real part over a size x size K_theta-K_psi grid, one batched
     eigenvalue call, and its zero contour) against a per-point loop computing the same max
     real part (Jacobian and ``numpy.linalg.eigvals`` at each point)."""
-    from whirl_cli import linear
+    from whirl_cli.analysis import linear
 
     axis = np.linspace(0.0, 0.6, size)
     vectorised = best_of(lambda: linear.grid(model, overrides, "K_theta", axis, "K_psi", axis))
@@ -333,7 +333,7 @@ class FoldBySimulation:
                       ) -> tuple[bool, np.ndarray]:
         """(True, a state of maximum pitch on the cycle) if the trajectory from ``start`` at
         ``k1`` survives ``periods`` periods; (False, start) once it decays."""
-        from whirl_cli.simulate import integrate
+        from whirl_cli.analysis.simulate import integrate
 
         params = self.model.parameter_vector({**self.overrides, "K1": k1})
         amplitude, state, chunk = abs(start[0]), start, 10

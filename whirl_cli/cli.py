@@ -93,7 +93,7 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     finally:
         if not keep_runs:
             shutil.rmtree(workroot, ignore_errors=True)
-    from .outputs import publish_study
+    from .output.study_files import publish_study
     from .verdict import verdict
 
     published = publish_study(result, output, study.plots if plots else (), overwrite)
@@ -116,7 +116,8 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 def check(result_file: Path) -> None:
     """Check the stable orbits and equilibria of a result file by time simulation."""
-    from . import simulate, store
+    from .analysis import simulate
+    from .output import store
     from .study import validate_text
 
     result = store.read(result_file)
@@ -163,7 +164,7 @@ def validate(study_file: Path) -> None:
               help="Where the generated AUTO files live.")
 def generate(check: bool, directory: Path) -> None:
     """(Re)write the AUTO-07p equation and constants files of every model variant."""
-    from .codegen import drifted, write_generated
+    from .auto.equation_files import drifted, write_generated
 
     if check:
         stale = drifted(directory)
@@ -197,8 +198,8 @@ def models() -> None:
               help="Directory for the PNG files [default: next to RESULT_FILE].")
 def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None) -> None:
     """Draw the plots of a whirl result file."""
-    from . import store
-    from .plots import save_study_plots
+    from .output import store
+    from .plots.files import save_study_plots
 
     result = store.read(result_file)
     output_dir = output_dir or result_file.parent
@@ -216,31 +217,32 @@ def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None) -> 
 @cli.command()
 def doctor() -> None:
     """Check gfortran and AUTO-07p: find them, compile a model, run AUTO once."""
-    from . import auto
-    from .codegen import fortran_source
+    from .auto import runner, toolchain
+    from .auto.codegen import fortran_source
+    from .continuation.engine import Numerics
+    from .continuation.equilibria import equilibrium_constants
     from .models import get_model
-    from .recipes import Numerics, equilibrium_constants
 
     problems = []
     click.echo(f"whirl {__version__}, Python {sys.version.split()[0]}")
     try:
-        click.echo(f"gfortran: {auto.gfortran()}")
+        click.echo(f"gfortran: {toolchain.gfortran()}")
     except WhirlError as error:
         problems.append(error.message)
     try:
-        click.echo(f"AUTO-07p: {auto.AUTO_DIR} ({len(auto.runtime_objects())} runtime objects, "
-                   f"package {auto.auto_version()})")
+        click.echo(f"AUTO-07p: {toolchain.AUTO_DIR} ({len(toolchain.runtime_objects())} runtime "
+                   f"objects, package {toolchain.auto_version()})")
     except WhirlError as error:
         problems.append(error.message)
     if not problems:
         model = get_model("classical")
         try:
-            executable = auto.compile_equations(fortran_source(model), model.name)
+            executable = toolchain.compile_equations(fortran_source(model), model.name)
             click.echo(f"compile: ok ({executable.path})")
             constants = equilibrium_constants(model, Numerics(), model.parameters[0].name,
                                               (0.0, 0.5), -1)
             with tempfile.TemporaryDirectory(prefix="whirl-doctor-") as scratch:
-                outcome = auto.run(executable.path, constants, Path(scratch) / "run", "doctor",
+                outcome = runner.run(executable.path, constants, Path(scratch) / "run", "doctor",
                                    timeout=60)
             if outcome.success:
                 click.echo(f"AUTO run: ok ({outcome.n_points} points, "
@@ -275,7 +277,7 @@ def sweep(paths: tuple[Path, ...], out_dir: Path, jobs: int, dask_address: str |
     Resumable: a study whose output has the same study_sha256 and whirl_version is skipped.
     Exit 1 if any study failed (the others still run), 130 on Ctrl-C, 143 on SIGTERM.
     """
-    from .sweep import run_sweep
+    from .sweep.run import run_sweep
 
     try:
         tally = run_sweep(paths, out_dir, jobs=jobs, dask_address=dask_address, force=force,
@@ -306,8 +308,8 @@ def compare(file_a: Path, file_b: Path, rtol: float | None, atol: float | None,
             limit: int, strict: bool) -> None:
     """Compare two result files on physics (special points, branches along the parameter,
     stability, linear sweeps, boundaries), not point indices. Exit 1 on drift."""
-    from .compare import Tolerances
-    from .compare import compare as compare_results
+    from .output.compare import Tolerances
+    from .output.compare import compare as compare_results
 
     found = compare_results(file_a, file_b, Tolerances.from_options(rtol, atol), strict)
     differences = found.differences

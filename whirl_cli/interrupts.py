@@ -1,7 +1,7 @@
 """Interrupts and worker processes: what every part of whirl that forks or stops shares.
 
 * :class:`Interrupted` is the KeyboardInterrupt whirl raises for SIGINT and SIGTERM (see
-  :func:`whirl_cli.auto.interruptible`); it survives pickling, so it can travel back from a
+  :func:`whirl_cli.auto.runner.interruptible`); it survives pickling, so it can travel back from a
   worker process.
 * :func:`quiet_worker` is the initializer of every worker process whirl forks (cross-check
   simulations, sweep studies); :func:`end_processes` ends such workers after an interrupt.

@@ -1,7 +1,7 @@
 """A whole study, end to end: Study -> model -> AUTO runs + linear analysis -> StudyResult.
 
 ``run_study`` is what ``whirl run`` calls; it does not write files other than AUTO's working
-directories under ``workroot`` (the caller stores the result with :mod:`whirl_cli.store`).
+directories under ``workroot`` (the caller stores the result with :mod:`whirl_cli.output.store`).
 """
 
 from __future__ import annotations
@@ -12,10 +12,12 @@ from pathlib import Path
 
 import numpy as np
 
-from . import boundaries, linear, simulate
-from .auto import RunOutcome, interruptible
-from .provenance import provenance
-from .recipes import Engine, Numerics, one_parameter, two_parameter
+from .analysis import boundaries, linear, simulate
+from .auto.runner import RunOutcome, interruptible
+from .continuation.engine import Engine, Numerics
+from .continuation.loci import two_parameter
+from .continuation.one_parameter import one_parameter
+from .output.provenance import provenance
 from .results import Boundary, ContinuationResult, StudyResult
 from .study import Study
 
@@ -25,7 +27,8 @@ def run_study(study: Study, workroot: Path, jobs: int = 1,
     """Run every continuation and linear sweep of ``study``; AUTO works under ``workroot``.
 
     In the main thread, SIGINT and SIGTERM kill the running AUTO processes at once and raise
-    :class:`whirl_cli.auto.Interrupted` (a KeyboardInterrupt), see :func:`auto.interruptible`.
+    :class:`whirl_cli.interrupts.Interrupted` (a KeyboardInterrupt), see
+    :func:`whirl_cli.auto.runner.interruptible`.
     """
     with interruptible():
         return _run_study(study, workroot, jobs, on_run)

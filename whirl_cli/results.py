@@ -2,8 +2,8 @@
 
 All are frozen dataclasses holding numpy columns (one array per quantity, one row per point), in
 SI units with physical time: angles in rad, rates in rad/s, periods in s, eigenvalues in 1/s.
-``branches.py`` builds them from AUTO's files, ``store.py`` writes and reads them, ``plots.py``
-draws them; none of those modules change them.
+``auto/parse.py`` builds them from AUTO's files, ``output/store.py`` writes and reads them,
+``plots/`` draws them; none of those modules change them.
 """
 
 from __future__ import annotations
@@ -175,7 +175,7 @@ class SpecialPoint:
     the relative fit residual). ``criticality``: "supercritical" | "subcritical" | "" (Hopf
     points: from the periodic family leaving it, else from ``lyapunov``). ``lyapunov``: first
     Lyapunov coefficient of a Hopf point of equilibria [1/(s unit^2), SI states; < 0
-    supercritical], NaN otherwise (see :mod:`whirl_cli.normal_form`).
+    supercritical], NaN otherwise (see :mod:`whirl_cli.analysis.normal_form`).
     """
 
     branch: str
@@ -285,7 +285,7 @@ class RunRecord:
 
 @dataclass(frozen=True)
 class CrossCheck:
-    """One time-simulation check of a point of a branch (``whirl_cli.simulate``).
+    """One time-simulation check of a point of a branch (``whirl_cli.analysis.simulate``).
 
     ``kind``: "orbit" (expected/simulated: max over the orbit of the state the stiffness law
     acts on, SI units) or "equilibrium" (expected: initial perturbation, simulated: final

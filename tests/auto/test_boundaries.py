@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from whirl_cli import boundaries, linear, simulate
+from whirl_cli.analysis import boundaries, linear, simulate
 from whirl_cli.models import get_model
 from whirl_cli.pipeline import run_study
 from whirl_cli.results import BranchKind

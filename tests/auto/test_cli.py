@@ -6,8 +6,8 @@ import h5py
 import numpy as np
 from click.testing import CliRunner
 
-from whirl_cli import store
 from whirl_cli.cli import cli
+from whirl_cli.output import store
 
 from ..conftest import STUDIES
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from whirl_cli import linear
+from whirl_cli.analysis import linear
 from whirl_cli.models import get_model
 from whirl_cli.results import PointType
 

@@ -10,10 +10,10 @@ import h5py
 import pytest
 from click.testing import CliRunner
 
-from whirl_cli import outputs, store
 from whirl_cli.cli import cli
 from whirl_cli.errors import OutputError
-from whirl_cli.sweep import PLOT, SKIP, plan
+from whirl_cli.output import atomic, store, study_files
+from whirl_cli.sweep.plan import PLOT, SKIP, plan
 
 from ..conftest import STUDIES
 
@@ -40,7 +40,7 @@ def airspeed(tmp_path_factory):
 def test_the_hdf5_file_records_its_plots(airspeed):
     directory, result = airspeed
     assert names(directory) == ["r.h5", "r_airspeed_bifurcation.png", "r_linear_V.png"]
-    assert outputs.recorded_plots(directory / "r.h5") == ("r_airspeed_bifurcation.png",
+    assert study_files.recorded_plots(directory / "r.h5") == ("r_airspeed_bifurcation.png",
                                                           "r_linear_V.png")
 
 
@@ -64,7 +64,7 @@ def test_overwrite_removes_the_plots_of_the_old_result(tmp_path):
     again = run(fewer, "-o", tmp_path / "r.h5", "--overwrite")
     assert again.exit_code == 0, again.output
     assert names(tmp_path) == ["fewer.yaml", "r.h5", "r_linear_V.png"]
-    assert outputs.recorded_plots(tmp_path / "r.h5") == ("r_linear_V.png",)
+    assert study_files.recorded_plots(tmp_path / "r.h5") == ("r_linear_V.png",)
 
 
 def test_an_interrupt_while_publishing_is_held_until_the_set_is_complete(
@@ -72,7 +72,7 @@ def test_an_interrupt_while_publishing_is_held_until_the_set_is_complete(
     """SIGINT arriving between the first plot and the HDF5 file: every output appears, then
     the interrupt is raised (whirl exits 130 with a complete set, not half of one)."""
     _, result = airspeed
-    real = store.publish
+    real = atomic.publish
     sent = []
 
     def publish_and_interrupt(*args, **kwargs):
@@ -80,9 +80,9 @@ def test_an_interrupt_while_publishing_is_held_until_the_set_is_complete(
             sent.append(os.kill(os.getpid(), signal.SIGINT))
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(store, "publish", publish_and_interrupt)
+    monkeypatch.setattr(atomic, "publish", publish_and_interrupt)
     with pytest.raises(KeyboardInterrupt):
-        outputs.publish_study(result, tmp_path / "r.h5", ("bifurcation", "linear"))
+        study_files.publish_study(result, tmp_path / "r.h5", ("bifurcation", "linear"))
     assert sent and names(tmp_path) == ["r.h5", "r_airspeed_bifurcation.png", "r_linear_V.png"]
     assert store.read(tmp_path / "r.h5").study_name == result.study_name
 
@@ -99,22 +99,22 @@ def test_a_file_appearing_meanwhile_leaves_no_plots_behind(airspeed, tmp_path, m
 
     monkeypatch.setattr(store, "write", appear_first)
     with pytest.raises(OutputError, match="output exists"):
-        outputs.publish_study(result, tmp_path / "r.h5", ("bifurcation", "linear"))
+        study_files.publish_study(result, tmp_path / "r.h5", ("bifurcation", "linear"))
     assert names(tmp_path) == ["r.h5"] and (tmp_path / "r.h5").read_bytes() == b"another run"
 
 
 def test_a_drawing_error_keeps_the_result_and_is_a_problem(tmp_path, monkeypatch):
-    from whirl_cli import plots
+    from whirl_cli.plots import files
 
     def broken(*args, **kwargs):
         raise ZeroDivisionError("a bug in a plot")
 
-    monkeypatch.setattr(plots, "render_study_plots", broken)
+    monkeypatch.setattr(files, "render_study_plots", broken)
     failed = run(AIRSPEED, "-o", tmp_path / "r.h5")
     assert failed.exit_code == 1
     assert "plots: ZeroDivisionError: a bug in a plot" in failed.output
     assert names(tmp_path) == ["r.h5"]
-    assert outputs.recorded_plots(tmp_path / "r.h5") == ()
+    assert study_files.recorded_plots(tmp_path / "r.h5") == ()
 
 
 def test_a_sweep_completes_missing_plots_without_rerunning(tmp_path):

@@ -1,4 +1,4 @@
-"""The parser (``whirl_cli.branches``) on the files real AUTO-07p has just written, checked
+"""The parser (``whirl_cli.auto.parse``) on the files real AUTO-07p has just written, checked
 against facts that do not come from the parser: the b-file rows at labelled points against the
 s-file solutions of the same label (parameters, type, the states of equilibria, and for
 periodic orbits the max/min/amplitude PVLS columns against the max/min of the s-file profile),
@@ -15,10 +15,12 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from whirl_cli.branches import parse_b, parse_d, parse_s, read_branch
-from whirl_cli.codegen import AMPLITUDE, PERIOD_INDEX, par_layout
+from whirl_cli.auto.constants import AMPLITUDE, PERIOD_INDEX, par_layout
+from whirl_cli.auto.parse import parse_b, parse_d, parse_s, read_branch
+from whirl_cli.continuation.engine import Engine, Numerics, RunSpec
+from whirl_cli.continuation.equilibria import equilibrium_constants
+from whirl_cli.continuation.periodic import periodic_constants
 from whirl_cli.models import get_model
-from whirl_cli.recipes import Engine, Numerics, RunSpec, equilibrium_constants, periodic_constants
 from whirl_cli.results import BranchKind, PointType
 
 CASE = {"K2": 10.0, "K3": 0.0, "K_psi": 0.3}

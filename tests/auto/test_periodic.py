@@ -9,7 +9,7 @@ from functools import cache
 import numpy as np
 import pytest
 
-from whirl_cli import linear, simulate
+from whirl_cli.analysis import linear, simulate
 from whirl_cli.models import get_model
 from whirl_cli.pipeline import run_study
 from whirl_cli.results import BranchKind, PointType

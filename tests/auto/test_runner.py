@@ -6,10 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from whirl_cli import auto, codegen
-from whirl_cli.branches import parse_b, parse_d, parse_s
+from whirl_cli.auto import codegen, runner, toolchain
+from whirl_cli.auto.constants import par_layout
+from whirl_cli.auto.parse import parse_b, parse_d, parse_s
+from whirl_cli.continuation.engine import Numerics
+from whirl_cli.continuation.equilibria import equilibrium_constants
 from whirl_cli.models import get_model
-from whirl_cli.recipes import Numerics, equilibrium_constants
 
 
 @pytest.fixture(scope="module")
@@ -19,7 +21,7 @@ def model():
 
 @pytest.fixture(scope="module")
 def executable(model):
-    return auto.compile_equations(lambda: codegen.fortran_source(model), model.name,
+    return toolchain.compile_equations(lambda: codegen.fortran_source(model), model.name,
                                   codegen.source_key(model))
 
 
@@ -30,7 +32,7 @@ def constants(model):
 
 
 def test_compiled_once_then_cached(model, executable):
-    again = auto.compile_equations(lambda: pytest.fail("source regenerated"), model.name,
+    again = toolchain.compile_equations(lambda: pytest.fail("source regenerated"), model.name,
                                    codegen.source_key(model))
     assert again.path == executable.path and not again.compiled
 
@@ -38,7 +40,7 @@ def test_compiled_once_then_cached(model, executable):
 def test_successful_run_and_parser_round_trip(executable, constants, tmp_path, model):
     """Every labelled b-file row has its s-file solution with the same parameters and state,
     and every accepted point has its eigenvalue block in the d-file."""
-    outcome = auto.run(executable.path, constants, tmp_path / "run", "ep")
+    outcome = runner.run(executable.path, constants, tmp_path / "run", "ep")
     assert outcome.status == "ok" and outcome.returncode == 0
     assert not (tmp_path / "run" / "fort.2").exists()
     (segment,) = parse_b(outcome.file("b").read_text())
@@ -46,7 +48,7 @@ def test_successful_run_and_parser_round_trip(executable, constants, tmp_path, m
     points, _ = parse_d(outcome.file("d").read_text())
     assert len(segment.pt) == outcome.n_points
     assert [s.lab for s in solutions] == [int(x) for x in segment.lab if x]
-    layout = codegen.par_layout(model)
+    layout = par_layout(model)
     for solution in solutions:
         row = int(np.flatnonzero(segment.lab == solution.lab)[0])
         assert solution.ty == segment.ty[row]
@@ -68,7 +70,7 @@ def test_analytic_jacobian_agrees_with_finite_differences(executable, constants,
     Hopf and branch points."""
     found = {}
     for jac in (1, 0):
-        outcome = auto.run(executable.path, constants | {"JAC": jac}, tmp_path / f"j{jac}", "j")
+        outcome = runner.run(executable.path, constants | {"JAC": jac}, tmp_path / f"j{jac}", "j")
         (segment,) = parse_b(outcome.file("b").read_text())
         special = np.isin(segment.ty, (1, 3))
         found[jac] = segment.column("K1")[special]
@@ -86,7 +88,7 @@ def test_analytic_jacobian_agrees_with_finite_differences(executable, constants,
 ])
 def test_failures_are_reported_not_hidden(executable, constants, tmp_path, change, status,
                                           message):
-    outcome = auto.run(executable.path, constants | change, tmp_path / "run", "bad",
+    outcome = runner.run(executable.path, constants | change, tmp_path / "run", "bad",
                        timeout=0.5)
     assert outcome.status == status and not outcome.success
     assert message in outcome.message
@@ -98,4 +100,4 @@ def test_a_stale_fort2_cannot_leak_into_a_run(executable, constants, tmp_path):
     workdir.mkdir()
     (workdir / "fort.2").write_text("NDIM = 3\n")
     with pytest.raises(FileExistsError):
-        auto.run(executable.path, constants, workdir, "ep")
+        runner.run(executable.path, constants, workdir, "ep")

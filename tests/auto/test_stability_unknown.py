@@ -12,9 +12,12 @@ import h5py
 import numpy as np
 import pytest
 
-from whirl_cli import plots, simulate, store
-from whirl_cli.boundaries import unsafe_from_branches
-from whirl_cli.compare import compare_results
+from whirl_cli.analysis import simulate
+from whirl_cli.analysis.boundaries import unsafe_from_branches
+from whirl_cli.output import store
+from whirl_cli.output.compare import compare_results
+from whirl_cli.plots.diagrams import bifurcation_diagram, period_plot
+from whirl_cli.plots.key import PLOT_KEY, stability_segments
 from whirl_cli.results import BranchKind
 
 from ..conftest import ROOT
@@ -73,13 +76,13 @@ def _has_vertex(line, xy) -> bool:
 @pytest.mark.parametrize("kind", ["bifurcation", "period"])
 def test_no_unstable_stub_is_drawn_at_the_hopf_point(continuation, kind):
     if kind == "bifurcation":
-        figure = plots.bifurcation_diagram(continuation)
+        figure = bifurcation_diagram(continuation)
         y = {b.name: np.degrees(b.state("theta", "max")) for b in periodic(continuation)}
     else:
-        figure = plots.period_plot(continuation)
+        figure = period_plot(continuation)
         y = {b.name: b.period for b in periodic(continuation)}
     (ax,) = figure.axes
-    styles = {key: (plots.PLOT_KEY[key]["color"], plots.PLOT_KEY[key]["linestyle"])
+    styles = {key: (PLOT_KEY[key]["color"], PLOT_KEY[key]["linestyle"])
               for key in ("stable_periodic", "unstable_periodic")}
     lines = {key: [line for line in ax.lines
                    if (line.get_color(), line.get_linestyle()) == style]
@@ -99,11 +102,11 @@ def test_stability_segments_let_unknown_points_join_their_neighbours():
     x = np.arange(7.0)
     stable = np.array([0, 1, 1, 0, 0, 0, 1], bool)
     known = np.array([0, 1, 1, 1, 0, 1, 1], bool)
-    segments = plots.stability_segments(x, x, stable, known)
+    segments = stability_segments(x, x, stable, known)
     assert [(list(xs), s) for xs, _, s in segments] == [
         ([0, 1, 2, 3], True), ([3, 4, 5, 6], False), ([6], True)]
-    assert [s for *_, s in plots.stability_segments(x, x, stable)] == [False, True, False, True]
-    nothing = plots.stability_segments(x, x, stable, np.zeros(7, bool))
+    assert [s for *_, s in stability_segments(x, x, stable)] == [False, True, False, True]
+    nothing = stability_segments(x, x, stable, np.zeros(7, bool))
     assert [s for *_, s in nothing] == [False, True, False, True]  # AUTO's flags as they are
 
 

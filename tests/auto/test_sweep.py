@@ -14,12 +14,14 @@ import h5py
 import pytest
 from click.testing import CliRunner
 
-from whirl_cli import __version__, store
+from whirl_cli import __version__
 from whirl_cli.cli import cli
-from whirl_cli.compare import compare_files
 from whirl_cli.errors import WhirlError
-from whirl_cli.provenance import code_sha256
-from whirl_cli.sweep import INVALID, RUN, SKIP, dask_pool, find_studies, plan
+from whirl_cli.output import store
+from whirl_cli.output.compare import compare_files
+from whirl_cli.output.provenance import code_sha256
+from whirl_cli.sweep.executors import dask_pool
+from whirl_cli.sweep.plan import INVALID, RUN, SKIP, find_studies, plan
 
 from ..conftest import ROOT, STUDIES
 

@@ -14,9 +14,9 @@ import h5py
 import pytest
 from click.testing import CliRunner
 
-from whirl_cli import store
 from whirl_cli.cli import cli
-from whirl_cli.compare import compare_files
+from whirl_cli.output import store
+from whirl_cli.output.compare import compare_files
 from whirl_cli.pipeline import run_study
 from whirl_cli.study import load_study
 

@@ -5,7 +5,7 @@ and the other continuations intact, and ``whirl run`` exits 1 naming the failed 
 Provoked with real study settings where one exists: no convergence (MX) and a hanging run
 (timeout) from too tight a Newton tolerance on the secondary branches, NaN from a continuation
 that starts at zero inertia. A crash needs constants no study can write (a wrong NDIM): the
-testing hook WHIRL_AUTO_EXTRA_CONSTANTS (whirl_cli/auto.py) provides them. Missing gfortran
+testing hook WHIRL_AUTO_EXTRA_CONSTANTS (whirl_cli/auto/runner.py) provides them. Missing gfortran
 or AUTO-07p are run through the console script with a stripped environment.
 """
 

@@ -1,6 +1,6 @@
 """Bad study files through the real CLI: every mutation of a valid study is refused before any
 AUTO run with exit status 1, no traceback, a message naming the file, line and key path (or
-one of the whole-file forms of study.py), and no output file.
+one of the whole-file forms of whirl_cli/study), and no output file.
 
 The seeds are the thesis studies (studies/thesis_ch3/*.yaml); hypothesis picks a seed, a kind
 of mutation and where to apply it. The number of cases tried is printed with the test.

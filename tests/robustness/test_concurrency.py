@@ -2,7 +2,7 @@
 ``--jobs 2``, sharing an EMPTY compile cache (both compile the same model variant at once) and
 one ``--keep-runs`` directory. Neither corrupts the other: each run has its own directory
 with its own constants, both outputs are right (Hopf points equal to the eigenvalue ones of
-whirl_cli.linear.critical_points), and the cache ends with exactly one executable for the
+whirl_cli.analysis.linear.critical_points), and the cache ends with exactly one executable for the
 variant and no half-built entries."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import h5py
 import numpy as np
 import pytest
 
-from whirl_cli.linear import critical_points
+from whirl_cli.analysis.linear import critical_points
 from whirl_cli.study import load_study
 
 from .helpers import STUDIES, WHIRL, environment

@@ -22,7 +22,8 @@ import pytest
 import yaml
 from click.testing import CliRunner
 
-from whirl_cli import codegen
+from whirl_cli.auto import codegen
+from whirl_cli.auto.constants import constants_text
 from whirl_cli.cli import cli
 from whirl_cli.errors import CodegenError
 from whirl_cli.models import all_variants
@@ -190,7 +191,7 @@ def test_generated_fortran_refuses_line_breaks_and_non_finite_numbers():
 ])
 def test_constants_writer_refuses_what_could_break_a_line(constants):
     with pytest.raises(CodegenError):
-        codegen.constants_text(constants)
+        constants_text(constants)
 
 
 # ------------------------------------------------------------------------------ shells

@@ -23,9 +23,10 @@ import h5py
 import pytest
 from click.testing import CliRunner
 
-from whirl_cli import pipeline, store
+from whirl_cli import pipeline
 from whirl_cli.cli import cli
 from whirl_cli.errors import OutputError
+from whirl_cli.output import atomic, store
 from whirl_cli.results import StudyResult
 
 from .helpers import STUDIES, WHIRL, auto_processes, environment
@@ -47,7 +48,7 @@ def wait_for_no_auto(cache: Path, seconds: float = 5.0) -> list[int]:
 
 def check_output_dir(directory: Path, name: str = "r.h5") -> bool:
     """The output is absent or a complete whirl file, with no temporary file (of it or of a
-    plot: both are published atomically, ``store.publish``) and nothing else but its plots.
+    plot: both are published atomically, ``atomic.publish``) and nothing else but its plots.
     Returns whether the output exists."""
     names = sorted(p.name for p in directory.iterdir()) if directory.exists() else []
     hidden = [n for n in names if n.startswith(".") or "tmp" in n]
@@ -143,11 +144,11 @@ def test_a_write_that_fails_at_any_step_leaves_the_old_file_or_nothing(
         def half(fd, data):
             os.write(fd, data[:len(data) // 2])
             raise Boom
-        monkeypatch.setattr(store, "_write_all", half)
+        monkeypatch.setattr(atomic, "_write_all", half)
     elif step == "link":
-        monkeypatch.setattr(store.os, "link", explode)
+        monkeypatch.setattr(atomic.os, "link", explode)
     elif step == "replace":
-        monkeypatch.setattr(store.os, "replace", explode)
+        monkeypatch.setattr(atomic.os, "replace", explode)
     elif step == "unlink":  # the old file (temporaries may still be removed)
         real_unlink = os.unlink
 
@@ -155,7 +156,7 @@ def test_a_write_that_fails_at_any_step_leaves_the_old_file_or_nothing(
             if name == path.name:
                 raise Boom
             return real_unlink(name, *args, **kwargs)
-        monkeypatch.setattr(store.os, "unlink", unlink)
+        monkeypatch.setattr(atomic.os, "unlink", unlink)
     else:  # a link after the old file was removed: the second link of one write
         real_link, calls = os.link, []
 
@@ -164,7 +165,7 @@ def test_a_write_that_fails_at_any_step_leaves_the_old_file_or_nothing(
             if len(calls) > 1:
                 raise Boom
             return real_link(*args, **kwargs)
-        monkeypatch.setattr(store.os, "link", link)
+        monkeypatch.setattr(atomic.os, "link", link)
     # what is at ``path`` afterwards: "old" (the write failed), "none" (it failed), "new"
     replacing = tmpfile and overwrite  # the O_TMPFILE path removes the old file, then links
     outcome = {
@@ -173,7 +174,7 @@ def test_a_write_that_fails_at_any_step_leaves_the_old_file_or_nothing(
         else "old" if overwrite else "none",
         "replace": "old" if overwrite and not tmpfile else "new",
         "unlink": "old" if replacing else "new",
-        "relink": "none" if replacing else "new",  # the trade-off of store._link_unnamed
+        "relink": "none" if replacing else "new",  # the trade-off of atomic._link_unnamed
     }[step]
     if outcome == "new":
         store.write(small_result(), path, overwrite=overwrite)
@@ -200,7 +201,7 @@ def test_the_writer_never_replaces_a_file_without_overwrite(tmp_path, monkeypatc
         store.write(small_result(), path)
     # the file appears between the check and the link (another process): still refused
     with pytest.raises(OutputError, match="output exists; pass --overwrite"):
-        store._publish(b"other", path, overwrite=False)
+        atomic._publish(b"other", path, overwrite=False)
     assert path.read_bytes() == before
     store.write(small_result(), path, overwrite=True)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.h5"]
@@ -211,12 +212,12 @@ def test_the_writer_never_replaces_a_file_without_overwrite(tmp_path, monkeypatc
 
 
 def test_publish_writes_bytes_the_same_way(tmp_path):
-    """``store.publish`` (for plots rendered to memory): no-clobber unless overwrite."""
-    path = store.publish(b"first", tmp_path / "p.png")
+    """``atomic.publish`` (for plots rendered to memory): no-clobber unless overwrite."""
+    path = atomic.publish(b"first", tmp_path / "p.png")
     with pytest.raises(OutputError, match="output exists"):
-        store.publish(b"second", path)
+        atomic.publish(b"second", path)
     assert path.read_bytes() == b"first"
-    store.publish(b"third", path, overwrite=True)
+    atomic.publish(b"third", path, overwrite=True)
     assert path.read_bytes() == b"third" and [p.name for p in tmp_path.iterdir()] == ["p.png"]
 
 
@@ -314,7 +315,7 @@ def test_a_signal_stops_cleanly_and_kills_auto(tmp_path, signum, status):
 
 
 def test_interrupted_is_a_keyboard_interrupt_with_the_signal():
-    from whirl_cli.auto import Interrupted
+    from whirl_cli.interrupts import Interrupted
 
     assert issubclass(Interrupted, KeyboardInterrupt)
     assert Interrupted(signal.SIGTERM).signum == signal.SIGTERM

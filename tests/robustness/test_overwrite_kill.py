@@ -2,7 +2,7 @@
 over an existing file and kills itself just before its k-th file-system call, for every k.
 Afterwards the output is the old file, the new complete file, or absent (only when killed
 between removing the old file and linking the new one, the documented trade-off of
-``store._link_unnamed``); never a partial or a temporary file."""
+``atomic._link_unnamed``); never a partial or a temporary file."""
 
 from __future__ import annotations
 
@@ -13,14 +13,14 @@ import textwrap
 
 import pytest
 
-from whirl_cli import store
 from whirl_cli.errors import OutputError
+from whirl_cli.output import atomic, store
 from whirl_cli.results import StudyResult
 
 CHILD = textwrap.dedent("""
     import os, signal, sys
     from pathlib import Path
-    from whirl_cli import store
+    from whirl_cli.output import store
     from whirl_cli.results import StudyResult
 
     target, calls = int(sys.argv[2]), []
@@ -90,7 +90,7 @@ def test_an_overwrite_replaces_a_file_another_writer_links_in_between(tmp_path, 
         removed.append(name)
         if len(removed) < 3:
             path.write_bytes(b"another writer's")
-    monkeypatch.setattr(store.os, "unlink", unlink)
+    monkeypatch.setattr(atomic.os, "unlink", unlink)
     store.write(small_result(), path, overwrite=True)
     assert removed == ["r.h5"] * 3
     assert store.read(path).study_name == "mine"
@@ -100,7 +100,7 @@ def test_an_overwrite_replaces_a_file_another_writer_links_in_between(tmp_path, 
     def always(name, *args, **kwargs):
         real_unlink(name, *args, **kwargs)
         path.write_bytes(b"another writer's")
-    monkeypatch.setattr(store.os, "unlink", always)
+    monkeypatch.setattr(atomic.os, "unlink", always)
     with pytest.raises(OutputError, match="r.h5: not replaced: other processes keep writing"):
         store.write(small_result(), path, overwrite=True)
     assert path.read_bytes() == b"another writer's"

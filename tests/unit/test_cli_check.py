@@ -9,7 +9,7 @@ import re
 
 from click.testing import CliRunner
 
-from whirl_cli import simulate
+from whirl_cli.analysis import simulate
 from whirl_cli.cli import cli
 
 from ..conftest import ROOT

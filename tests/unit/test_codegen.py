@@ -7,7 +7,8 @@ import shutil
 import pytest
 from click.testing import CliRunner
 
-from whirl_cli import codegen
+from whirl_cli.auto import codegen
+from whirl_cli.auto.constants import constants_text, par_layout
 from whirl_cli.cli import cli
 from whirl_cli.errors import CodegenError
 from whirl_cli.models import get_model
@@ -31,7 +32,7 @@ def test_fortran_is_deterministic_and_complete(model):
 
 
 def test_par_layout_avoids_auto_reserved_slots(model):
-    layout = codegen.par_layout(model)
+    layout = par_layout(model)
     used = [*layout.parameters.values(), *layout.state_max.values(), *layout.state_min.values(),
             layout.amplitude]
     assert len(set(used)) == len(used)
@@ -46,16 +47,16 @@ def test_fortran_number_round_trips(value):
 
 
 def test_constants_text_format_and_limits(model):
-    text = codegen.constants_text({"NDIM": 4, "DS": -0.01, "ICP": ["K1", "PERIOD"],
+    text = constants_text({"NDIM": 4, "DS": -0.01, "ICP": ["K1", "PERIOD"],
                                    "UZSTOP": {"K1": [-0.3, 0.5]}, "e": "x"})
     assert text == ("NDIM = 4\nDS = -0.01\nICP = ['K1', 'PERIOD']\n"
                     "UZSTOP = {'K1': [-0.3, 0.5]}\ne = 'x'\n")
     with pytest.raises(CodegenError, match="<= 13 characters"):
-        codegen.constants_text({"parnames": {1: "a_name_longer_than_13"}})
+        constants_text({"parnames": {1: "a_name_longer_than_13"}})
     with pytest.raises(CodegenError, match="cannot hold"):
-        codegen.constants_text({"e": "x'; rm"})
+        constants_text({"e": "x'; rm"})
     with pytest.raises(CodegenError, match="2048"):
-        codegen.constants_text({"UZR": {"K1": [0.1] * 400}})
+        constants_text({"UZR": {"K1": [0.1] * 400}})
 
 
 def test_committed_files_match_the_models():

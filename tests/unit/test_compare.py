@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from whirl_cli import store
 from whirl_cli.cli import cli
-from whirl_cli.compare import (
+from whirl_cli.output import store
+from whirl_cli.output.compare import (
     Tolerances,
     compare_curves,
     compare_files,
@@ -274,7 +274,8 @@ def test_curves_compare_by_distance_not_by_sampling():
 
 
 def write_pair(tmp_path, curve_b: np.ndarray):
-    """Two result files, equal but for a locus curve under /boundaries (layout of store.py)."""
+    """Two result files, equal but for a locus curve under /boundaries (layout of
+    output/store.py)."""
     a, b = tmp_path / "a.h5", tmp_path / "b.h5"
     for path, curve in ((a, circle(2001)), (b, curve_b)):
         store.write(make_result(), path, overwrite=True)

@@ -11,7 +11,7 @@ import h5py
 from click.testing import CliRunner
 
 from whirl_cli.cli import cli
-from whirl_cli.compare import compare, compare_results
+from whirl_cli.output.compare import compare, compare_results
 
 from ..conftest import ROOT
 from .test_compare import make_result

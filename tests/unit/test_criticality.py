@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from whirl_cli.recipes import _origin, _with_criticality
+from whirl_cli.continuation.criticality import _origin, _with_criticality
 from whirl_cli.results import Branch, BranchKind, PointType, SpecialPoint
 
 OMEGA = 30.0  # rad/s, the Hopf pair

@@ -8,7 +8,7 @@ import pytest
 from numpy.polynomial import polynomial as P
 from scipy.optimize import brentq
 
-from whirl_cli import linear
+from whirl_cli.analysis import linear
 from whirl_cli.models import get_model
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from whirl_cli.recipes import _near_polyline
+from whirl_cli.continuation.geometry import _near_polyline
 
 
 def test_point_between_vertices_is_on_the_polyline():

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
+from whirl_cli.analysis.normal_form import criticality_of, first_lyapunov_coefficient
 from whirl_cli.models import get_model
-from whirl_cli.normal_form import criticality_of, first_lyapunov_coefficient
 
 x, y = sp.symbols("x y")
 

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from whirl_cli.branches import fortran_float, parse_b, parse_d, parse_s
+from whirl_cli.auto.parse import fortran_float, parse_b, parse_d, parse_s
 from whirl_cli.results import PointType
 
 
@@ -127,8 +127,8 @@ def b_segment(br: int, columns: list[str], rows: list[tuple[int, float]]) -> str
 
 
 def read_fragment(tmp_path, text: str):
-    from whirl_cli.auto import RunOutcome
-    from whirl_cli.branches import read_branch
+    from whirl_cli.auto.parse import read_branch
+    from whirl_cli.auto.runner import RunOutcome
     from whirl_cli.models import get_model
 
     (tmp_path / "b.k1.main").write_text(text)

@@ -11,8 +11,18 @@ from matplotlib.container import ErrorbarContainer
 from matplotlib.contour import QuadContourSet
 from matplotlib.patches import Polygon
 
-from whirl_cli import plots
 from whirl_cli.errors import WhirlError
+from whirl_cli.plots import files
+from whirl_cli.plots.diagrams import (
+    bifurcation_diagram,
+    period_plot,
+    phase_plane,
+    projections_figure,
+)
+from whirl_cli.plots.files import PLOT_KINDS, save_study_plots
+from whirl_cli.plots.key import _new_figure, stability_segments
+from whirl_cli.plots.linear import linear_sweep_plot
+from whirl_cli.plots.maps import boundary_plot, overhang_diagram, slice_continuation
 from whirl_cli.results import (
     Boundary,
     Branch,
@@ -95,7 +105,7 @@ def marker_lines(ax):
 def test_segments_split_with_shared_switching_points():
     x = np.arange(6.0)
     y = 10 * x
-    segments = plots.stability_segments(x, y, np.array([1, 1, 0, 0, 0, 1], bool))
+    segments = stability_segments(x, y, np.array([1, 1, 0, 0, 0, 1], bool))
     assert [s for _, _, s in segments] == [True, False, True]
     np.testing.assert_array_equal(segments[0][0], [0, 1, 2])
     np.testing.assert_array_equal(segments[1][0], [2, 3, 4, 5])
@@ -109,33 +119,33 @@ def test_segments_split_with_shared_switching_points():
 @pytest.mark.parametrize("flag", [True, False])
 def test_segments_uniform_stability_is_one_piece(flag):
     x, y = np.linspace(0, 1, 4), np.linspace(2, 3, 4)
-    (segment,) = plots.stability_segments(x, y, np.full(4, flag))
+    (segment,) = stability_segments(x, y, np.full(4, flag))
     np.testing.assert_array_equal(segment[0], x)
     np.testing.assert_array_equal(segment[1], y)
     assert segment[2] is flag
 
 
 def test_segments_single_point_and_empty():
-    ((xs, ys, stable),) = plots.stability_segments(np.array([1.0]), np.array([2.0]),
-                                                   np.array([False]))
+    ((xs, ys, stable),) = stability_segments(np.array([1.0]), np.array([2.0]),
+                                             np.array([False]))
     assert xs.tolist() == [1.0] and ys.tolist() == [2.0] and stable is False
-    assert plots.stability_segments(np.array([]), np.array([]), np.array([], bool)) == []
+    assert stability_segments(np.array([]), np.array([]), np.array([], bool)) == []
 
 
 def test_segments_alternating_every_point():
-    segments = plots.stability_segments(np.arange(3.0), np.arange(3.0), [True, False, True])
+    segments = stability_segments(np.arange(3.0), np.arange(3.0), [True, False, True])
     assert [xs.tolist() for xs, _, _ in segments] == [[0, 1], [1, 2], [2]]
 
 
 def test_segments_reject_mismatched_lengths():
     with pytest.raises(ValueError):
-        plots.stability_segments(np.arange(3.0), np.arange(2.0), np.ones(3, bool))
+        stability_segments(np.arange(3.0), np.arange(2.0), np.ones(3, bool))
 
 
 # -- bifurcation_diagram -------------------------------------------------------------------------
 
 def test_branch_styles_follow_kind_and_stability(continuation):
-    ax = plots.bifurcation_diagram(continuation).axes[0]
+    ax = bifurcation_diagram(continuation).axes[0]
     styles = [line_style(line) for line in branch_lines(ax)]
     expected = {("green", "-"), ("magenta", "--"), ("blue", "-"), ("red", ":")}
     assert set(styles) == expected
@@ -150,7 +160,7 @@ def test_branch_styles_follow_kind_and_stability(continuation):
 
 
 def test_y_data_are_degrees(continuation):
-    ax = plots.bifurcation_diagram(continuation).axes[0]
+    ax = bifurcation_diagram(continuation).axes[0]
     periodic = [line for line in branch_lines(ax) if line_style(line)[0] in ("red", "blue")]
     ys = np.concatenate([line.get_ydata() for line in periodic])
     np.testing.assert_allclose(np.sort(np.unique(ys)), np.degrees([0.0, 0.1, 0.2, 0.3, 0.4]))
@@ -160,21 +170,21 @@ def test_y_data_are_degrees(continuation):
 
 
 def test_radians_when_degrees_false(continuation):
-    ax = plots.bifurcation_diagram(continuation, degrees=False).axes[0]
+    ax = bifurcation_diagram(continuation, degrees=False).axes[0]
     ys = np.concatenate([line.get_ydata() for line in branch_lines(ax)])
     assert np.max(ys) == pytest.approx(0.4)
     assert ax.get_ylabel() == "theta (max) [rad]"
 
 
 def test_rate_state_in_deg_per_second(continuation):
-    ax = plots.bifurcation_diagram(continuation, state="dtheta").axes[0]
+    ax = bifurcation_diagram(continuation, state="dtheta").axes[0]
     ys = np.concatenate([line.get_ydata() for line in branch_lines(ax)])
     assert np.max(ys) == pytest.approx(np.degrees(0.04))
     assert ax.get_ylabel() == "dtheta (max) [deg/s]"
 
 
 def test_min_drawn_for_periodic_only(continuation):
-    ax = plots.bifurcation_diagram(continuation, which=("max", "min")).axes[0]
+    ax = bifurcation_diagram(continuation, which=("max", "min")).axes[0]
     periodic = [line for line in branch_lines(ax) if line_style(line)[0] in ("red", "blue")]
     equilibrium = [line for line in branch_lines(ax) if line_style(line)[0] in ("green", "magenta")]
     assert len(periodic) == 4 and len(equilibrium) == 2
@@ -184,7 +194,7 @@ def test_min_drawn_for_periodic_only(continuation):
 
 
 def test_special_point_markers(continuation):
-    ax = plots.bifurcation_diagram(continuation).axes[0]
+    ax = bifurcation_diagram(continuation).axes[0]
     markers = {line.get_marker(): line for line in marker_lines(ax)}
     assert set(markers) == {"s", "*", "o"}  # HB, BP, LPC; no marker for EP
     hopf, branch_point, fold = markers["s"], markers["*"], markers["o"]
@@ -202,7 +212,7 @@ def test_special_point_markers(continuation):
 
 
 def test_legend_lists_only_present_styles(continuation):
-    ax = plots.bifurcation_diagram(continuation).axes[0]
+    ax = bifurcation_diagram(continuation).axes[0]
     labels = [text.get_text() for text in ax.get_legend().get_texts()]
     assert labels == ["stable equilibrium", "unstable equilibrium", "stable periodic",
                       "unstable periodic", "Hopf (HB)", "branch point (BP, BPC)",
@@ -212,7 +222,7 @@ def test_legend_lists_only_present_styles(continuation):
 def test_legend_without_periodic_or_points():
     equilibrium = make_branch("main", BranchKind.EQUILIBRIUM, [0.1, 0.2], [0.0, 0.0], [1, 1])
     result = ContinuationResult("eq", "one-parameter", (equilibrium,), ())
-    ax = plots.bifurcation_diagram(result).axes[0]
+    ax = bifurcation_diagram(result).axes[0]
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["stable equilibrium"]
     assert ax.get_ylabel() == "theta [deg]"
 
@@ -223,8 +233,8 @@ def test_all_markers_of_the_key():
              PointType.HOMOCLINIC, PointType.HETEROCLINIC, PointType.TR, PointType.PD,
              PointType.REGULAR, PointType.RG, PointType.UZ, PointType.EP, PointType.MX]
     points = tuple(make_point("main", t, 0.1 + 0.01 * i, 0.0) for i, t in enumerate(types))
-    ax = plots.bifurcation_diagram(ContinuationResult("all", "one-parameter", (equilibrium,),
-                                                      points)).axes[0]
+    ax = bifurcation_diagram(ContinuationResult("all", "one-parameter", (equilibrium,),
+                                                points)).axes[0]
     found = {(line.get_marker(), line.get_markerfacecolor() == "none"): len(line.get_xdata())
              for line in marker_lines(ax)}
     assert found == {("s", True): 1, ("*", False): 2, ("o", False): 2, ("^", False): 1,
@@ -232,9 +242,9 @@ def test_all_markers_of_the_key():
 
 
 def test_draws_on_given_axes(continuation):
-    figure = plots._new_figure()
+    figure = _new_figure()
     ax = figure.add_subplot()
-    assert plots.bifurcation_diagram(continuation, ax=ax) is figure
+    assert bifurcation_diagram(continuation, ax=ax) is figure
     assert len(figure.axes) == 1 and ax.lines
 
 
@@ -242,15 +252,15 @@ def test_loci_are_skipped(continuation):
     locus = make_branch("hopf_locus", BranchKind.HOPF_LOCUS, [0.1, 0.2], [0.0, 0.0], [0, 0])
     extended = ContinuationResult(continuation.name, continuation.kind,
                                   continuation.branches + (locus,), continuation.special_points)
-    plain = plots.bifurcation_diagram(continuation).axes[0]
-    with_locus = plots.bifurcation_diagram(extended).axes[0]
+    plain = bifurcation_diagram(continuation).axes[0]
+    with_locus = bifurcation_diagram(extended).axes[0]
     assert len(with_locus.lines) == len(plain.lines)
 
 
 @pytest.mark.parametrize("kwargs", [{"state": "phi"}, {"which": ("mean",)}, {"which": ()}])
 def test_bad_arguments_raise(continuation, kwargs):
     with pytest.raises(WhirlError):
-        plots.bifurcation_diagram(continuation, **kwargs)
+        bifurcation_diagram(continuation, **kwargs)
 
 
 # -- linear_sweep_plot ---------------------------------------------------------------------------
@@ -268,7 +278,7 @@ def make_sweep() -> LinearSweep:
 
 def test_linear_sweep_plot_modes():
     sweep = make_sweep()
-    figure = plots.linear_sweep_plot(sweep)
+    figure = linear_sweep_plot(sweep)
     ax_freq, ax_damp = figure.axes
     labels = [line.get_label() for line in ax_freq.lines]
     assert labels == ["BW", "FW"]
@@ -286,7 +296,7 @@ def test_linear_sweep_plot_modes():
 def test_save_study_plots_writes_pngs_only(tmp_path, continuation):
     two_parameter = ContinuationResult("hopf_locus", "two-parameter", (), ())
     result = StudyResult("study", "classical", (continuation, two_parameter), (make_sweep(),), ())
-    paths = plots.save_study_plots(result, ("bifurcation", "linear"), tmp_path, "run")
+    paths = save_study_plots(result, ("bifurcation", "linear"), tmp_path, "run")
     assert paths == sorted([tmp_path / "run_hopf_K1_bifurcation.png",
                             tmp_path / "run_linear_K1.png"])
     assert sorted(tmp_path.iterdir()) == paths  # no temporary files left behind
@@ -297,7 +307,7 @@ def test_save_study_plots_writes_pngs_only(tmp_path, continuation):
 def test_save_study_plots_selected_kind_and_overwrite(tmp_path, continuation):
     result = StudyResult("study", "classical", (continuation,), (make_sweep(),), ())
     (tmp_path / "run_linear_K1.png").write_bytes(b"old")
-    paths = plots.save_study_plots(result, ("linear",), tmp_path, "run")
+    paths = save_study_plots(result, ("linear",), tmp_path, "run")
     assert paths == [tmp_path / "run_linear_K1.png"]
     assert paths[0].read_bytes()[:8] == PNG_MAGIC
     assert [p.name for p in tmp_path.iterdir()] == ["run_linear_K1.png"]
@@ -306,19 +316,19 @@ def test_save_study_plots_selected_kind_and_overwrite(tmp_path, continuation):
 def test_save_study_plots_rejects_unknown_kind(tmp_path, continuation):
     result = StudyResult("study", "classical", (continuation,), (), ())
     with pytest.raises(WhirlError):
-        plots.save_study_plots(result, ("contour",), tmp_path, "run")
+        save_study_plots(result, ("contour",), tmp_path, "run")
     assert list(tmp_path.iterdir()) == []
 
 
 def test_plot_kinds():
-    assert plots.PLOT_KINDS == ("bifurcation", "linear", "projections", "period", "phase",
-                                "boundary")
+    assert PLOT_KINDS == ("bifurcation", "linear", "projections", "period", "phase",
+                          "boundary")
 
 
 # -- projections_figure --------------------------------------------------------------------------
 
 def test_projections_one_axes_per_state(continuation):
-    figure = plots.projections_figure(continuation)
+    figure = projections_figure(continuation)
     axes = figure.axes
     assert len(axes) == 4
     assert [ax.get_ylabel() for ax in axes] == ["theta (max) [deg]", "psi (max) [deg]",
@@ -343,7 +353,7 @@ def test_projections_odd_state_count_in_radians(continuation):
     cut = replace(continuation, branches=tuple(three(b) for b in continuation.branches),
                   special_points=tuple(replace(p, state=p.state[:3])
                                        for p in continuation.special_points))
-    axes = plots.projections_figure(cut, which=("max", "min"), degrees=False).axes
+    axes = projections_figure(cut, which=("max", "min"), degrees=False).axes
     assert [ax.get_ylabel() for ax in axes] == ["theta (max, min) [rad]", "psi (max, min) [rad]",
                                                 "dtheta (max, min) [rad/s]"]
     assert [ax.get_xlabel() for ax in axes] == ["", "K1 [N m/rad]", "K1 [N m/rad]"]
@@ -352,7 +362,7 @@ def test_projections_odd_state_count_in_radians(continuation):
 
 
 def test_projections_without_branches():
-    figure = plots.projections_figure(ContinuationResult("empty", "one-parameter", (), ()))
+    figure = projections_figure(ContinuationResult("empty", "one-parameter", (), ()))
     assert len(figure.axes) == 1 and not figure.axes[0].lines
 
 
@@ -378,7 +388,7 @@ def test_period_plot_segments_styles_and_markers():
     bp_on_equilibrium = make_point("main_down", PointType.BP, 0.2, 0.0)
     result = period_continuation([0.2, 0.25, 0.3, 0.35, 0.4],
                                  [hopf, fold, end, bp_on_equilibrium])
-    ax = plots.period_plot(result).axes[0]
+    ax = period_plot(result).axes[0]
     lines = branch_lines(ax)
     assert sorted(line_style(line) for line in lines) == [("blue", "-"), ("red", ":")]
     by_style = {line_style(line): line for line in lines}
@@ -401,7 +411,7 @@ def test_period_plot_segments_styles_and_markers():
 
 @pytest.mark.parametrize(("last", "scale"), [(3.9, "linear"), (4.0, "linear"), (4.2, "log")])
 def test_period_plot_log_scale_only_above_factor_20(last, scale):
-    ax = plots.period_plot(period_continuation([0.2, 0.5, 1.0, 2.0, last])).axes[0]
+    ax = period_plot(period_continuation([0.2, 0.5, 1.0, 2.0, last])).axes[0]
     assert ax.get_yscale() == scale
 
 
@@ -415,7 +425,7 @@ def test_period_plot_brackets_bracketed_homoclinic():
                            parameters=np.array([0.295]), status="located",
                            bracket=np.full(2, np.nan))
     result = period_continuation([0.2, 0.5, 1.0, 12.0, 8.0], [homoclinic, heteroclinic])
-    ax = plots.period_plot(result).axes[0]
+    ax = period_plot(result).axes[0]
     found = {(line.get_marker(), line.get_markerfacecolor() == "none"): line
              for line in marker_lines(ax) if line.get_marker() == "^"}
     # both at the period of the branch's last point, x = their parameter estimate
@@ -435,8 +445,8 @@ def test_period_plot_brackets_bracketed_homoclinic():
 def test_period_plot_without_periodic_branch():
     equilibrium = make_branch("main", BranchKind.EQUILIBRIUM, [0.1, 0.2], [0.0, 0.0], [1, 1])
     points = (make_point("main", PointType.HB, 0.1, 0.0),)  # no period: no marker
-    ax = plots.period_plot(ContinuationResult("eq", "one-parameter", (equilibrium,),
-                                              points)).axes[0]
+    ax = period_plot(ContinuationResult("eq", "one-parameter", (equilibrium,),
+                                        points)).axes[0]
     assert not ax.lines and ax.get_legend() is None
 
 
@@ -465,7 +475,7 @@ def orbit_branch() -> Branch:
 
 
 def test_phase_plane_closed_curves_in_degrees(orbit_branch):
-    ax = plots.phase_plane(orbit_branch).axes[0]
+    ax = phase_plane(orbit_branch).axes[0]
     assert len(ax.lines) == 2
     for line, orbit in zip(ax.lines, orbit_branch.orbits, strict=True):
         xs, ys = line.get_xdata(), line.get_ydata()
@@ -482,8 +492,8 @@ def test_phase_plane_closed_curves_in_degrees(orbit_branch):
 
 
 def test_phase_plane_selected_labels_states_and_radians(orbit_branch):
-    ax = plots.phase_plane(orbit_branch, labels=[5], x="theta", y="dtheta",
-                           degrees=False).axes[0]
+    ax = phase_plane(orbit_branch, labels=[5], x="theta", y="dtheta",
+                     degrees=False).axes[0]
     (line,) = ax.lines
     assert np.max(line.get_ydata()) == pytest.approx(0.4 * 31.4)
     assert ax.get_ylabel() == "dtheta [rad/s]"
@@ -491,21 +501,21 @@ def test_phase_plane_selected_labels_states_and_radians(orbit_branch):
 
 
 def test_phase_plane_draws_on_given_axes(orbit_branch):
-    figure = plots._new_figure()
+    figure = _new_figure()
     ax = figure.add_subplot()
-    assert plots.phase_plane(orbit_branch, ax=ax) is figure and len(ax.lines) == 2
+    assert phase_plane(orbit_branch, ax=ax) is figure and len(ax.lines) == 2
 
 
 @pytest.mark.parametrize("kwargs", [{"labels": [4]}, {"x": "phi"}, {"y": "chi"}])
 def test_phase_plane_bad_arguments_raise(orbit_branch, kwargs):
     with pytest.raises(WhirlError):
-        plots.phase_plane(orbit_branch, **kwargs)
+        phase_plane(orbit_branch, **kwargs)
 
 
 def test_phase_plane_rejects_equilibrium_branch():
     equilibrium = make_branch("main", BranchKind.EQUILIBRIUM, [0.1, 0.2], [0.0, 0.0], [1, 1])
     with pytest.raises(WhirlError):
-        plots.phase_plane(equilibrium)
+        phase_plane(equilibrium)
 
 
 # -- save_study_plots: new kinds -----------------------------------------------------------------
@@ -517,7 +527,7 @@ def test_save_study_plots_new_kinds(tmp_path, continuation, orbit_branch):
     equilibria = ContinuationResult("eq", "one-parameter", (continuation.branches[0],), ())
     locus = ContinuationResult("hopf_locus", "two-parameter", (), ())
     result = StudyResult("study", "classical", (rich, equilibria, locus), (make_sweep(),), ())
-    paths = plots.save_study_plots(result, ("projections", "period", "phase"), tmp_path, "run")
+    paths = save_study_plots(result, ("projections", "period", "phase"), tmp_path, "run")
     assert [p.name for p in paths] == sorted([
         "run_hopf_K1_projections.png", "run_eq_projections.png", "run_hopf_K1_period.png",
         "run_hopf_K1_periodic_1_phase.png"])
@@ -579,7 +589,7 @@ def polyline(ax, points) -> object:
 
 def test_boundary_plot_shades_linearly_unstable_region():
     grid = make_grid()
-    ax = plots.boundary_plot(None, grid).axes[0]
+    ax = boundary_plot(None, grid).axes[0]
     (contours,) = contour_sets(ax)
     np.testing.assert_array_equal(contours.levels, [0.0, np.inf])
     assert same_color(contours.get_facecolor()[0], "lightgrey")
@@ -594,20 +604,20 @@ def test_boundary_plot_shades_linearly_unstable_region():
 
 
 def test_boundary_plot_without_unstable_points_has_no_shading():
-    ax = plots.boundary_plot(None, make_grid(np.full((11, 21), -1.0))).axes[0]
+    ax = boundary_plot(None, make_grid(np.full((11, 21), -1.0))).axes[0]
     assert contour_sets(ax) == []
     assert legend_labels(ax) == ["linear boundary (flutter)", "linear boundary (divergence)"]
 
 
 def test_boundary_plot_linear_contour_styles():
-    ax = plots.boundary_plot(None, make_grid()).axes[0]
+    ax = boundary_plot(None, make_grid()).axes[0]
     flutter, divergence = polyline(ax, FLUTTER_LINE), polyline(ax, DIVERGENCE_LINE)
     assert line_style(flutter) == ("black", "-") and flutter.get_linewidth() < 1.0
     assert line_style(divergence) == ("black", "--") and divergence.get_linewidth() < 1.0
 
 
 def test_boundary_plot_grid_only_labels_limits_and_legend():
-    ax = plots.boundary_plot(None, make_grid()).axes[0]
+    ax = boundary_plot(None, make_grid()).axes[0]
     assert ax.get_xlabel() == "K1 [N m/rad]" and ax.get_ylabel() == "K_psi [N m/rad]"
     assert ax.get_xlim() == (0.0, 1.0) and ax.get_ylim() == (0.0, 0.5)
     assert legend_labels(ax) == ["linearly unstable", "linear boundary (flutter)",
@@ -616,7 +626,7 @@ def test_boundary_plot_grid_only_labels_limits_and_legend():
 
 
 def test_boundary_plot_loci_styles_per_kind():
-    ax = plots.boundary_plot(make_boundary(), None).axes[0]
+    ax = boundary_plot(make_boundary(), None).axes[0]
     assert same_color(polyline(ax, HOPF).get_color(), "darkblue")
     assert polyline(ax, HOPF).get_linestyle() == "-"
     assert line_style(polyline(ax, PITCHFORK)) == ("black", "--")
@@ -628,7 +638,7 @@ def test_boundary_plot_loci_styles_per_kind():
 
 def test_boundary_plot_unsafe_polygons():
     second = POLYGON + [0.0, 0.1]
-    ax = plots.boundary_plot(make_boundary(polygons=(POLYGON, second)), None).axes[0]
+    ax = boundary_plot(make_boundary(polygons=(POLYGON, second)), None).axes[0]
     polygons = [patch for patch in ax.patches if isinstance(patch, Polygon)]
     assert len(polygons) == 2
     for patch, expected in zip(polygons, (POLYGON, second), strict=True):
@@ -638,7 +648,7 @@ def test_boundary_plot_unsafe_polygons():
 
 
 def test_boundary_plot_case_lines_and_labels():
-    ax = plots.boundary_plot(make_boundary(), make_grid(), cases=CASES).axes[0]
+    ax = boundary_plot(make_boundary(), make_grid(), cases=CASES).axes[0]
     dotted = [line for line in ax.lines if line.get_linestyle() == ":"]
     assert [tuple(line.get_ydata()) for line in dotted] == [(v, v) for v in CASES]
     assert all(line_style(line)[0] == "black" for line in dotted)
@@ -653,12 +663,12 @@ def test_boundary_plot_case_lines_and_labels():
 
 
 def test_boundary_plot_cases_outside_limits_are_not_labelled():
-    ax = plots.boundary_plot(None, make_grid(), cases=(0.2, 0.9)).axes[0]
+    ax = boundary_plot(None, make_grid(), cases=(0.2, 0.9)).axes[0]
     assert [text.get_text() for text in ax.texts] == ["case 1"]
 
 
 def test_boundary_plot_both_legend_and_title():
-    ax = plots.boundary_plot(make_boundary(), make_grid(), cases=CASES).axes[0]
+    ax = boundary_plot(make_boundary(), make_grid(), cases=CASES).axes[0]
     assert legend_labels(ax) == [
         "linearly unstable", "linear boundary (flutter)", "linear boundary (divergence)",
         "Hopf locus (flutter)", "branch point locus (divergence)", "fold locus (LP)",
@@ -670,7 +680,7 @@ def test_boundary_plot_both_legend_and_title():
 def test_boundary_plot_boundary_only_legend_and_limits():
     loci = {"hopf_1": ("hopf", HOPF), "hopf_2": ("hopf", HOPF + 0.05),
             "lpc_1": ("fold_of_cycles", LPC), "other": ("torus", np.array([[5.0, 5.0]] * 2))}
-    ax = plots.boundary_plot(make_boundary(loci=loci, polygons=()), None).axes[0]
+    ax = boundary_plot(make_boundary(loci=loci, polygons=()), None).axes[0]
     assert legend_labels(ax) == ["Hopf locus (flutter)", "fold of cycles locus (LPC)"]
     assert len(ax.lines) == 3 and contour_sets(ax) == []
     # extent of the loci (x 0..0.45, y 0..0.35) with a 2 % margin
@@ -684,7 +694,7 @@ def test_boundary_plot_transposes_a_swapped_grid():
     swapped = LinearGrid("K_psi", "K1", "N m/rad", "N m/rad", grid.y, grid.x,
                          grid.max_real.T, grid.oscillatory.T, (FLUTTER_LINE[:, ::-1],),
                          (DIVERGENCE_LINE[:, ::-1],))
-    ax = plots.boundary_plot(make_boundary(), swapped).axes[0]
+    ax = boundary_plot(make_boundary(), swapped).axes[0]
     assert ax.get_xlim() == (0.0, 1.0) and ax.get_ylim() == (0.0, 0.5)
     polyline(ax, FLUTTER_LINE)
     (contours,) = contour_sets(ax)
@@ -693,16 +703,16 @@ def test_boundary_plot_transposes_a_swapped_grid():
 
 def test_boundary_plot_rejects_bad_input():
     with pytest.raises(WhirlError):
-        plots.boundary_plot(None, None)
+        boundary_plot(None, None)
     other = replace(make_grid(), x_parameter="V")
     with pytest.raises(WhirlError):
-        plots.boundary_plot(make_boundary(), other)
+        boundary_plot(make_boundary(), other)
 
 
 def test_boundary_plot_draws_on_given_axes():
-    figure = plots._new_figure()
+    figure = _new_figure()
     ax = figure.add_subplot()
-    assert plots.boundary_plot(make_boundary(), None, ax=ax) is figure
+    assert boundary_plot(make_boundary(), None, ax=ax) is figure
     assert len(figure.axes) == 1 and ax.lines
 
 
@@ -724,18 +734,18 @@ def bands(ax) -> list[tuple[float, float]]:
 
 
 def test_slice_continuation(continuation):
-    sliced = plots.slice_continuation(two_parameter_continuation(continuation), 2)
+    sliced = slice_continuation(two_parameter_continuation(continuation), 2)
     assert sliced.kind == "one-parameter" and sliced.name == "kk.slice_2"
     assert [b.name for b in sliced.branches] == ["main_down", "periodic_1"]
     assert [p.branch for p in sliced.special_points] == [
         "main_down", "main_down", "periodic_1", "periodic_1"]
-    assert plots.slice_continuation(two_parameter_continuation(continuation), 1
-                                    ).special_points == ()
+    assert slice_continuation(two_parameter_continuation(continuation), 1
+                              ).special_points == ()
 
 
 def test_overhang_diagram_bands_at_interval_edges(continuation):
     two = two_parameter_continuation(continuation)
-    ax = plots.overhang_diagram(two, make_boundary(), 0.2).axes[0]
+    ax = overhang_diagram(two, make_boundary(), 0.2).axes[0]
     assert bands(ax) == [pytest.approx((0.1, 0.25)), pytest.approx((0.32, 0.35))]
     for patch in ax.patches:
         assert same_color(patch.get_facecolor()[:3], "red")
@@ -746,7 +756,7 @@ def test_overhang_diagram_bands_at_interval_edges(continuation):
     assert ax.get_title() == "kk: K_psi = 0.2"
     assert ax.get_xlabel() == "K1 [N m/rad]" and ax.get_ylabel() == "theta (max) [deg]"
     # the slice's branches only, as in a plain bifurcation diagram
-    plain = plots.bifurcation_diagram(continuation).axes[0]
+    plain = bifurcation_diagram(continuation).axes[0]
     assert len(ax.lines) == len(plain.lines)
     for mine, theirs in zip(ax.lines, plain.lines, strict=True):
         np.testing.assert_allclose(mine.get_xydata(), theirs.get_xydata())
@@ -754,31 +764,31 @@ def test_overhang_diagram_bands_at_interval_edges(continuation):
 
 def test_overhang_diagram_other_slice_and_no_interval(continuation):
     two = two_parameter_continuation(continuation)
-    ax = plots.overhang_diagram(two, make_boundary(), 0.3).axes[0]
+    ax = overhang_diagram(two, make_boundary(), 0.3).axes[0]
     assert bands(ax) == [pytest.approx((0.0, 0.15))]
     assert len(marker_lines(ax)) == 0  # special points are on slice 2 only
-    ax = plots.overhang_diagram(two, make_boundary(), 0.05).axes[0]
+    ax = overhang_diagram(two, make_boundary(), 0.05).axes[0]
     assert len(ax.patches) == 0 and "unsafe (overhang)" not in legend_labels(ax)
 
 
 def test_overhang_diagram_one_parameter(continuation):
-    ax = plots.overhang_diagram(continuation, make_boundary(), 0.2, which=("max", "min"),
-                                degrees=False).axes[0]
+    ax = overhang_diagram(continuation, make_boundary(), 0.2, which=("max", "min"),
+                          degrees=False).axes[0]
     assert bands(ax) == [pytest.approx((0.1, 0.25)), pytest.approx((0.32, 0.35))]
     assert ax.get_ylabel() == "theta (max, min) [rad]"
     assert legend_labels(ax)[-1] == "unsafe (overhang)"
-    ax = plots.overhang_diagram(continuation, None, 0.2).axes[0]
+    ax = overhang_diagram(continuation, None, 0.2).axes[0]
     assert len(ax.patches) == 0 and ax.get_title() == "hopf_K1"
 
 
 def test_overhang_diagram_rejects_bad_input(continuation):
     two = two_parameter_continuation(continuation)
     with pytest.raises(WhirlError):
-        plots.overhang_diagram(two, None, 0.2)
+        overhang_diagram(two, None, 0.2)
     with pytest.raises(WhirlError):
-        plots.overhang_diagram(two, make_boundary(), 0.25)  # not a slice
+        overhang_diagram(two, make_boundary(), 0.25)  # not a slice
     with pytest.raises(WhirlError):
-        plots.overhang_diagram(two, make_boundary(), 0.2, state="phi")
+        overhang_diagram(two, make_boundary(), 0.2, state="phi")
 
 
 # -- save_study_plots: boundary ------------------------------------------------------------------
@@ -789,7 +799,7 @@ def test_save_study_plots_boundary(tmp_path, continuation):
     two_slices = replace(make_boundary(), slices=(0.2, 0.3))
     result = StudyResult("study", "classical", (continuation, two), (), (),
                          boundaries=(two_slices, other), linear_grid=make_grid())
-    paths = plots.save_study_plots(result, ("boundary",), tmp_path, "run", dpi=40)
+    paths = save_study_plots(result, ("boundary",), tmp_path, "run", dpi=40)
     assert [p.name for p in paths] == sorted([
         "run_kk_boundary.png", "run_kk_slice_0_overhang.png", "run_kk_slice_1_overhang.png",
         "run_no_continuation_boundary.png", "run_no_continuation_slice_0_overhang.png"])
@@ -800,11 +810,11 @@ def test_save_study_plots_boundary(tmp_path, continuation):
 
 def test_save_study_plots_boundary_grid_only_or_nothing(tmp_path, continuation):
     result = StudyResult("study", "classical", (continuation,), (), (), linear_grid=make_grid())
-    paths = plots.save_study_plots(result, ("boundary", "linear"), tmp_path, "run", dpi=40)
+    paths = save_study_plots(result, ("boundary", "linear"), tmp_path, "run", dpi=40)
     assert [p.name for p in paths] == ["run_linear_grid.png"]
     assert paths[0].read_bytes()[:8] == PNG_MAGIC
     empty = StudyResult("study", "classical", (continuation,), (), ())
-    assert plots.save_study_plots(empty, ("boundary",), tmp_path / "none", "run") == []
+    assert save_study_plots(empty, ("boundary",), tmp_path / "none", "run") == []
 
 
 def test_save_study_plots_boundary_ignores_grid_of_other_parameters(tmp_path, monkeypatch):
@@ -812,13 +822,13 @@ def test_save_study_plots_boundary_ignores_grid_of_other_parameters(tmp_path, mo
 
     def fake(boundary, grid, cases=(), ax=None):
         seen.append((boundary, grid, tuple(cases)))
-        return plots._new_figure()
+        return _new_figure()
 
-    monkeypatch.setattr(plots, "boundary_plot", fake)
+    monkeypatch.setattr(files, "boundary_plot", fake)
     boundary = replace(make_boundary(), slices=())
     grid = replace(make_grid(), y_parameter="V")
     result = StudyResult("study", "classical", (), (), (), boundaries=(boundary,),
                          linear_grid=grid)
-    paths = plots.save_study_plots(result, ("boundary",), tmp_path, "run", dpi=40)
+    paths = save_study_plots(result, ("boundary",), tmp_path, "run", dpi=40)
     assert [p.name for p in paths] == ["run_kk_boundary.png"]
     assert seen == [(boundary, None, ())]

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from whirl_cli import simulate
+from whirl_cli.analysis import simulate
 from whirl_cli.models import get_model
 from whirl_cli.results import Branch, BranchKind, PointType
 

@@ -9,7 +9,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from whirl_cli import store
+from whirl_cli.output import store
 from whirl_cli.results import Boundary, LinearGrid, Orbit, RunRecord, UnsafeInterval
 
 from ..conftest import ROOT

@@ -22,8 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .models import Model
-from .results import Branch, BranchKind, PointType, SpecialPoint
+from ..models import Model
+from ..results import Branch, BranchKind, PointType, SpecialPoint
 
 #: A family is in blow-up when its period exceeds this multiple of the Hopf period.
 BLOWUP_FACTOR = 3.0

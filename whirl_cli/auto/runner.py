@@ -1,10 +1,5 @@
-"""Running AUTO-07p: compile once, run each job in its own directory, classify the outcome.
+"""Running AUTO-07p: each job in its own directory, its outcome classified.
 
-* Equation files are compiled and linked against Debian's AUTO runtime objects
-  (``/usr/lib/auto-07p/lib/*.o``) once per source text: executables are cached under
-  ``$WHIRL_CACHE_DIR`` (default ``~/.cache/whirl``) keyed by a hash of the source, the compiler,
-  the flags and the runtime objects. The cache entry appears atomically (a directory rename), so
-  concurrent processes never see a half-written executable.
 * Every run gets a fresh working directory, its constants written as ``fort.2`` (and as
   ``c.<name>`` for inspection), ``OMP_NUM_THREADS=1`` and a wall-clock timeout. The process is
   started from an argument list (never a shell string) with an explicit environment.
@@ -24,30 +19,23 @@
 from __future__ import annotations
 
 import fnmatch
-import hashlib
 import json
 import os
 import re
 import shutil
 import signal
 import subprocess
-import tempfile
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
 
-from .codegen import constants_text
-from .errors import ToolchainError, WhirlError
-from .interrupts import Interrupted
-
-AUTO_DIR = Path(os.environ.get("WHIRL_AUTO_DIR", "/usr/lib/auto-07p"))
-#: The flags of Debian's ``cmds/cmds.make`` (minus the build-path mapping).
-FFLAGS = ("-g", "-O2", "-fstack-protector-strong", "-fPIC", "-std=legacy", "-fopenmp")
-INSTALL_HINT = "install them with: sudo apt-get install auto-07p gfortran   (or: make setup)"
+from ..errors import WhirlError
+from ..interrupts import Interrupted
+from .constants import constants_text
 
 #: stdout texts meaning AUTO did not do what was asked, although it exits 0 -> message shown.
 FATAL_PATTERNS = (
@@ -64,115 +52,6 @@ FATAL_PATTERNS = (
 )
 _LABEL_LINE = re.compile(r"^\s*-?\d+\s+-?\d+\s+([A-Z][A-Z0-9]{1,2})\s+(\d+)\s")
 
-
-# ------------------------------------------------------------------------------ toolchain
-def cache_dir() -> Path:
-    root = os.environ.get("WHIRL_CACHE_DIR")
-    if root:
-        return Path(root)
-    xdg = os.environ.get("XDG_CACHE_HOME")
-    return (Path(xdg) if xdg else Path.home() / ".cache") / "whirl"
-
-
-def runtime_objects() -> list[Path]:
-    objects = sorted((AUTO_DIR / "lib").glob("*.o"))
-    if not objects:
-        raise ToolchainError(f"AUTO-07p runtime objects not found in {AUTO_DIR / 'lib'}; "
-                             + INSTALL_HINT)
-    return objects
-
-
-def gfortran() -> str:
-    path = shutil.which("gfortran")
-    if not path:
-        raise ToolchainError("gfortran (needed to compile AUTO equation files) is not installed; "
-                             + INSTALL_HINT)
-    return path
-
-
-@cache
-def _compiler_identity(compiler: str) -> str:
-    out = subprocess.run([compiler, "--version"], capture_output=True, text=True, check=False)
-    return out.stdout.splitlines()[0] if out.stdout else compiler
-
-
-@cache
-def auto_version() -> str:
-    """The installed AUTO-07p package version (Debian), or 'unknown'."""
-    try:
-        out = subprocess.run(["dpkg-query", "-W", "-f=${Version}", "auto-07p"],
-                             capture_output=True, text=True, check=False, timeout=10)
-    except (OSError, subprocess.TimeoutExpired):
-        return "unknown"
-    return out.stdout.strip() or "unknown"
-
-
-@dataclass(frozen=True)
-class Executable:
-    """A compiled AUTO program for one equation source."""
-
-    path: Path
-    source_hash: str
-    compiled: bool  # True if this call compiled it, False if it came from the cache
-
-
-def compile_equations(source: str | Callable[[], str], name: str,
-                      source_key: str | None = None) -> Executable:
-    """Compile and link a free-form .f90 source once; later calls reuse the cached program.
-
-    ``source`` may be a function producing the text, called only on a cache miss; then
-    ``source_key`` must identify the text it would produce.
-    """
-    compiler = gfortran()
-    objects = runtime_objects()
-    if source_key is None:
-        assert isinstance(source, str)
-        source_key = hashlib.sha256(source.encode()).hexdigest()
-    key = hashlib.sha256()
-    for part in (source_key, _compiler_identity(compiler), " ".join(FFLAGS),
-                 *(f"{o.name}:{o.stat().st_size}:{o.stat().st_mtime_ns}" for o in objects)):
-        key.update(part.encode())
-        key.update(b"\0")
-    digest = key.hexdigest()[:24]
-    final = cache_dir() / "exe" / f"{name}-{digest}"
-    exe = final / f"{name}.exe"
-    if exe.exists():
-        return Executable(exe, digest, compiled=False)
-    final.parent.mkdir(parents=True, exist_ok=True)
-    _remove_stale_builds(final.parent)
-    build = Path(tempfile.mkdtemp(prefix=f".{name}-", dir=final.parent))
-    try:
-        (build / f"{name}.f90").write_text(source if isinstance(source, str) else source())
-        for command in (
-            [compiler, *FFLAGS, "-c", f"{name}.f90", "-o", f"{name}.o"],
-            [compiler, *FFLAGS, f"{name}.o", "-o", f"{name}.exe", *map(str, objects)],
-        ):
-            done = subprocess.run(command, cwd=build, capture_output=True, text=True, check=False)
-            if done.returncode != 0:
-                raise ToolchainError(f"compiling {name}.f90 failed ({command[0]} exit "
-                                     f"{done.returncode}):\n{done.stderr.strip()[-2000:]}")
-        try:
-            build.rename(final)  # atomic: another process may have won the race
-        except OSError:
-            if not exe.exists():
-                raise
-        return Executable(exe, digest, compiled=True)
-    finally:
-        shutil.rmtree(build, ignore_errors=True)
-
-
-def _remove_stale_builds(root: Path, age: float = 3600.0) -> None:
-    """Remove build directories (``.<name>-*``) left by a compile that was killed."""
-    now = time.time()
-    for build in root.glob(".*-*"):
-        try:
-            if build.is_dir() and now - build.stat().st_mtime > age:
-                shutil.rmtree(build, ignore_errors=True)
-        except OSError:
-            pass
-
-
-# ------------------------------------------------------------------------------ running
 #: Running AUTO processes, and whether new runs are refused (after an interrupt).
 _LIVE: set[subprocess.Popen] = set()
 _LIVE_LOCK = threading.RLock()
@@ -386,3 +265,4 @@ def _classify(returncode: int | None, timed_out: bool, stdout: str, n_points: in
         return "mx", ("no convergence with the minimum step size (MX): the branch ends early; "
                       "try a smaller auto.step_min or more auto.mesh_intervals")
     return "ok", "ok"
+

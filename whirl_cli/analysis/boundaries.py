@@ -19,9 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..models import Model
+from ..results import Boundary, Branch, BranchKind, UnsafeInterval
 from . import linear
-from .models import Model
-from .results import Boundary, Branch, BranchKind, UnsafeInterval
 
 Interval = tuple[float, float]
 

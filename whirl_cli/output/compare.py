@@ -24,7 +24,7 @@ on other machines. Point indices, step counts and provenance are not compared; i
   every point of one curve to the polyline of the other, in axes scaled by their span;
 * **runs** by status, **cross-checks** by their pass/fail outcome.
 
-Files are read with :func:`whirl_cli.store.read`; ``/boundaries`` (not part of
+Files are read with :func:`whirl_cli.output.store.read`; ``/boundaries`` (not part of
 :class:`~whirl_cli.results.StudyResult`) with h5py.
 """
 
@@ -36,8 +36,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from ..results import Branch, ContinuationResult, LinearSweep, PointType, SpecialPoint, StudyResult
 from . import store
-from .results import Branch, ContinuationResult, LinearSweep, PointType, SpecialPoint, StudyResult
 
 #: Root attributes that change from run to run without any physical meaning.
 IGNORED_ATTRIBUTES = frozenset({"created", "git_describe", "whirl_version", "whirl_code_sha256",

@@ -16,14 +16,14 @@ File formats (AUTO-07p 0.9.2, verified against its Fortran writers; ``../shared/
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
-from .auto import RunOutcome
-from .codegen import PERIOD_INDEX, par_layout
-from .models import Model
-from .results import Branch, BranchKind, Orbit, PointType
+from ..models import Model
+from ..results import Branch, BranchKind, Orbit, PointType
+from .constants import PERIOD_INDEX, par_layout
+from .runner import RunOutcome
 
 
 def fortran_float(text: str) -> float:
@@ -42,7 +42,6 @@ def fortran_float(text: str) -> float:
         return float("nan")
 
 
-# ---------------------------------------------------------------------------------- b-file
 @dataclass(frozen=True)
 class BSegment:
     """One header block of a b-file and its data rows (one branch of one run)."""
@@ -107,7 +106,6 @@ def parse_b(text: str) -> list[BSegment]:
     return segments
 
 
-# ---------------------------------------------------------------------------------- s-file
 @dataclass(frozen=True)
 class Solution:
     """One labelled solution from an s-file. ``u``: (NTPL, NAR-1); PAR(i) is ``par[i-1]``."""
@@ -151,7 +149,6 @@ def parse_s(text: str) -> list[Solution]:
     return solutions
 
 
-# ---------------------------------------------------------------------------------- d-file
 @dataclass(frozen=True)
 class Diagnostics:
     """Eigenvalues or Floquet multipliers of one accepted point (from a d-file)."""
@@ -222,7 +219,6 @@ def _attach(segment: BSegment, diagnostics: list[Diagnostics], n: int) -> np.nda
     return table
 
 
-# ---------------------------------------------------------------------------------- branch
 def read_branch(outcome: RunOutcome, model: Model, *, name: str, kind: str, origin: str,
                 parameter_names: tuple[str, ...]) -> Branch:
     """The branch one AUTO run wrote, in SI units (see :mod:`whirl_cli.results`)."""
@@ -346,29 +342,3 @@ def _concatenate(segments: list[BSegment]) -> BSegment:
                       ("br", "pt", "ty", "lab")),
                     np.concatenate(values).reshape(-1, len(shared)))
 
-
-def head(branch: Branch, rows: int) -> Branch:
-    """The first ``rows`` points of ``branch`` (with the orbits stored on them)."""
-    return replace(branch, **{key: getattr(branch, key)[:rows] for key in (
-        "parameters", "state_max", "state_min", "l2_norm", "period", "stable", "point_type",
-        "label", "eigenvalues", "stability_known")},
-        orbits=tuple(o for o in branch.orbits if o.index < rows))
-
-
-def join(first: Branch, second: Branch, name: str) -> Branch:
-    """One branch from two consecutive runs (the second restarted at the first's last point,
-    which it repeats)."""
-    shift = len(first)
-    stacked = {key: np.concatenate([getattr(first, key), getattr(second, key)[1:]])
-               for key in ("parameters", "state_max", "state_min", "l2_norm", "period", "stable",
-                           "point_type", "label", "eigenvalues", "stability_known")}
-    moved = tuple(replace(o, index=o.index + shift - 1) for o in second.orbits if o.index > 0)
-    return replace(first, name=name, status=second.status, message=second.message,
-                   run=f"{first.run}+{second.run}", orbits=first.orbits + moved, **stacked)
-
-
-def amplitude(branch: Branch, model: Model) -> np.ndarray:
-    """(N,) the largest half peak-to-peak value of any state over each orbit, in AUTO's
-    non-dimensional units (the PVLS ``amplitude`` output); 0 on equilibria."""
-    scale = np.asarray(model.state_scale, dtype=float)
-    return ((branch.state_max - branch.state_min) / (2 * scale)).max(axis=1)

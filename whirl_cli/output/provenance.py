@@ -13,9 +13,9 @@ from datetime import UTC, datetime
 from functools import cache
 from pathlib import Path
 
-from . import __version__
+from .. import __version__
 
-PACKAGE = Path(__file__).resolve().parent
+PACKAGE = Path(__file__).resolve().parent.parent
 
 
 @cache
@@ -32,7 +32,7 @@ def code_sha256() -> str:
 def provenance(study) -> dict[str, str]:
     """Root attributes of a result file: versions, the code fingerprint, the study text and
     its hash, the time of creation (UTC) and ``git describe`` where available."""
-    from .auto import auto_version
+    from ..auto.toolchain import auto_version
 
     attributes = {
         "whirl_version": __version__,

@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .models import Model
-from .results import LinearGrid, LinearSweep
+from ..models import Model
+from ..results import LinearGrid, LinearSweep
 
 FORWARD, BACKWARD, NON_OSCILLATORY = "FW", "BW", "--"
 

@@ -15,10 +15,10 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
+from ..interrupts import end_processes, quiet_worker
+from ..models import Model
+from ..results import Branch, BranchKind, CrossCheck, Orbit, PointType
 from .global_bifurcations import BLOWUP_FACTOR
-from .interrupts import end_processes, quiet_worker
-from .models import Model
-from .results import Branch, BranchKind, CrossCheck, Orbit, PointType
 
 #: Relative tolerance on the amplitude for "the simulation stays on the orbit".
 ORBIT_TOLERANCE = 0.01
@@ -118,8 +118,8 @@ def cross_check(model: Model, overrides: dict[str, float], branches: tuple[Branc
     to bifurcations, orbits in a period blow-up (T > 3 T_Hopf) and equilibria too weakly damped
     or too stiff to simulate in bounded time. ``jobs`` > 1 simulates in that many forked
     processes (results identical, in the same order); the workers ignore SIGINT and die with
-    the parent (:func:`whirl_cli.auto.quiet_worker`), and an interrupt of the parent kills them
-    at once."""
+    the parent (:func:`whirl_cli.interrupts.quiet_worker`), and an interrupt of the parent kills
+    them at once."""
     tasks = planned_checks(branches, per_branch)
     if jobs > 1 and len(tasks) > 1 and "fork" in multiprocessing.get_all_start_methods():
         global _SHARED

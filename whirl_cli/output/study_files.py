@@ -2,7 +2,7 @@
 
 :func:`publish_study` is how ``whirl run`` and ``whirl sweep`` write a finished study:
 
-1. every plot is rendered in memory first (:func:`whirl_cli.plots.render_study_plots`); if
+1. every plot is rendered in memory first (:func:`whirl_cli.plots.files.render_study_plots`); if
    drawing fails (a bug), the HDF5 file is still published, alone, and the error reported
    (the result is not lost, and a sweep draws the missing plots again next time);
 2. without ``overwrite`` nothing is written if the HDF5 file or any of the plot files exists
@@ -10,7 +10,7 @@
 3. the files are published with SIGINT and SIGTERM held back (an interrupt arriving then is
    delivered once the set is complete): the plots first, the HDF5 file last. Its root
    attribute ``plots`` lists the plot files published with it. Each file appears complete or
-   not at all (:func:`whirl_cli.store.publish`), so even a SIGKILL can leave at most plots
+   not at all (:func:`whirl_cli.output.atomic.publish`), so even a SIGKILL can leave at most plots
    without their HDF5 file, never an HDF5 file without its plots; a sweep treats a study
    without its HDF5 file as not run, and completes the plots of an up-to-date file that lacks
    some (:func:`missing_plots`);
@@ -28,9 +28,9 @@ from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from . import store
-from .errors import OutputError
-from .results import StudyResult
+from ..errors import OutputError
+from ..results import StudyResult
+from . import atomic, store
 
 #: Root attribute of the HDF5 file: names of the plot files published with it.
 PLOTS_ATTRIBUTE = "plots"
@@ -52,7 +52,7 @@ def publish_study(result: StudyResult, output: Path, kinds: Sequence[str],
     output = Path(output)
     plots, plot_error = [], ""
     if kinds:
-        from .plots import render_study_plots
+        from ..plots.files import render_study_plots
 
         try:
             plots = render_study_plots(result, tuple(kinds), output.stem)
@@ -71,7 +71,7 @@ def publish_study(result: StudyResult, output: Path, kinds: Sequence[str],
     with held_signals():
         try:
             for (_, data), path in zip(plots, targets, strict=True):
-                written.append(store.publish(data, path, overwrite, what="the plot"))
+                written.append(atomic.publish(data, path, overwrite, what="the plot"))
             written.append(store.write(result, output, overwrite=overwrite))
         except BaseException:
             if not overwrite:  # they did not exist before: leave no plots without their file
@@ -86,11 +86,11 @@ def publish_study(result: StudyResult, output: Path, kinds: Sequence[str],
 def publish_plots(output: Path, kinds: Sequence[str]) -> tuple[Path, ...]:
     """Draw the plots of ``kinds`` of the existing result ``output`` next to it (replacing
     files of the same names): how a sweep completes an up-to-date study's plots."""
-    from .plots import render_study_plots
+    from ..plots.files import render_study_plots
 
     rendered = render_study_plots(store.read(output), tuple(kinds), Path(output).stem)
     with held_signals():
-        return tuple(store.publish(data, Path(output).parent / name, True, what="the plot")
+        return tuple(atomic.publish(data, Path(output).parent / name, True, what="the plot")
                      for name, data in rendered)
 
 
@@ -117,7 +117,7 @@ def missing_plots(output: Path, kinds: Sequence[str]) -> list[str]:
         return []
     names = recorded_plots(output)
     if not names:
-        from .plots import plot_names
+        from ..plots.files import plot_names
 
         names = tuple(plot_names(store.read(output), tuple(kinds), Path(output).stem))
     return [name for name in names if not (Path(output).parent / name).exists()]
@@ -127,7 +127,7 @@ def missing_plots(output: Path, kinds: Sequence[str]) -> list[str]:
 def held_signals() -> Iterator[None]:
     """SIGINT and SIGTERM are held back while inside (main thread only; elsewhere a no-op):
     one that arrives is recorded, and raised again on leaving, so that the handler that was
-    in place (Python's KeyboardInterrupt, :func:`whirl_cli.auto.interruptible`'s, or the
+    in place (Python's KeyboardInterrupt, :func:`whirl_cli.auto.runner.interruptible`'s, or the
     default action) deals with it then. (Blocking the signals would not do: the kernel hands
     a process-directed signal to any thread that does not block it.)"""
     if threading.current_thread() is not threading.main_thread():

@@ -38,10 +38,11 @@ The groups holding collections (continuations, branches, orbits, sweeps, boundar
 polygons, contour lines, runs) track the creation order of their members, so a round trip
 keeps the order of the study and its results; older files list (and read) by name.
 
-The file is built in memory, written to an unnamed file in the output directory (O_TMPFILE)
-and linked into place, so an output path never holds a partial file and an interrupted write
-(even SIGKILL) leaves no temporary file; an existing file is only replaced with ``overwrite``
-(removed, then the new one linked: see :func:`_link_unnamed` for the trade-off).
+The file is built in memory and published by :mod:`whirl_cli.output.atomic`: written to an
+unnamed file in the output directory (O_TMPFILE) and linked into place, so an output path never
+holds a partial file and an interrupted write (even SIGKILL) leaves no temporary file; an
+existing file is only replaced with ``overwrite`` (removed, then the new one linked: see
+:func:`whirl_cli.output.atomic._link_unnamed` for the trade-off).
 """
 
 from __future__ import annotations
@@ -55,8 +56,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from .errors import OutputError
-from .results import (
+from ..errors import OutputError
+from ..results import (
     Boundary,
     Branch,
     BranchKind,
@@ -70,6 +71,7 @@ from .results import (
     StudyResult,
     UnsafeInterval,
 )
+from .atomic import publish
 
 SCHEMA = 1
 _STR = h5py.string_dtype()
@@ -231,8 +233,9 @@ def write(result: StudyResult, path: Path, overwrite: bool = False) -> Path:
     SIGKILL leaves no partial file and no temporary file behind. Without ``overwrite`` the link
     fails if ``path`` exists (also if it appeared meanwhile); with it, the old file is removed
     and the new one linked in its place (a SIGKILL in between leaves neither, see
-    :func:`_link_unnamed`). Where ``O_TMPFILE`` is unavailable a hidden named temporary is
-    written and renamed into place (a SIGKILL before the rename leaves it).
+    :func:`whirl_cli.output.atomic._link_unnamed`). Where ``O_TMPFILE`` is unavailable a
+    hidden named temporary is written and renamed into place (a SIGKILL before the rename
+    leaves it).
     """
     path = Path(path)
     if path.exists() and not overwrite:
@@ -240,18 +243,6 @@ def write(result: StudyResult, path: Path, overwrite: bool = False) -> Path:
     if not path.parent.is_dir():
         raise OutputError(f"{path}: the output directory {path.parent} does not exist")
     return publish(_image(result), path, overwrite, what="the output")
-
-
-def publish(data: bytes, path: Path, overwrite: bool = False, what: str = "the file") -> Path:
-    """Write ``data`` (e.g. a PNG rendered to memory) to ``path`` the way :func:`write` writes
-    result files: complete or not at all, no temporary file left even by SIGKILL. ``what``
-    names the file in the error message."""
-    path = Path(path)
-    try:
-        _publish(data, path, overwrite)
-    except OSError as error:
-        raise OutputError(f"{path}: cannot write {what} ({error.strerror or error})") from None
-    return path
 
 
 def _image(result: StudyResult) -> bytes:
@@ -293,98 +284,6 @@ def _image(result: StudyResult) -> bytes:
         return handle.id.get_file_image()
 
 
-def _publish(image: bytes, path: Path, overwrite: bool) -> None:
-    """Make ``image`` the file at ``path`` in one step (see :func:`write`)."""
-    directory = os.open(path.parent, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
-    try:
-        fd = None
-        if os.path.isdir("/proc/self/fd"):  # the unnamed file is linked through /proc
-            try:
-                fd = os.open(path.parent, os.O_TMPFILE | os.O_WRONLY | os.O_CLOEXEC, 0o666)
-            except (AttributeError, OSError):  # not Linux, or a file system without O_TMPFILE
-                fd = None
-        if fd is None:
-            _publish_named(image, path, overwrite, directory)
-        else:
-            try:
-                _write_all(fd, image)
-                _link_unnamed(fd, path, overwrite, directory)
-            finally:
-                os.close(fd)
-        try:
-            os.fsync(directory)  # the new name survives a power cut
-        except OSError:  # some file systems cannot sync a directory; the file is in place
-            pass
-    finally:
-        os.close(directory)
-
-
-def _write_all(fd: int, data: bytes) -> None:
-    view = memoryview(data)
-    while view:
-        view = view[os.write(fd, view):]
-    os.fsync(fd)
-
-
-def _exists_error(path: Path) -> OutputError:
-    return OutputError(f"{path}: output exists; pass --overwrite to replace it")
-
-
-#: How often an overwriting write removes a file another writer put in its place meanwhile.
-_REPLACE_ATTEMPTS = 100
-
-
-def _link_unnamed(fd: int, path: Path, overwrite: bool, directory: int) -> None:
-    """Give the O_TMPFILE file ``fd`` the name ``path`` (linked through /proc/self/fd).
-
-    Without ``overwrite`` the link fails if ``path`` exists. With it, an existing file is
-    removed and the unnamed one linked in its place, again if another writer's file appeared
-    in between. A link cannot replace a name, and a rename needs the new file to have a name
-    first: a named temporary, which SIGKILL before the rename would leave behind. The
-    trade-off: for the microseconds between the unlink and the link no file is at ``path``
-    (a reader may find none, and a SIGKILL exactly then leaves neither the old file nor the
-    new one), but there is never a partial or a temporary file.
-    """
-    source = f"/proc/self/fd/{fd}"
-    for _ in range(_REPLACE_ATTEMPTS):
-        try:
-            os.link(source, path.name, dst_dir_fd=directory, follow_symlinks=True)
-            return
-        except FileExistsError:
-            if not overwrite:
-                raise _exists_error(path) from None
-        try:
-            os.unlink(path.name, dir_fd=directory)
-        except FileNotFoundError:  # another writer removed it first
-            pass
-    raise OutputError(f"{path}: not replaced: other processes keep writing it")
-
-
-def _publish_named(image: bytes, path: Path, overwrite: bool, directory: int) -> None:
-    """Fallback without O_TMPFILE: a hidden temporary next to ``path``, renamed into place."""
-    temporary = f".{path.name}.tmp-{os.getpid()}"
-    fd = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o666,
-                 dir_fd=directory)
-    try:
-        try:
-            _write_all(fd, image)
-        finally:
-            os.close(fd)
-        if overwrite:
-            os.replace(temporary, path.name, src_dir_fd=directory, dst_dir_fd=directory)
-        else:
-            try:
-                os.link(temporary, path.name, src_dir_fd=directory, dst_dir_fd=directory)
-            except FileExistsError:
-                raise _exists_error(path) from None
-    finally:
-        try:
-            os.unlink(temporary, dir_fd=directory)
-        except FileNotFoundError:
-            pass
-
-
-# ----------------------------------------------------------------------------------- reading
 def _text(value) -> str:
     return value.decode() if isinstance(value, bytes) else str(value)
 
@@ -461,9 +360,9 @@ _DAMAGED = (KeyError, OSError, ValueError, TypeError, IndexError)
 @contextmanager
 def opened(path: Path) -> Iterator[h5py.File]:
     """``path`` opened with h5py for reading, for the readers of result files (:func:`read`,
-    :mod:`whirl_cli.compare`). A file that is not HDF5, a truncated or unreadable one, and one
-    missing what its reader looks up inside the ``with`` block raise :class:`OutputError` as
-    one line ``<path>: <reason>``, never an h5py traceback."""
+    :mod:`whirl_cli.output.compare`). A file that is not HDF5, a truncated or unreadable one,
+    and one missing what its reader looks up inside the ``with`` block raise
+    :class:`OutputError` as one line ``<path>: <reason>``, never an h5py traceback."""
     try:
         handle = h5py.File(path, "r")
     except OSError as error:
@@ -537,3 +436,4 @@ def read(path: Path) -> StudyResult:
         return StudyResult(_text(handle.attrs["study_name"]), _text(handle.attrs["model"]),
                            tuple(continuations), tuple(sweeps), runs, attributes, boundaries,
                            grid)
+

@@ -1,0 +1,64 @@
+"""Operations on branches: their first rows, two runs joined into one, the orbit amplitude, the
+special points on them; and notes joined (shared by the recipes).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..models import Model
+from ..results import Branch, PointType, SpecialPoint
+
+
+def head(branch: Branch, rows: int) -> Branch:
+    """The first ``rows`` points of ``branch`` (with the orbits stored on them)."""
+    return replace(branch, **{key: getattr(branch, key)[:rows] for key in (
+        "parameters", "state_max", "state_min", "l2_norm", "period", "stable", "point_type",
+        "label", "eigenvalues", "stability_known")},
+        orbits=tuple(o for o in branch.orbits if o.index < rows))
+
+
+def join(first: Branch, second: Branch, name: str) -> Branch:
+    """One branch from two consecutive runs (the second restarted at the first's last point,
+    which it repeats)."""
+    shift = len(first)
+    stacked = {key: np.concatenate([getattr(first, key), getattr(second, key)[1:]])
+               for key in ("parameters", "state_max", "state_min", "l2_norm", "period", "stable",
+                           "point_type", "label", "eigenvalues", "stability_known")}
+    moved = tuple(replace(o, index=o.index + shift - 1) for o in second.orbits if o.index > 0)
+    return replace(first, name=name, status=second.status, message=second.message,
+                   run=f"{first.run}+{second.run}", orbits=first.orbits + moved, **stacked)
+
+
+def amplitude(branch: Branch, model: Model) -> np.ndarray:
+    """(N,) the largest half peak-to-peak value of any state over each orbit, in AUTO's
+    non-dimensional units (the PVLS ``amplitude`` output); 0 on equilibria."""
+    scale = np.asarray(model.state_scale, dtype=float)
+    return ((branch.state_max - branch.state_min) / (2 * scale)).max(axis=1)
+
+
+def special_points(branch: Branch, skip_first: bool = False) -> list[SpecialPoint]:
+    """The bifurcations on ``branch`` (HB, BP, LP, LPC, PD, TR, codim-2 ...)."""
+    found = []
+    for index in range(len(branch)):
+        kind = PointType(int(branch.point_type[index]))
+        if not kind.is_special or (skip_first and index == 0):
+            continue
+        found.append(SpecialPoint(
+            branch=branch.name, index=index, point_type=int(kind),
+            parameter_names=branch.parameter_names, parameters=branch.parameters[index].copy(),
+            state=branch.state_max[index].copy(), period=float(branch.period[index]),
+            stable=bool(branch.stable[index]), label=int(branch.label[index])))
+    return found
+
+
+def _same_point(a: SpecialPoint, b: SpecialPoint, width: float) -> bool:
+    return (abs(a.parameters[0] - b.parameters[0]) <= 1e-5 * width
+            and np.allclose(a.state, b.state, atol=1e-5, rtol=1e-4))
+
+
+def _joined(*notes: str) -> str:
+    return "; ".join(n for n in notes if n)
+

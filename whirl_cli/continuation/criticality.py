@@ -1,0 +1,91 @@
+"""Criticality of Hopf points: a provisional one from the first Lyapunov coefficient
+(:mod:`whirl_cli.analysis.normal_form`), then the side the periodic family lies on, which has
+the last word.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..analysis.normal_form import criticality_of, hopf_lyapunov_coefficient
+from ..models import Model
+from ..results import Branch, PointType, SpecialPoint
+from .branches import _joined
+from .periodic import _hopf_at
+
+
+def _with_criticality(points: list[SpecialPoint], families: list[Branch],
+                      branches: list[Branch], width: float, scale: np.ndarray
+                      ) -> list[SpecialPoint]:
+    """Hopf points labelled supercritical or subcritical from the periodic family at them:
+    supercritical when the family lies on the side where the Hopf pair is unstable."""
+    equilibria = {b.name: b for b in branches}
+    hopfs = [p for p in points if p.point_type == PointType.HB]
+    sides: dict[int, float] = {}
+    for family in families:
+        if len(family) < 3:
+            continue
+        for row, neighbour in ((0, 1), (len(family) - 1, len(family) - 2)):
+            k = _hopf_at(family, row, hopfs, width, scale) if row else next(
+                (i for i, h in enumerate(hopfs) if family.origin == _origin(h)), None)
+            if k is not None and k not in sides:
+                sides[k] = float(np.sign(family.parameters[neighbour, 0]
+                                         - hopfs[k].parameters[0]))
+    labelled = []
+    for point in points:
+        if point.point_type == PointType.HB:
+            k = next(i for i, h in enumerate(hopfs) if h is point)
+            growth = _hopf_growth_direction(equilibria[point.branch], point)
+            side = sides.get(k, 0.0)
+            if side and growth:
+                from_family = "supercritical" if side == growth else "subcritical"
+                if point.criticality and point.criticality != from_family:
+                    point = replace(point, note=_joined(
+                        point.note, f"first Lyapunov coefficient says {point.criticality}"))
+                point = replace(point, criticality=from_family)
+        labelled.append(point)
+    return labelled
+
+
+def with_lyapunov(model: Model, parameter: str, parameters: dict[str, float],
+                  points: list[SpecialPoint]) -> list[SpecialPoint]:
+    """Hopf points of equilibria with their first Lyapunov coefficient and, from its sign, a
+    provisional criticality (a periodic family, when computed, has the last word: see
+    :func:`_with_criticality`)."""
+    labelled = []
+    for point in points:
+        if point.point_type == PointType.HB:
+            values = model.parameter_vector({**parameters, parameter: point.parameters[0]})
+            try:
+                l1 = hopf_lyapunov_coefficient(model, point.state, values)
+            except (ValueError, np.linalg.LinAlgError):
+                l1 = float("nan")
+            point = replace(point, lyapunov=l1,
+                            criticality=criticality_of(l1, 2 * np.pi / point.period))
+        labelled.append(point)
+    return labelled
+
+
+def _origin(hopf: SpecialPoint) -> str:
+    return f"HB at {hopf.parameter_names[0]} = {hopf.parameters[0]:.6g} on {hopf.branch}"
+
+
+def _hopf_growth_direction(branch: Branch, hopf: SpecialPoint) -> float:
+    """Sign of d(Re lambda)/dp of the critical pair at a Hopf point, from the eigenvalues AUTO
+    printed at the neighbouring points of the equilibrium branch; 0 (unknown) where AUTO
+    printed none there."""
+    k = hopf.index
+    if k == 0 or k + 1 >= len(branch):
+        return 0.0
+    omega = 2 * np.pi / hopf.period
+
+    def critical(row: int) -> float:
+        values = branch.eigenvalues[row]
+        return float(values[np.argmin(np.abs(np.abs(values.imag) - omega))].real)
+
+    slope = (critical(k + 1) - critical(k - 1)) / (branch.parameters[k + 1, 0]
+                                                   - branch.parameters[k - 1, 0])
+    return float(np.sign(slope)) if np.isfinite(slope) else 0.0
+

@@ -1,0 +1,159 @@
+"""The engine under every recipe: AUTO numerics, run specifications, runs made in parallel.
+
+An :class:`Engine` compiles a model's equations once and makes :class:`RunSpec` runs, each in
+its own directory, ``jobs`` at a time; :func:`_run_branches` and :func:`_read` read the branches
+they wrote (an empty branch with the run's status and message where a run failed).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, fields, replace
+from pathlib import Path
+
+import numpy as np
+
+from ..auto import runner, toolchain
+from ..auto.codegen import fortran_source, source_key
+from ..auto.parse import read_branch
+from ..models import Model
+from ..results import Branch, RunRecord, SpecialPoint
+from .branches import special_points
+
+
+@dataclass(frozen=True)
+class Numerics:
+    """Resolved AUTO numerics under readable names (study ``auto:`` keys override them).
+
+    Step sizes are fractions of the width of the continuation range, so one set of defaults
+    serves every parameter (the model's time is non-dimensional, see ``models/base.py``).
+    """
+
+    max_steps: int = 2000  # NMX
+    step_initial: float = 0.002  # |DS| / range width
+    step_min: float = 1e-7  # DSMIN / range width
+    step_max: float = 0.005  # DSMAX / range width
+    mesh_intervals: int = 40  # NTST
+    collocation_points: int = 4  # NCOL
+    newton_max_iterations: int = 7  # ITNW
+    tolerance: float = 1e-8  # EPSL = EPSU
+    timeout: float = 120.0  # s per AUTO run
+    max_amplitude: float = 1.5  # rad: branches stop when an angle exceeds it
+    orbits_at: tuple[float, ...] = ()  # parameter values with a labelled solution (UZR)
+
+    @classmethod
+    def from_settings(cls, settings: object | None) -> Numerics:
+        """Defaults overridden by the non-None attributes of a study's ``auto`` settings."""
+        if settings is None:
+            return cls()
+        chosen = {f.name: getattr(settings, f.name) for f in fields(cls)
+                  if getattr(settings, f.name, None) is not None}
+        return replace(cls(), **chosen)
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One AUTO run to make, named ``<continuation>/<branch>``.
+
+    ``restart``: (AUTO name of an earlier run, i.e. its name with "/" -> ".", label to restart
+    from).
+    """
+
+    name: str
+    constants: dict
+    kind: str
+    origin: str
+    parameter_names: tuple[str, ...]
+    restart: tuple[str, int] | None = None
+
+
+class Engine:
+    """Runs AUTO jobs of one model: compiles once, one directory per run, ``jobs`` in parallel."""
+
+    def __init__(self, model: Model, workroot: Path, jobs: int = 1, timeout: float = 120.0,
+                 on_run: Callable[[runner.RunOutcome], None] | None = None) -> None:
+        self.model = model
+        self.workroot = Path(workroot)
+        self.jobs = max(1, jobs)
+        self.timeout = timeout
+        self.on_run = on_run
+        self.executable = toolchain.compile_equations(lambda: fortran_source(model), model.name,
+                                                 source_key=source_key(model))
+        self.outcomes: dict[str, runner.RunOutcome] = {}
+
+    def run_many(self, specs: Sequence[RunSpec]) -> list[runner.RunOutcome]:
+        """Execute ``specs`` (independent of each other) and return outcomes in spec order."""
+        with ThreadPoolExecutor(max_workers=self.jobs) as pool:
+            outcomes = list(pool.map(self._execute, specs))
+        return outcomes
+
+    def _execute(self, spec: RunSpec) -> runner.RunOutcome:
+        constants = dict(spec.constants)
+        restart_file = None
+        if spec.restart is not None:
+            source, label = spec.restart
+            restart_file = self.outcomes[source].file("s")
+            constants["IRS"] = label
+        outcome = runner.run(self.executable.path, constants, self.workroot / spec.name,
+                           spec.name.replace("/", "."), restart=restart_file,
+                           timeout=self.timeout)
+        self.outcomes[outcome.name] = outcome
+        if self.on_run is not None:
+            self.on_run(outcome)
+        return outcome
+
+    def run_with_label(self, runs: str, label: int) -> str:
+        """Which of the AUTO runs ``runs`` ("a+b+..." for a branch joined from several runs)
+        wrote the solution labelled ``label``."""
+        for name in reversed(runs.split("+")):  # the latest run of a chain of restarts
+            if any(found == label for _, found in self.outcomes[name].labels):
+                return name
+        raise KeyError(f"label {label} not found in runs {runs}")
+
+    def records(self) -> tuple[RunRecord, ...]:
+        return tuple(
+            RunRecord(o.name, o.status, o.message, o.constants,
+                      -1 if o.returncode is None else o.returncode, o.wall_seconds, o.n_points)
+            for o in sorted(self.outcomes.values(), key=lambda o: str(o.workdir)))
+
+
+def _run_branches(engine: Engine, specs: list[RunSpec], branches: list[Branch],
+                  points: list[SpecialPoint], skip_first: bool) -> list[SpecialPoint]:
+    """Run ``specs``, append their branches and special points; return the new points."""
+    new_points: list[SpecialPoint] = []
+    for spec, outcome in zip(specs, engine.run_many(specs), strict=True):
+        if not outcome.has_output:
+            branches.append(_failed_branch(engine.model, spec, outcome))
+            continue
+        branch = read_branch(outcome, engine.model, name=spec.name.split("/", 1)[-1],
+                             kind=spec.kind, origin=spec.origin,
+                             parameter_names=spec.parameter_names)
+        branches.append(branch)
+        found = special_points(branch, skip_first=skip_first)
+        points.extend(found)
+        new_points.extend(found)
+    return new_points
+
+
+def _failed_branch(model: Model, spec: RunSpec, outcome: runner.RunOutcome) -> Branch:
+    """An empty branch that records a failed run (status and message kept for the HDF5)."""
+    n, p = model.n_states, len(spec.parameter_names)
+    return Branch(
+        name=spec.name.split("/", 1)[-1], kind=spec.kind, origin=spec.origin,
+        parameter_names=spec.parameter_names,
+        parameter_units=tuple(model.parameter(x).unit for x in spec.parameter_names),
+        state_names=model.state_names, state_units=tuple(s.unit for s in model.states),
+        parameters=np.empty((0, p)), state_max=np.empty((0, n)), state_min=np.empty((0, n)),
+        l2_norm=np.empty(0), period=np.empty(0), stable=np.empty(0, dtype=bool),
+        point_type=np.empty(0, dtype=np.int64), label=np.empty(0, dtype=np.int64),
+        eigenvalues=np.empty((0, n), dtype=complex), status=outcome.status,
+        message=outcome.message, run=outcome.name)
+
+
+def _read(engine: Engine, spec: RunSpec, outcome: runner.RunOutcome) -> Branch:
+    if not outcome.has_output:
+        return _failed_branch(engine.model, spec, outcome)
+    return read_branch(outcome, engine.model, name=spec.name.split("/", 1)[-1], kind=spec.kind,
+                       origin=spec.origin, parameter_names=spec.parameter_names)
+

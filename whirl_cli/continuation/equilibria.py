@@ -1,0 +1,117 @@
+"""One-parameter equilibria and their AUTO constants.
+
+1. the main branch from the start value, both directions, to the ends of the range;
+2. at every branch point (BP) found, branch switching (ISW=-1) in both directions to the
+   secondary (static-divergence) equilibria, recursively for branch points on those branches
+   (each point once).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..auto.constants import base_constants, par_layout
+from ..models import Model
+from ..results import Branch, BranchKind, PointType, SpecialPoint
+from .branches import _same_point
+from .engine import Engine, Numerics, RunSpec, _run_branches
+
+#: How deep branch switching recurses (main -> secondary -> tertiary).
+MAX_SWITCH_DEPTH = 3
+
+
+def _stops(model: Model, parameter: str, bounds: tuple[float, float], amplitude: float) -> dict:
+    stops: dict = {parameter: [float(bounds[0]), float(bounds[1])]}
+    for state in model.states:
+        if state.unit == "rad":
+            stops[f"max_{state.name}"] = amplitude
+            stops[f"min_{state.name}"] = -amplitude
+    return stops
+
+
+def equilibrium_constants(model: Model, numerics: Numerics, parameter: str,
+                          bounds: tuple[float, float], direction: int) -> dict:
+    """Constants for a one-parameter continuation of equilibria (IPS=1) of ``parameter``."""
+    lower, upper = bounds
+    width = upper - lower
+    return base_constants(model) | {
+        "IPS": 1, "ISW": 1, "IRS": 0, "ILP": 1, "ISP": 2, "MXBF": 0,
+        "ICP": [parameter, *par_layout(model).measures()],
+        "NMX": numerics.max_steps, "NPR": 0, "IID": 2,
+        "DS": direction * numerics.step_initial * width,
+        "DSMIN": numerics.step_min * width, "DSMAX": numerics.step_max * width,
+        "EPSL": numerics.tolerance, "EPSU": numerics.tolerance, "EPSS": 1e-6,
+        "ITMX": 30, "ITNW": numerics.newton_max_iterations, "NWTN": 3,
+        "NTST": numerics.mesh_intervals, "NCOL": numerics.collocation_points, "IAD": 3,
+        "RL0": lower - 0.05 * width, "RL1": upper + 0.05 * width,
+        "UZSTOP": _stops(model, parameter, bounds, numerics.max_amplitude),
+    } | ({"UZR": {parameter: [float(v) for v in numerics.orbits_at]}} if numerics.orbits_at
+         else {})
+
+
+def equilibria(engine: Engine, name: str, parameter: str, start: float,
+               bounds: tuple[float, float], parameters: dict[str, float], numerics: Numerics,
+               branch_points: bool = True) -> tuple[list[Branch], list[SpecialPoint]]:
+    """Equilibrium branches (main, then secondary from every BP) and their special points."""
+    model = engine.model
+    lower, upper = bounds
+    width = upper - lower
+    start_parameters = {**parameters, parameter: float(start)}
+    specs = []
+    for direction, label in ((-1, "down"), (1, "up")):
+        if (direction < 0 and start > lower) or (direction > 0 and start < upper):
+            constants = equilibrium_constants(model, numerics, parameter, bounds, direction)
+            constants["PAR"] = start_parameters
+            specs.append(RunSpec(f"{name}/main_{label}", constants, BranchKind.EQUILIBRIUM,
+                                 f"start at {parameter} = {start:g}", (parameter,)))
+    branches: list[Branch] = []
+    points: list[SpecialPoint] = []
+    frontier = _run_branches(engine, specs, branches, points, skip_first=False)
+
+    # In a linear model a branch point carries a straight line of equilibria at a fixed
+    # parameter value; AUTO's fold test fires all along it, so fold detection is switched off.
+    neutral = is_linear(model, parameters)
+    switched: list[SpecialPoint] = []
+    depth = 0
+    while branch_points and frontier and depth < MAX_SWITCH_DEPTH:
+        depth += 1
+        todo = []
+        for point in frontier:
+            if point.point_type != PointType.BP or any(
+                    _same_point(point, done, width) for done in switched):
+                continue
+            switched.append(point)
+            source = _run_of(branches, point.branch)
+            for direction, label in ((1, "a"), (-1, "b")):
+                constants = equilibrium_constants(model, numerics, parameter, bounds, direction)
+                constants["ISW"] = -1
+                if neutral:
+                    constants["ILP"] = 0
+                todo.append(RunSpec(
+                    f"{name}/secondary_{len(switched)}{label}", constants,
+                    BranchKind.EQUILIBRIUM,
+                    f"BP at {parameter} = {point.parameters[0]:.6g} on {point.branch}",
+                    (parameter,), restart=(source, point.label)))
+        frontier = [p for p in _run_branches(engine, todo, branches, points, skip_first=True)
+                    if not any(_same_point(p, q, width) for q in switched)]
+
+    unique: list[SpecialPoint] = []
+    for point in points:
+        if not any(point.point_type == q.point_type and _same_point(point, q, width)
+                   for q in unique):
+            unique.append(point)
+    return branches, unique
+
+
+def is_linear(model: Model, parameters: dict[str, float]) -> bool:
+    """True if the right-hand side is linear in the states at these parameter values."""
+    values = model.parameter_vector(parameters)
+    probe = np.random.default_rng(0).standard_normal(model.n_states) * 0.3
+    rhs = model.rhs_numpy(probe, values)
+    linearised = model.jacobian_numpy(np.zeros(model.n_states), values) @ probe
+    return bool(np.allclose(rhs, linearised, rtol=1e-10, atol=1e-12 * np.abs(rhs).max()))
+
+
+def _run_of(branches: list[Branch], branch_name: str) -> str:
+    return next(b.run for b in branches if b.name == branch_name)
+

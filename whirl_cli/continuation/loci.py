@@ -1,0 +1,227 @@
+"""The two-parameter recipe: one-parameter runs at every slice, then the loci of their special
+points (Hopf, branch point, fold, fold of cycles), each traced once, chunk by chunk.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..auto import runner
+from ..auto.constants import par_layout
+from ..models import Model
+from ..results import Branch, BranchKind, ContinuationResult, PointType, SpecialPoint
+from .branches import _same_point, head, join, special_points
+from .engine import Engine, Numerics, RunSpec, _read
+from .equilibria import equilibrium_constants
+from .geometry import _at_range_edge, _chunk_used, _closed, _near_polyline, _on_curve
+from .one_parameter import one_parameter
+
+#: Special point type -> (locus name in studies, branch kind of its locus).
+LOCI = {
+    PointType.HB: ("hopf", BranchKind.HOPF_LOCUS),
+    PointType.BP: ("branch_point", BranchKind.BRANCH_POINT_LOCUS),
+    PointType.LP: ("fold", BranchKind.FOLD_LOCUS),
+    PointType.LPC: ("fold_of_cycles", BranchKind.FOLD_OF_CYCLES_LOCUS),
+}
+
+
+def locus_constants(model: Model, numerics: Numerics, pair: tuple[str, str],
+                    bounds: dict[str, tuple[float, float]], direction: int,
+                    kind: PointType) -> dict:
+    """Constants of a two-parameter locus (ISW=2) of a special point of type ``kind``.
+    Debian's AUTO 0.9.2 overruns a heap buffer on fold-of-cycles loci unless ISP=0."""
+    first, second = pair
+    constants = equilibrium_constants(model, numerics, first, bounds[first], direction)
+    constants.update(ISW=2, ICP=[first, second, "PERIOD", *par_layout(model).measures()])
+    constants.pop("UZR", None)
+    lower, upper = bounds[second]
+    constants["UZSTOP"] = dict(constants["UZSTOP"], **{second: [lower, upper]})
+    if kind == PointType.LPC:
+        constants.update(IPS=2, ISP=0, ILP=1)
+    return constants
+
+
+def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
+                  bounds: dict[str, tuple[float, float]], start: float,
+                  slices: tuple[float, ...], loci: tuple[str, ...],
+                  parameters: dict[str, float], numerics: Numerics
+                  ) -> tuple[ContinuationResult, list[Branch]]:
+    """One-parameter runs at every slice of the second parameter, then the loci of their
+    special points (both directions, each locus once). Returns the continuation (slice branches
+    named ``slice_<k>.<branch>`` and the locus branches) and the locus branches."""
+    first, second = pair
+    wanted = {kind for kind, (locus, _) in LOCI.items() if locus in loci}
+    periodic = PointType.LPC in wanted
+    branches: list[Branch] = []
+    points: list[SpecialPoint] = []
+    starts: list[tuple[SpecialPoint, str]] = []
+    for k, value in enumerate(slices):
+        result = one_parameter(engine, f"{name}.slice_{k}", first, start, bounds[first],
+                               {**parameters, second: value}, numerics, periodic=periodic)
+        runs = {b.name: b.run for b in result.branches}
+        for branch in result.branches:
+            branches.append(replace(branch, name=f"slice_{k}.{branch.name}"))
+        for point in result.special_points:
+            named = replace(point, branch=f"slice_{k}.{point.branch}", parameter_names=pair,
+                            parameters=np.array([point.parameters[0], value]))
+            points.append(named)
+            width = bounds[first][1] - bounds[first][0]
+            if point.point_type in wanted and point.status == "located" and not any(
+                    point.point_type == other.point_type and _same_point(named, other, width)
+                    for other, _ in starts):
+                starts.append((named, runs[point.branch]))
+    curves = _loci(engine, name, pair, bounds, numerics, starts)
+    for curve in curves:
+        points += special_points(curve, skip_first=True)
+    return (ContinuationResult(name, "two-parameter", tuple(branches + curves), tuple(points)),
+            curves)
+
+
+def _loci(engine: Engine, name: str, pair: tuple[str, str],
+          bounds: dict[str, tuple[float, float]], numerics: Numerics,
+          starts: list[tuple[SpecialPoint, str]]) -> list[Branch]:
+    """Locus branches from the start points, both directions, each locus once.
+
+    Starts are taken slice by slice: a start lying on a locus of its type already traced
+    from an earlier slice is the same locus and is not run again (AUTO's runs, not just the
+    results, are saved). Duplicates left (two starts of one slice on one locus) are dropped."""
+    width = np.array([bounds[p][1] - bounds[p][0] for p in pair])
+    numbered = list(enumerate(starts, 1))
+    waves: dict[str, list] = {}
+    for k, (point, runs) in numbered:
+        waves.setdefault(point.branch.split(".", 1)[0], []).append((k, point, runs))
+    curves: list[tuple[int, Branch]] = []
+    for wave in waves.values():
+        todo = [(k, point, runs) for k, point, runs in wave if not any(
+            kind == point.point_type and _near_polyline(point.parameters[:2], curve.parameters,
+                                                        width)
+            for kind, curve in curves)]
+        curves += _trace(engine, name, pair, bounds, numerics, todo)
+    kept: list[Branch] = []
+    for _, curve in sorted(curves, key=lambda c: c[1].name):
+        curve = _closed(curve, width)
+        if len(curve) and not any(_on_curve(curve.parameters[0], other.parameters, width)
+                                  and _on_curve(curve.parameters[-1], other.parameters, width)
+                                  for other in kept):
+            kept.append(curve)
+    codim2 = [p for c in kept for p in special_points(c, skip_first=True)
+              if PointType(p.point_type) in CODIM2]
+    return [_locus_end(c, codim2, bounds, width) for c in kept]
+
+
+def _trace(engine: Engine, name: str, pair: tuple[str, str],
+           bounds: dict[str, tuple[float, float]], numerics: Numerics,
+           starts: list[tuple[int, SpecialPoint, str]]) -> list[tuple[int, Branch]]:
+    """(point type, locus branch) of every start, both directions, run in parallel."""
+    model = engine.model
+    specs = []
+    for k, point, runs in starts:
+        kind = PointType(point.point_type)
+        locus, branch_kind = LOCI[kind]
+        source = engine.run_with_label(runs, point.label)
+        origin = f"{kind.name} at {pair[0]} = {point.parameters[0]:.6g} on {point.branch}"
+        for direction, tag in ((1, "a"), (-1, "b")):
+            constants = locus_constants(model, numerics, pair, bounds, direction, kind)
+            if kind == PointType.LPC:  # stage 1: AUTO builds the extended system (NMX 5)
+                constants["NMX"] = 5
+            specs.append((kind, RunSpec(f"{name}/{locus}_{k}{tag}", constants, branch_kind,
+                                        origin, pair, restart=(source, point.label))))
+    outcomes = engine.run_many([spec for _, spec in specs])
+    second_stage = []
+    final: list[tuple[int, RunSpec, runner.RunOutcome]] = []
+    for (kind, spec), outcome in zip(specs, outcomes, strict=True):
+        if kind == PointType.LPC and outcome.has_output:
+            constants = dict(spec.constants, NMX=min(LOCUS_CHUNK, numerics.max_steps))
+            second_stage.append((kind, replace(spec, name=spec.name + "2", constants=constants,
+                                               restart=(outcome.name, outcome.labels[-1][1]))))
+        else:
+            final.append((kind, spec, outcome))
+    final += [(kind, spec, outcome) for (kind, spec), outcome in zip(
+        second_stage, engine.run_many([spec for _, spec in second_stage]), strict=True)]
+    curves = [_read(engine, spec, outcome) for _, spec, outcome in final]
+    width = np.array([bounds[p][1] - bounds[p][0] for p in pair])
+    curves = _extended(engine, [spec for _, spec, _ in final], curves, numerics, bounds, width)
+    curves = _retried(engine, [spec for _, spec, _ in final], curves)
+    return [(kind, curve) for (kind, _, _), curve in zip(final, curves, strict=True)]
+
+
+#: Locus runs go LOCUS_CHUNK steps at a time: a closed locus is recognised after the chunk
+#: that closes it instead of being traced round and round up to the step limit.
+LOCUS_CHUNK = 400
+
+
+def _extended(engine: Engine, specs: list[RunSpec], curves: list[Branch], numerics: Numerics,
+              bounds: dict[str, tuple[float, float]], width: np.ndarray) -> list[Branch]:
+    """Loci that used up a chunk of steps without closing or reaching the range, continued
+    chunk by chunk from their last point (up to ``numerics.max_steps`` in all)."""
+    done = list(curves)
+    chunk = 1
+    while True:
+        again, where = [], []
+        for k, (spec, curve) in enumerate(zip(specs, done, strict=True)):
+            if spec.constants.get("NMX") != LOCUS_CHUNK or not _chunk_used(curve, width,
+                                                                          bounds):
+                continue
+            if len(curve) >= numerics.max_steps or not curve.label[-1]:
+                continue
+            again.append(replace(spec, name=f"{spec.name}c{chunk}",
+                                 restart=(curve.run.rsplit("+", 1)[-1], int(curve.label[-1]))))
+            where.append(k)
+        if not again:
+            return done
+        for spec, k, outcome in zip(again, where, engine.run_many(again), strict=True):
+            extra = _read(engine, spec, outcome)
+            if len(extra) > 1:
+                done[k] = join(done[k], extra, done[k].name)
+        chunk += 1
+
+
+#: Codimension-2 points where loci may end (Bogdanov-Takens, cusp, zero-Hopf, Bautin, ...).
+CODIM2 = {PointType.BT, PointType.CP, PointType.ZH, PointType.GH, PointType.R1, PointType.R2,
+          PointType.R3, PointType.R4}
+
+
+def _retried(engine: Engine, specs: list[RunSpec], curves: list[Branch]) -> list[Branch]:
+    """Loci that ended in MX continued once more from their last good labelled point with
+    twice the mesh and half the largest step, joined to what they had."""
+    again, where = [], []
+    for k, (spec, curve) in enumerate(zip(specs, curves, strict=True)):
+        labelled = [r for r in np.flatnonzero(curve.label) if curve.point_type[r] != PointType.MX]
+        if curve.status != "mx" or not labelled or labelled[-1] == 0:
+            continue
+        row = int(labelled[-1])
+        constants = dict(spec.constants, NTST=spec.constants["NTST"] * 2,
+                         DSMAX=spec.constants["DSMAX"] / 2)
+        again.append(replace(spec, name=spec.name + "r", constants=constants,
+                             restart=(engine.run_with_label(curve.run, int(curve.label[row])),
+                                      int(curve.label[row]))))
+        where.append((k, row))
+    done = list(curves)
+    for spec, (k, row), outcome in zip(again, where, engine.run_many(again), strict=True):
+        extra = _read(engine, spec, outcome)
+        if len(extra):
+            done[k] = join(head(curves[k], row + 1), extra, curves[k].name)
+    return done
+
+
+def _locus_end(curve: Branch, codim2: list[SpecialPoint], bounds: dict[str, tuple[float, float]],
+               width: np.ndarray) -> Branch:
+    """The locus with its end classified: range edge, closed, or a codimension-2 point (where
+    AUTO typically stops with MX: that is the locus' natural end, not a failure)."""
+    last = curve.parameters[-1, :2]
+    if _at_range_edge(curve, bounds, width):
+        return replace(curve, end="range")
+    if len(curve) > 2 and np.abs((last - curve.parameters[0, :2]) / width).max() < 0.005:
+        return replace(curve, end="closed")
+    near = [p for p in codim2 if np.abs((p.parameters[:2] - last) / width).max() < 0.01]
+    if near:
+        point = near[0]
+        where = ", ".join(f"{v:.5g}" for v in point.parameters[:2])
+        message = "ok" if curve.status == "ok" else \
+            "AUTO stopped with MX at the codimension-2 point (the locus ends there)"
+        return replace(curve, end=f"{point.type_name} at ({where})", status="ok",
+                       message=message)
+    return replace(curve, end="no convergence (MX)" if curve.status == "mx" else "step limit")
+

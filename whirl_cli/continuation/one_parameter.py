@@ -1,0 +1,40 @@
+"""The one-parameter recipe: equilibria with branch switching, the criticality of their Hopf
+points and, when asked, the periodic family of every Hopf point.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..results import ContinuationResult
+from .criticality import _with_criticality, with_lyapunov
+from .engine import Engine, Numerics
+from .equilibria import equilibria, is_linear
+from .periodic import periodic_families
+
+
+def one_parameter(engine: Engine, name: str, parameter: str, start: float,
+                  bounds: tuple[float, float], parameters: dict[str, float],
+                  numerics: Numerics, branch_points: bool = True,
+                  periodic: bool = False, orbits_at: tuple[float, ...] = ()
+                  ) -> ContinuationResult:
+    """Equilibria of ``parameter`` over ``bounds`` from ``start``, with branch switching, and
+    (``periodic``) the periodic families of every Hopf point. ``orbits_at``: parameter values
+    where every branch stores a labelled solution (orbit profiles)."""
+    numerics = replace(numerics, orbits_at=tuple(orbits_at))
+    branches, points = equilibria(engine, name, parameter, start, bounds, parameters, numerics,
+                                  branch_points)
+    points = with_lyapunov(engine.model, parameter, parameters, points)
+    # a linear model has no limit cycles: at a Hopf point it carries a continuum of neutral
+    # orbits of every amplitude, which AUTO reports as folds everywhere
+    if periodic and not is_linear(engine.model, parameters):
+        families, family_points = periodic_families(engine, name, parameter, bounds, numerics,
+                                                     branches, points, parameters)
+        branches += families
+        points = _with_criticality(points, families, branches, bounds[1] - bounds[0],
+                                   np.asarray(engine.model.state_scale, dtype=float)) \
+            + family_points
+    return ContinuationResult(name, "one-parameter", tuple(branches), tuple(points))
+

@@ -1,0 +1,262 @@
+"""Periodic families: from every Hopf point, grown and then continued fold by fold to their end
+(a Hopf point reached, the range, the amplitude bound, a period blow-up, ...); see
+:func:`periodic_families`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..analysis import global_bifurcations
+from ..auto.constants import AMPLITUDE, par_layout
+from ..models import Model
+from ..results import Branch, BranchKind, PointType, SpecialPoint
+from .branches import amplitude, head, join, special_points
+from .engine import Engine, Numerics, RunSpec, _read
+from .equilibria import equilibrium_constants
+from .homoclinic import locate_homoclinics
+
+#: A periodic run from a Hopf point first stops once the orbit has grown to this amplitude
+#: (AUTO's non-dimensional units, the PVLS ``amplitude``).
+GROWN_AMPLITUDE = 2e-3
+#: A family that shrinks back below this amplitude has reached a Hopf point.
+HOPF_RETURN_AMPLITUDE = 1e-3
+#: Periodic runs stop when the period exceeds this multiple of the Hopf period (blow-up).
+PERIOD_CAP = 25.0
+#: Label an orbit profile (kept in the results) every this many steps.
+ORBIT_EVERY = 20
+#: A family is continued fold by fold (AUTO stops at each fold of cycles); at most this many.
+MAX_SEGMENTS = 24
+#: After MX, a family is restarted with a finer mesh and smaller steps at most this often.
+MAX_RETRIES = 2
+
+
+def periodic_constants(model: Model, numerics: Numerics, parameter: str,
+                       bounds: tuple[float, float], hopf_period_tau: float) -> dict:
+    """Constants for periodic orbits (IPS=2) restarted from a Hopf or an earlier orbit."""
+    constants = equilibrium_constants(model, numerics, parameter, bounds, 1)
+    constants.update({
+        "IPS": 2, "ISW": 1, "ILP": 1, "ISP": 2,
+        "ICP": [parameter, "PERIOD", *par_layout(model).measures()],
+        "NPR": ORBIT_EVERY,
+    })
+    constants["UZSTOP"] = dict(constants["UZSTOP"], PERIOD=PERIOD_CAP * hopf_period_tau)
+    return constants
+
+
+@dataclass
+class _Family:
+    """A periodic family being continued: its Hopf point and the branch pieces so far."""
+
+    index: int
+    hopf: SpecialPoint
+    spec: RunSpec
+    pieces: list[Branch]
+    retries: int = 0
+
+
+def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[float, float],
+                      numerics: Numerics, equilibria: list[Branch], points: list[SpecialPoint],
+                      parameters: dict[str, float]
+                      ) -> tuple[list[Branch], list[SpecialPoint]]:
+    """The periodic family of every Hopf point, each stored once, with its special points.
+
+    A family starts at its Hopf point and grows to GROWN_AMPLITUDE; it is then continued in
+    segments that AUTO ends at each fold of cycles. A fold where the orbit has shrunk onto a
+    Hopf point is the family reaching that Hopf point (AUTO would go on round the closed family
+    again); there the family ends. Families that reach each other's Hopf points are one family,
+    kept once. A family whose period blows up ends there, with a bracketed global bifurcation.
+    """
+    model = engine.model
+    width = bounds[1] - bounds[0]
+    scale = np.asarray(model.state_scale, dtype=float)
+    hopfs = [p for p in points if p.point_type == PointType.HB]
+    runs = {b.name: b.run for b in equilibria}
+    families = []
+    for k, hopf in enumerate(hopfs, 1):
+        constants = periodic_constants(model, numerics, parameter, bounds,
+                                       hopf.period * model.time_scale)
+        constants["UZSTOP"][AMPLITUDE] = GROWN_AMPLITUDE
+        spec = RunSpec(f"{name}/periodic_{k}.0", constants, BranchKind.PERIODIC,
+                       f"HB at {parameter} = {hopf.parameters[0]:.6g} on {hopf.branch}",
+                       (parameter,), restart=(runs[hopf.branch], hopf.label))
+        families.append(_Family(k, hopf, spec, []))
+
+    wave = [(family, family.spec) for family in families]
+    while wave:
+        outcomes = engine.run_many([spec for _, spec in wave])
+        following = []
+        for (family, spec), outcome in zip(wave, outcomes, strict=True):
+            family.pieces.append(_read(engine, spec, outcome))
+            step = _next_segment(family, model, hopfs, width)
+            if step is not None:
+                following.append((family, step))
+        wave = following
+
+    kept: list[Branch] = []
+    found: list[SpecialPoint] = []
+    homoclinic: list[tuple[int, Branch]] = []  # (row in found, family) to locate with HomCont
+    reached: set[int] = set()
+    for family in families:
+        if family.index - 1 in reached:
+            continue  # the same family, already reached from another Hopf point
+        whole = _assemble(family, hopfs, width, scale)
+        end, returned_to = _periodic_end(whole, model, hopfs, bounds, numerics, family)
+        if returned_to is not None:
+            reached.add(returned_to)
+        global_point = global_bifurcations.analyse(whole, model, parameters, equilibria,
+                                                   family.hopf.period, width)
+        if global_point is not None:
+            end = f"period blow-up: {PointType(global_point.point_type).name.lower()} approach"
+            if whole.status == "mx":  # AUTO's expected failure right at the blow-up
+                whole = replace(whole, status="ok", message="ended with MX at the period "
+                                "blow-up (expected near a global bifurcation)")
+            found.append(global_point)
+            if global_point.point_type == PointType.HOMOCLINIC:
+                homoclinic.append((len(found) - 1, whole))
+        kept.append(replace(whole, end=end))
+        small = amplitude(whole, model) < HOPF_RETURN_AMPLITUDE
+        found += [p for p in special_points(whole, skip_first=True)
+                  if not small[p.index] and _hopf_at(whole, p.index, hopfs, width, scale) is None]
+    for row, point in zip([row for row, _ in homoclinic], locate_homoclinics(
+            engine, name, [(family, found[row]) for row, family in homoclinic], bounds,
+            parameters), strict=True):
+        found[row] = point
+    return kept, found
+
+
+def _assemble(family: _Family, hopfs: list[SpecialPoint], width: float,
+              scale: np.ndarray) -> Branch:
+    """One branch from a family's pieces, cut after the first point beyond the period cap
+    (AUTO can step over that stop while it locates a fold there)."""
+    whole = family.pieces[0]
+    for piece in family.pieces[1:]:
+        if len(piece):
+            whole = join(whole, piece, whole.name)
+    whole = replace(whole, name=f"periodic_{family.index}")
+    ends = list(np.flatnonzero(whole.period > PERIOD_CAP * family.hopf.period)[:1])
+    returned = _first_return(whole, hopfs, width, scale)
+    if returned is not None:
+        ends.append(returned)
+    if ends and min(ends) + 1 < len(whole):
+        whole = head(whole, min(ends) + 1)
+    return whole
+
+
+def _first_return(branch: Branch, hopfs: list[SpecialPoint], width: float,
+                  scale: np.ndarray) -> int | None:
+    """First row where a grown family has shrunk back onto a Hopf point (AUTO may pass
+    through a Hopf point without stopping there and go round the family again)."""
+    size = ((branch.state_max - branch.state_min) / 2).max(axis=1)
+    grown = np.flatnonzero(size > 0.5 * size.max())
+    if not len(grown):
+        return None
+    for row in range(int(grown[0]), len(branch)):
+        if _hopf_at(branch, row, hopfs, width, scale) is not None:
+            return row
+    return None
+
+
+def _hopf_at(branch: Branch, row: int, hopfs: list[SpecialPoint], width: float,
+             scale: np.ndarray) -> int | None:
+    """Index of the Hopf point the orbit at ``row`` has shrunk onto, if any: a small orbit
+    (in AUTO's non-dimensional units, ``scale`` = the model's state scale) centred on that Hopf
+    point's equilibrium."""
+    size = ((branch.state_max - branch.state_min) / (2 * scale)).max(axis=1)
+    if size[row] > max(5e-3, 0.05 * size.max()):
+        return None
+    centre = 0.5 * (branch.state_max[row] + branch.state_min[row]) / scale
+    for k, hopf in enumerate(hopfs):
+        if abs(hopf.parameters[0] - branch.parameters[row, 0]) < 2e-3 * width and np.allclose(
+                hopf.state / scale, centre, rtol=0, atol=2e-3 + 2 * size[row]):
+            return k
+    return None
+
+
+def _next_segment(family: _Family, model: Model, hopfs: list[SpecialPoint],
+                  width: float) -> RunSpec | None:
+    """The run continuing ``family`` after its last piece, or None if the family has ended."""
+    piece = family.pieces[-1]
+    scale = np.asarray(model.state_scale, dtype=float)
+    if piece.status == "mx" and family.retries < MAX_RETRIES:
+        return _retry(family, piece)
+    if not len(piece) or piece.status != "ok" or len(family.pieces) >= MAX_SEGMENTS:
+        return None
+    last = PointType(int(piece.point_type[-1]))
+    if len(family.pieces) == 1:
+        grown = last == PointType.UZ and abs(amplitude(piece, model)[-1] - GROWN_AMPLITUDE) \
+            < 1e-3 * GROWN_AMPLITUDE
+        if not grown:
+            return None
+    elif last != PointType.LPC or _first_return(piece, hopfs, width, scale) is not None or \
+            _hopf_at(piece, len(piece) - 1, hopfs, width, scale) is not None:
+        return None  # an end (range, amplitude, period, steps) or back at a Hopf point
+    if global_bifurcations.in_blowup(piece, family.hopf.period) and \
+            global_bifurcations.blowup_turns(*_columns(family), family.hopf.period) \
+            >= global_bifurcations.BRACKET_TURNS:
+        return None
+    constants = dict(family.spec.constants, STOP=["LP1"])
+    constants["UZSTOP"] = {k: v for k, v in constants["UZSTOP"].items() if k != AMPLITUDE}
+    return replace(family.spec, name=f"{family.spec.name.rsplit('.', 1)[0]}."
+                   f"{len(family.pieces)}", constants=constants,
+                   restart=(piece.run, int(piece.label[-1])))
+
+
+def _columns(family: _Family) -> tuple[np.ndarray, np.ndarray]:
+    """(principal parameter, period) along the family's pieces so far (a restart repeats the
+    point it starts from: a zero step, which counts as no turn)."""
+    return (np.concatenate([p.parameters[:, 0] for p in family.pieces]),
+            np.concatenate([p.period for p in family.pieces]))
+
+
+def _retry(family: _Family, piece: Branch) -> RunSpec | None:
+    """After MX (no convergence): restart from the last good labelled point of the piece with
+    twice the mesh intervals and half the largest step; the piece is cut back to that point."""
+    labelled = [k for k in np.flatnonzero(piece.label) if piece.point_type[k] != PointType.MX]
+    if not labelled or global_bifurcations.in_blowup(piece, family.hopf.period):
+        return None
+    row = int(labelled[-1])
+    family.pieces[-1] = head(piece, row + 1)
+    family.retries += 1
+    refine = 2 ** family.retries
+    constants = dict(family.spec.constants, STOP=["LP1"],
+                     NTST=family.spec.constants["NTST"] * refine,
+                     DSMAX=family.spec.constants["DSMAX"] / refine)
+    constants["UZSTOP"] = {k: v for k, v in constants["UZSTOP"].items() if k != AMPLITUDE}
+    return replace(family.spec, name=f"{family.spec.name.rsplit('.', 1)[0]}."
+                   f"{len(family.pieces)}r{family.retries}", constants=constants,
+                   restart=(piece.run.rsplit("+", 1)[-1], int(piece.label[row])))
+
+
+def _periodic_end(family: Branch, model: Model, hopfs: list[SpecialPoint],
+                  bounds: tuple[float, float], numerics: Numerics,
+                  state: _Family) -> tuple[str, int | None]:
+    """Why a periodic family ends, and the index of the Hopf point it returns to (if so)."""
+    if not len(family):
+        return f"failed: {family.message}", None
+    width = bounds[1] - bounds[0]
+    scale = np.asarray(model.state_scale, dtype=float)
+    value = family.parameters[-1, 0]
+    returned = _hopf_at(family, len(family) - 1, hopfs, width, scale) if len(family) > 3 else None
+    if returned is not None:
+        hopf = hopfs[returned]
+        which = "its own HB" if returned == state.index - 1 else "HB"
+        return (f"returns to {which} at {family.parameter_names[0]} = "
+                f"{hopf.parameters[0]:.6g} on {hopf.branch}"), returned
+    if family.point_type[-1] == PointType.MX:
+        return "no convergence (MX)", None
+    if family.period[-1] >= 0.999 * PERIOD_CAP * state.hopf.period:
+        return "period cap", None
+    if min(abs(value - bounds[0]), abs(value - bounds[1])) < 1e-6 * width:
+        return "range", None
+    angles = [i for i, s in enumerate(model.states) if s.unit == "rad"]
+    reach = np.abs(np.concatenate([family.state_max[-1, angles],
+                                   family.state_min[-1, angles]])).max()
+    if reach >= 0.999 * numerics.max_amplitude:
+        return "amplitude bound", None
+    if len(state.pieces) >= MAX_SEGMENTS:
+        return f"fold limit ({MAX_SEGMENTS} segments)", None
+    return "step limit", None
+

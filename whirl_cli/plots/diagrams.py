@@ -1,0 +1,317 @@
+"""One-parameter figures: bifurcation diagrams, state projections, period plots and phase
+planes of stored orbits.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..errors import WhirlError
+from ..results import Branch, ContinuationResult, PointType
+from .key import (
+    _BLACK,
+    _PLOTTED_KINDS,
+    MARKER_STYLE,
+    PLOT_KEY,
+    _colours,
+    _new_figure,
+    _plot_styled,
+    axis_label,
+    branch_style,
+    display_unit,
+    stability_segments,
+)
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+_PERIOD_POINTS = (PointType.HB, PointType.LPC, PointType.PD, PointType.TR, PointType.BPC,
+                  PointType.HOMOCLINIC, PointType.HETEROCLINIC)
+_GLOBAL_POINTS = (PointType.HOMOCLINIC, PointType.HETEROCLINIC)
+_LOG_SPAN = 20.0  # period plots switch to a log y-axis above this max/min ratio
+
+
+def bifurcation_diagram(continuation: ContinuationResult, state: str = "theta",
+                        which: Sequence[str] = ("max",), ax: Axes | None = None,
+                        degrees: bool = True) -> Figure:
+    """One-parameter bifurcation diagram: ``state`` against each branch's principal parameter.
+
+    Equilibrium and periodic branches are drawn (other kinds, e.g. loci, are skipped) with
+    y = max of ``state`` over the orbit (the state itself for equilibria), and for periodic
+    branches also the min when "min" is in ``which``; line styles follow :data:`PLOT_KEY` by kind
+    and stability. Special points get markers at (principal parameter, ``state`` value). Angle
+    states are shown in degrees (rad -> deg, rad/s -> deg/s) unless ``degrees`` is False; the
+    parameter keeps its SI unit. Draws on ``ax`` if given, else on a new figure; returns the
+    figure. The legend lists only styles present; the title is the continuation's name.
+    """
+    which, branches = _checked_branches(continuation, state, which)
+    if ax is None:
+        ax = _new_figure().add_subplot()
+    handles, labels = _draw_bifurcation(ax, continuation, branches, state, which, degrees)
+    if handles:
+        ax.legend(handles, labels, fontsize="small")
+    ax.set_title(continuation.name)
+    return ax.figure
+
+
+def _checked_branches(continuation: ContinuationResult, state: str, which: Sequence[str]
+                      ) -> tuple[tuple[str, ...], list[Branch]]:
+    """``which`` as a tuple and the plotted branches; WhirlError if either argument is bad."""
+    which = tuple(which)
+    if not which or not set(which) <= {"max", "min"}:
+        raise WhirlError(f"which must be a non-empty subset of ('max', 'min'), got {which}")
+    branches = [b for b in continuation.branches if b.kind in _PLOTTED_KINDS]
+    for branch in branches:
+        if state not in branch.state_names:
+            raise WhirlError(f"state {state!r} not on branch {branch.name!r} "
+                             f"(states: {', '.join(branch.state_names)})")
+    return which, branches
+
+
+def _draw_bifurcation(ax: Axes, continuation: ContinuationResult, branches: list[Branch],
+                      state: str, which: tuple[str, ...], degrees: bool
+                      ) -> tuple[list, list[str]]:
+    """Branches, special points and axis labels of a bifurcation diagram; legend entries."""
+    first: dict[str, object] = {}  # style -> first artist drawn with it (legend handle)
+    for branch in branches:
+        _draw_branch(ax, branch, state, which, degrees, first)
+    _draw_special_points(ax, continuation, branches, state, degrees, first)
+    _label_axes(ax, continuation, branches, state, which, degrees)
+    return ([first[key] for key in PLOT_KEY if key in first],
+            [str(PLOT_KEY[key]["label"]) for key in PLOT_KEY if key in first])
+
+
+def projections_figure(continuation: ContinuationResult, which: Sequence[str] = ("max",),
+                       degrees: bool = True) -> Figure:
+    """One bifurcation diagram per state on a grid of ceil(n/2) x 2 axes sharing the x-axis.
+
+    The states are those common to every plotted (equilibrium or periodic) branch, in the order
+    of the first; each panel is :func:`bifurcation_diagram` of one state (angles in deg, rates in
+    deg/s unless ``degrees`` is False; ``which`` as there). Only the first panel has a legend and
+    only the bottom panels an x label; the figure title is the continuation's name. Without
+    plotted branches the figure has one empty axes.
+    """
+    states = _common_states(continuation)
+    rows = max(1, -(-len(states) // 2))
+    figure = _new_figure(figsize=(10.0, 3.2 * rows + 0.6), layout="constrained")
+    if not states:
+        figure.add_subplot().set_title(continuation.name)
+        return figure
+    axes = figure.subplots(rows, 2, sharex=True, squeeze=False).ravel()
+    for k, (ax, state) in enumerate(zip(axes, states, strict=False)):
+        bifurcation_diagram(continuation, state=state, which=which, ax=ax, degrees=degrees)
+        ax.set_title("")
+        if k > 0 and ax.get_legend() is not None:
+            ax.get_legend().remove()
+        if k < len(states) - 2:  # another panel below in the same column
+            ax.set_xlabel("")
+    for ax in axes[len(states):]:
+        figure.delaxes(ax)
+    if len(states) % 2 and len(states) > 1:  # lone last panel: label its neighbour's x
+        axes[len(states) - 2].xaxis.set_tick_params(labelbottom=True)
+        axes[len(states) - 2].set_xlabel(axes[len(states) - 1].get_xlabel())
+    figure.suptitle(continuation.name)
+    return figure
+
+
+def _common_states(continuation: ContinuationResult) -> tuple[str, ...]:
+    """States on every plotted branch, in the order of the first (``()`` without branches)."""
+    branches = [b for b in continuation.branches if b.kind in _PLOTTED_KINDS]
+    if not branches:
+        return ()
+    return tuple(s for s in branches[0].state_names if all(s in b.state_names for b in branches))
+
+
+def period_plot(continuation: ContinuationResult) -> Figure:
+    """Period [s] of every periodic branch against its principal parameter (SI unit).
+
+    Lines follow :data:`PLOT_KEY` (stable solid blue, unstable dotted red) split as in
+    :func:`bifurcation_diagram`. Markers: LPC, PD, TR, BPC on periodic branches at their period
+    (the branch's period at the point's row if the point has none), Hopf points with a finite
+    period (where periodic branches are born), and HOMOCLINIC/HETEROCLINIC at (their parameter
+    estimate, the period at the last point of their branch). A "bracketed" global point also
+    gets its bracket drawn as a horizontal error bar at the top of the data. The y-axis is
+    logarithmic if the largest period exceeds 20 times the smallest. Without periodic branches
+    the axes stay empty.
+    """
+    ax = _new_figure().add_subplot()
+    periodic = [b for b in continuation.branches if b.is_periodic]
+    first: dict[str, object] = {}
+    for branch in periodic:
+        x = branch.parameters[:, 0]
+        for xs, ys, stable in stability_segments(x, branch.period, branch.stable,
+                                                 branch.stability_known):
+            _plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)
+    periods = np.concatenate([b.period for b in periodic]) if periodic else np.array([])
+    periods = periods[np.isfinite(periods) & (periods > 0)]
+    points, brackets = _period_points(continuation, periodic)
+    for style in PLOT_KEY:
+        if style in points:
+            xs, ys = np.array(points[style]).T
+            _plot_styled(ax, xs, ys, style, first)
+    handles = [first[key] for key in PLOT_KEY if key in first]
+    labels = [str(PLOT_KEY[key]["label"]) for key in PLOT_KEY if key in first]
+    if brackets and periods.size:
+        top = float(np.max(periods))
+        for low, high in brackets:
+            bar = ax.errorbar([(low + high) / 2], [top], xerr=[(high - low) / 2], fmt="none",
+                              ecolor=_BLACK, elinewidth=1.2, capsize=4, zorder=4,
+                              label="_bracket")
+        handles.append(bar)
+        labels.append("bracket (global bifurcation)")
+    if periods.size and periods.max() > _LOG_SPAN * periods.min():
+        ax.set_yscale("log")
+    if periodic:
+        ax.set_xlabel(axis_label(periodic[0].parameter_names[0], periodic[0].parameter_units[0]))
+    ax.set_ylabel(axis_label("period", "s"))
+    if handles:
+        ax.legend(handles, labels, fontsize="small")
+    ax.set_title(f"{continuation.name}: period")
+    return ax.figure
+
+
+def _period_points(continuation: ContinuationResult, periodic: list[Branch]
+                   ) -> tuple[dict[str, list[tuple[float, float]]], list[tuple[float, float]]]:
+    """Marker positions by style, and the finite brackets of "bracketed" global points."""
+    by_name = {b.name: b for b in continuation.branches}
+    periodic_names = {b.name for b in periodic}
+    x_name = periodic[0].parameter_names[0] if periodic else None
+    points: dict[str, list[tuple[float, float]]] = {}
+    brackets: list[tuple[float, float]] = []
+    for point in continuation.special_points:
+        kind = _point_type(point.point_type)
+        branch = by_name.get(point.branch)
+        if kind not in _PERIOD_POINTS or branch is None or point.parameter_names[0] != x_name:
+            continue
+        if kind != PointType.HB and point.branch not in periodic_names:
+            continue
+        if kind in _GLOBAL_POINTS:
+            finite = branch.period[np.isfinite(branch.period)]
+            period = float(finite[-1]) if finite.size else np.nan
+            bracket = np.asarray(point.bracket, dtype=float)
+            if point.status == "bracketed" and bracket.shape == (2,) and np.isfinite(
+                    bracket).all():
+                brackets.append((float(bracket.min()), float(bracket.max())))
+        else:
+            period = float(point.period)
+            if not np.isfinite(period) and 0 <= point.index < len(branch):
+                period = float(branch.period[point.index])
+        xy = (float(point.parameters[0]), period)
+        if np.all(np.isfinite(xy)):
+            points.setdefault(MARKER_STYLE[kind], []).append(xy)
+    return points, brackets
+
+
+def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str = "theta",
+                y: str = "psi", degrees: bool = True, ax: Axes | None = None) -> Figure:
+    """Stored orbits of a periodic branch as closed curves of state ``y`` against state ``x``.
+
+    All of ``branch.orbits`` if ``labels`` is None, else those with these AUTO labels (in the
+    order given). Each curve is closed (its first point repeated at the end unless already
+    equal), drawn solid if the branch is stable at the orbit's row, dotted if not and dashed
+    where its stability is unknown, in the default colour cycle, and labelled
+    ``"<parameter> = <value> (stable|unstable|stability unknown)"`` with the
+    principal parameter (4 significant digits). Angles in degrees, rates in deg/s unless
+    ``degrees`` is False; equal aspect when both axes have the same unit. Draws on ``ax`` if
+    given, else on a new figure; returns the figure. The title is the branch's name.
+    """
+    if not branch.is_periodic:
+        raise WhirlError(f"branch {branch.name!r} is {branch.kind}, not periodic: no orbits")
+    for name in (x, y):
+        if name not in branch.state_names:
+            raise WhirlError(f"state {name!r} not on branch {branch.name!r} "
+                             f"(states: {', '.join(branch.state_names)})")
+    orbits = list(branch.orbits)
+    if labels is not None:
+        by_label = {orbit.label: orbit for orbit in orbits}
+        missing = [label for label in labels if label not in by_label]
+        if missing:
+            raise WhirlError(f"no stored orbit with label(s) {missing} on branch "
+                             f"{branch.name!r} (labels: {sorted(by_label)})")
+        orbits = [by_label[label] for label in labels]
+    ix, iy = branch.state_names.index(x), branch.state_names.index(y)
+    fx, unit_x = display_unit(branch.state_units[ix], degrees)
+    fy, unit_y = display_unit(branch.state_units[iy], degrees)
+    if ax is None:
+        ax = _new_figure().add_subplot()
+    for orbit, colour in zip(orbits, _colours(), strict=False):
+        states = np.asarray(orbit.states, dtype=float)
+        if len(states) and not np.array_equal(states[0], states[-1]):
+            states = np.vstack([states, states[:1]])
+        stable = bool(branch.stable[orbit.index]) if 0 <= orbit.index < len(branch) \
+            and branch.stability_known[orbit.index] else None
+        status = {True: "stable", False: "unstable", None: "stability unknown"}[stable]
+        ax.plot(states[:, ix] * fx, states[:, iy] * fy, color=colour,
+                linestyle={True: "-", False: ":", None: "--"}[stable],
+                label=f"{branch.parameter_names[0]} = {orbit.parameters[0]:.4g} ({status})")
+    ax.set_xlabel(axis_label(x, unit_x))
+    ax.set_ylabel(axis_label(y, unit_y))
+    if unit_x == unit_y:
+        ax.set_aspect("equal", adjustable="datalim")
+    if orbits:
+        ax.legend(fontsize="small")
+    ax.set_title(branch.name)
+    return ax.figure
+
+
+def _draw_branch(ax: Axes, branch: Branch, state: str, which: tuple[str, ...], degrees: bool,
+                 first: dict) -> None:
+    """Draw one branch's max (and min, periodic only) curves, split by stability."""
+    factor, _ = display_unit(branch.state_units[branch.state_names.index(state)], degrees)
+    x = branch.parameters[:, 0]
+    tables = [w for w in ("max", "min") if w in which] if branch.is_periodic else [which[0]]
+    for table in tables:
+        y = branch.state(state, table) * factor
+        for xs, ys, stable in stability_segments(x, y, branch.stable,
+                                                 branch.stability_known):
+            _plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)
+
+
+def _draw_special_points(ax: Axes, continuation: ContinuationResult, branches: list[Branch],
+                         state: str, degrees: bool, first: dict) -> None:
+    """Markers for special points, one artist per marker style.
+
+    A point's state is read by the state names of its branch (or of the first plotted branch if
+    its branch is not among them); points not on the x-axis parameter are skipped.
+    """
+    by_name = {b.name: b for b in branches}
+    x_name = branches[0].parameter_names[0] if branches else None
+    points: dict[str, list[tuple[float, float]]] = {}
+    for point in continuation.special_points:
+        style = MARKER_STYLE.get(_point_type(point.point_type))
+        branch = by_name.get(point.branch, branches[0] if branches else None)
+        if style is None or branch is None or point.parameter_names[0] != x_name:
+            continue
+        index = branch.state_names.index(state)
+        factor, _ = display_unit(branch.state_units[index], degrees)
+        xy = (float(point.parameters[0]), float(point.state[index]) * factor)
+        if np.all(np.isfinite(xy)):
+            points.setdefault(style, []).append(xy)
+    for style in PLOT_KEY:
+        if style in points:
+            xs, ys = np.array(points[style]).T
+            _plot_styled(ax, xs, ys, style, first)
+
+
+def _point_type(code: int) -> PointType | None:
+    try:
+        return PointType(int(code))
+    except ValueError:
+        return None
+
+
+def _label_axes(ax: Axes, continuation: ContinuationResult, branches: list[Branch], state: str,
+                which: tuple[str, ...], degrees: bool) -> None:
+    """Axis labels with units from the first plotted branch (nothing if there is none)."""
+    if not branches:
+        return
+    ref = branches[0]
+    ax.set_xlabel(axis_label(ref.parameter_names[0], ref.parameter_units[0]))
+    _, unit = display_unit(ref.state_units[ref.state_names.index(state)], degrees)
+    extent = ", ".join(which) if any(b.is_periodic for b in branches) else ""
+    ax.set_ylabel(axis_label(f"{state} ({extent})" if extent else state, unit))
+

@@ -1,0 +1,176 @@
+"""The plot key (thesis Table 2.1) and what every figure shares: styles, stability segments,
+units and axis labels, new figures on an Agg canvas, legend handles.
+
+:data:`PLOT_KEY` has one entry per semantic style, with the matplotlib ``Line2D`` keyword
+arguments that draw it and its legend label. Stability maps (thesis figures 3.13, 3.15, 3.28,
+3.29) use :data:`BOUNDARY_KEY` in the same way.
+"""
+
+from __future__ import annotations
+
+import itertools
+import re
+from collections.abc import Iterator
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..results import BranchKind, PointType
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+_BLACK = "black"
+_MARKER_SIZE = 8.0
+
+PLOT_KEY: dict[str, dict[str, object]] = {
+    # branches
+    "stable_equilibrium": {"color": "green", "linestyle": "-", "label": "stable equilibrium"},
+    "unstable_equilibrium": {"color": "magenta", "linestyle": "--",
+                             "label": "unstable equilibrium"},
+    "stable_periodic": {"color": "blue", "linestyle": "-", "label": "stable periodic"},
+    "unstable_periodic": {"color": "red", "linestyle": ":", "label": "unstable periodic"},
+    # special points
+    "hopf": {"marker": "s", "markerfacecolor": "none", "markeredgecolor": _BLACK,
+             "label": "Hopf (HB)"},
+    "branch_point": {"marker": "*", "markerfacecolor": _BLACK, "markeredgecolor": _BLACK,
+                     "label": "branch point (BP, BPC)"},
+    "fold": {"marker": "o", "markerfacecolor": _BLACK, "markeredgecolor": _BLACK,
+             "label": "fold (LP, LPC)"},
+    "homoclinic": {"marker": "^", "markerfacecolor": _BLACK, "markeredgecolor": _BLACK,
+                   "label": "homoclinic"},
+    "heteroclinic": {"marker": "^", "markerfacecolor": "none", "markeredgecolor": _BLACK,
+                     "label": "heteroclinic"},
+    "torus": {"marker": "o", "markerfacecolor": "none", "markeredgecolor": _BLACK,
+              "label": "torus (TR)"},
+    "period_doubling": {"marker": "D", "markerfacecolor": _BLACK, "markeredgecolor": _BLACK,
+                        "label": "period doubling (PD)"},
+}
+"""Semantic style -> Line2D keyword arguments (including ``label``). Do not mutate."""
+
+MARKER_STYLE: dict[PointType, str] = {
+    PointType.HB: "hopf",
+    PointType.BP: "branch_point",
+    PointType.BPC: "branch_point",
+    PointType.LP: "fold",
+    PointType.LPC: "fold",
+    PointType.HOMOCLINIC: "homoclinic",
+    PointType.HETEROCLINIC: "heteroclinic",
+    PointType.TR: "torus",
+    PointType.PD: "period_doubling",
+}
+"""Point type -> key of :data:`PLOT_KEY`; types not listed (REGULAR, RG, UZ, EP, MX, ...) get
+no marker."""
+
+_UNSAFE_LABEL = "unsafe (overhang)"
+BOUNDARY_KEY: dict[str, dict[str, object]] = {
+    # linear analysis over a grid
+    "linearly_unstable": {"color": "lightgrey", "label": "linearly unstable"},
+    "linear_flutter": {"color": _BLACK, "linestyle": "-", "linewidth": 0.8,
+                       "label": "linear boundary (flutter)"},
+    "linear_divergence": {"color": _BLACK, "linestyle": "--", "linewidth": 0.8,
+                          "label": "linear boundary (divergence)"},
+    # loci of the two-parameter continuation, by Boundary.loci kind
+    "hopf": {"color": "darkblue", "linestyle": "-", "linewidth": 1.5,
+             "label": "Hopf locus (flutter)"},
+    "branch_point": {"color": _BLACK, "linestyle": "--", "linewidth": 1.5,
+                     "label": "branch point locus (divergence)"},
+    "fold": {"color": "grey", "linestyle": "-.", "linewidth": 1.5, "label": "fold locus (LP)"},
+    "fold_of_cycles": {"color": "orange", "linestyle": "-", "linewidth": 1.5,
+                       "label": "fold of cycles locus (LPC)"},
+    # the unsafe region
+    "unsafe": {"color": "red", "alpha": 0.5, "label": _UNSAFE_LABEL},
+}
+"""Stability-map style -> keyword arguments (``Line2D`` for lines, patch colour/alpha for the
+"linearly_unstable" shading and the "unsafe" polygons), including the legend ``label``. The
+locus entries are keyed by the kinds of :attr:`Boundary.loci`. Do not mutate."""
+
+_PLOTTED_KINDS = (BranchKind.EQUILIBRIUM, BranchKind.PERIODIC)
+
+
+def branch_style(kind: str, stable: bool) -> str:
+    """Key of :data:`PLOT_KEY` for a branch piece of ``kind`` (a :class:`BranchKind`)."""
+    family = "periodic" if kind == BranchKind.PERIODIC else "equilibrium"
+    return f"{'stable' if stable else 'unstable'}_{family}"
+
+
+def stability_segments(x: np.ndarray, y: np.ndarray, stable: np.ndarray,
+                       known: np.ndarray | None = None
+                       ) -> list[tuple[np.ndarray, np.ndarray, bool]]:
+    """Split a curve into runs of equal stability, ``[(x_i, y_i, stable_i), ...]`` in order.
+
+    The first point of each new run (the switching point) also ends the previous run, so drawn
+    pieces join without gaps. Points whose stability is not ``known`` (e.g. the first point of
+    a periodic family, where AUTO printed no multipliers) have none of their own: each joins
+    the run before it (leading ones the run after), so they never make a stub of their own;
+    with no point known, ``stable`` is drawn as it is. Units are those of ``x`` and ``y``;
+    empty input gives ``[]``.
+    """
+    x = np.asarray(x)
+    y = np.asarray(y)
+    stable = np.asarray(stable, dtype=bool)
+    if not (x.shape == y.shape == stable.shape) or x.ndim != 1:
+        raise ValueError(f"x, y and stable must be 1-D of equal length, got shapes "
+                         f"{x.shape}, {y.shape}, {stable.shape}")
+    if len(x) == 0:
+        return []
+    if known is not None and np.asarray(known, dtype=bool).any():
+        known = np.asarray(known, dtype=bool)
+        if known.shape != stable.shape:
+            raise ValueError(f"known must have the shape of stable {stable.shape}, got "
+                             f"{known.shape}")
+        # the stability of the nearest known point before (the first known one for leading
+        # unknown points)
+        last_known = np.maximum.accumulate(np.where(known, np.arange(len(x)), -1))
+        stable = stable[np.where(last_known >= 0, last_known, np.flatnonzero(known)[0])]
+    starts = np.concatenate(([0], np.flatnonzero(stable[1:] != stable[:-1]) + 1))
+    ends = np.append(starts[1:] + 1, len(x))  # inclusive of the next run's first point
+    return [(x[a:b], y[a:b], bool(stable[a])) for a, b in zip(starts, ends, strict=True)]
+
+
+def display_unit(unit: str, degrees: bool = True) -> tuple[float, str]:
+    """(factor, unit) to show an SI quantity: rad -> deg (and rad/s -> deg/s) if ``degrees``."""
+    if degrees and re.fullmatch(r"rad(/.*)?", unit):
+        return float(np.degrees(1.0)), "deg" + unit[3:]
+    return 1.0, unit
+
+
+def axis_label(name: str, unit: str) -> str:
+    """``"name [unit]"``, with ``[-]`` for dimensionless quantities (unit "" or "1")."""
+    return f"{name} [{unit if unit not in ('', '1') else '-'}]"
+
+
+def _new_figure(**kwargs) -> Figure:
+    """A Figure on an Agg canvas, outside pyplot (needs no display, no closing)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    figure = Figure(**{"layout": "constrained", **kwargs})  # no clipped labels, no bbox pass
+    FigureCanvasAgg(figure)
+    return figure
+
+
+def _plot_styled(ax: Axes, x: np.ndarray, y: np.ndarray, style: str, first: dict) -> None:
+    """Plot with ``PLOT_KEY[style]``; remember the first artist of each style for the legend."""
+    kwargs = dict(PLOT_KEY[style])
+    kwargs["label"] = "_" + str(kwargs["label"])  # legend is assembled from ``first``
+    if "marker" in kwargs:
+        kwargs.update(linestyle="none", markersize=_MARKER_SIZE, zorder=3)
+    (line,) = ax.plot(x, y, **kwargs)
+    first.setdefault(style, line)
+
+
+def _colours() -> Iterator[str]:
+    """Endless cycle of the default matplotlib line colours."""
+    from matplotlib import rcParams
+
+    return itertools.cycle(rcParams["axes.prop_cycle"].by_key().get("color", ["C0"]))
+
+
+def _patch_proxy(style: dict[str, object]):
+    """A legend handle for a filled area of ``style``'s colour (and alpha)."""
+    from matplotlib.patches import Patch
+
+    return Patch(facecolor=style["color"], alpha=style.get("alpha"), label=style["label"])
+

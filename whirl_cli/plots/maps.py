@@ -1,0 +1,243 @@
+"""Two-parameter stability maps (thesis figures 3.13, 3.15, 3.28, 3.29) with the unsafe
+(overhang) region, and the bifurcation diagram of a slice with its unsafe intervals shaded.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..errors import WhirlError
+from ..results import Boundary, ContinuationResult, LinearGrid
+from .diagrams import _checked_branches, _draw_bifurcation
+from .key import _BLACK, _UNSAFE_LABEL, BOUNDARY_KEY, _new_figure, _patch_proxy, axis_label
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+_LOCUS_KINDS = ("hopf", "branch_point", "fold", "fold_of_cycles")
+_SLICE_TOLERANCE = 1e-12  # slice values equal within this are the same slice
+_BAND_ALPHA = 0.25  # unsafe bands of overhang diagrams
+_CASE_LABEL_GAP = 0.04  # least distance of case labels, in axes fractions
+_LIMIT_MARGIN = 0.02  # fraction of the data span added around loci-derived axis limits
+
+
+def boundary_plot(boundary: Boundary | None, grid: LinearGrid | None,
+                  cases: Sequence[float] = (), ax: Axes | None = None) -> Figure:
+    """Stability map in two parameters (thesis figures 3.13, 3.15, 3.28, 3.29).
+
+    x is the first parameter of ``boundary`` (or ``grid.x_parameter``), y the second, both in
+    their own (SI) units. Drawn, styled after :data:`BOUNDARY_KEY`:
+
+    * from ``grid``: the linearly unstable region (``max_real`` > 0) shaded light grey and the
+      linear zero contour thin black, solid where the critical eigenvalue is complex (flutter),
+      dashed where it is real (divergence);
+    * from ``boundary``: its loci (Hopf solid dark blue, branch point dashed black, fold
+      dash-dot grey, fold of cycles solid orange; other kinds are not drawn) and the unsafe
+      (overhang) region, its polygons filled red;
+    * a thin dotted horizontal line at each value of ``cases`` (e.g. ``boundary.slices``),
+      labelled "case 1", "case 2", ... just right of the axes (labels only for lines within
+      the y limits, nudged up where they would overlap).
+
+    The legend lists only what is drawn. Axis limits are the grid's extent, else the extent of
+    the loci (or, without loci, of the polygons) plus a 2 % margin, else matplotlib's. A grid
+    over the same two parameters in the other order is transposed; over other parameters it is
+    a :class:`WhirlError`, as is passing neither. Title: ``boundary.name`` (else "linear
+    stability"). Draws on ``ax`` if given, else on a new figure; returns the figure.
+    """
+    if boundary is None and grid is None:
+        raise WhirlError("boundary_plot needs a boundary, a linear grid or both")
+    if boundary is not None and grid is not None:
+        oriented = _oriented_grid(grid, boundary.parameter_names)
+        if oriented is None:
+            raise WhirlError(f"linear grid over ({grid.x_parameter}, {grid.y_parameter}) does "
+                             f"not match boundary {boundary.name!r} over "
+                             f"({', '.join(boundary.parameter_names)})")
+        grid = oriented
+    if ax is None:
+        ax = _new_figure().add_subplot()
+    first: dict[str, object] = {}
+    if grid is not None:
+        _draw_grid(ax, grid, first)
+    if boundary is not None:
+        _draw_loci(ax, boundary, first)
+        for polygon in boundary.polygons:
+            polygon = np.asarray(polygon, dtype=float)
+            if len(polygon) >= 3:
+                style = dict(BOUNDARY_KEY["unsafe"], label="_unsafe")
+                (patch,) = ax.fill(polygon[:, 0], polygon[:, 1], **style, zorder=2)
+                first.setdefault("unsafe", patch)
+    _set_map_limits(ax, boundary, grid)
+    _draw_cases(ax, cases)
+    if boundary is not None:
+        names, units = boundary.parameter_names, boundary.parameter_units
+    else:
+        names, units = (grid.x_parameter, grid.y_parameter), (grid.x_unit, grid.y_unit)
+    ax.set_xlabel(axis_label(names[0], units[0]))
+    ax.set_ylabel(axis_label(names[1], units[1]))
+    if first:
+        ax.legend([first[key] for key in BOUNDARY_KEY if key in first],
+                  [str(BOUNDARY_KEY[key]["label"]) for key in BOUNDARY_KEY if key in first],
+                  fontsize="small")
+    ax.set_title(boundary.name if boundary is not None else "linear stability")
+    return ax.figure
+
+
+def _oriented_grid(grid: LinearGrid, names: Sequence[str]) -> LinearGrid | None:
+    """``grid`` with x = ``names[0]`` and y = ``names[1]`` (transposed if needed), else None."""
+    if (grid.x_parameter, grid.y_parameter) == tuple(names):
+        return grid
+    if (grid.y_parameter, grid.x_parameter) == tuple(names):
+        return LinearGrid(grid.y_parameter, grid.x_parameter, grid.y_unit, grid.x_unit,
+                          grid.y, grid.x, np.asarray(grid.max_real).T,
+                          np.asarray(grid.oscillatory).T,
+                          tuple(np.asarray(line)[:, ::-1] for line in grid.flutter),
+                          tuple(np.asarray(line)[:, ::-1] for line in grid.divergence))
+    return None
+
+
+def _draw_grid(ax: Axes, grid: LinearGrid, first: dict) -> None:
+    """Shade max_real > 0 (contourf, levels [0, inf]); draw the zero contour by kind."""
+    max_real = np.ma.masked_invalid(np.asarray(grid.max_real, dtype=float))
+    if np.ma.any(max_real > 0):
+        style = BOUNDARY_KEY["linearly_unstable"]
+        ax.contourf(grid.x, grid.y, max_real, levels=[0.0, np.inf], colors=[style["color"]],
+                    zorder=0)
+        first["linearly_unstable"] = _patch_proxy(style)
+    for key, lines in (("linear_flutter", grid.flutter), ("linear_divergence", grid.divergence)):
+        for line in lines:
+            _plot_polyline(ax, line, key, first, zorder=1)
+
+
+def _plot_polyline(ax: Axes, line: np.ndarray, key: str, first: dict, zorder: float) -> None:
+    """Draw a (K, 2) polyline with ``BOUNDARY_KEY[key]`` (nothing if it has < 2 points)."""
+    line = np.asarray(line, dtype=float)
+    if line.ndim != 2 or len(line) < 2:
+        return
+    kwargs = dict(BOUNDARY_KEY[key], label=f"_{key}")
+    (artist,) = ax.plot(line[:, 0], line[:, 1], **kwargs, zorder=zorder)
+    first.setdefault(key, artist)
+
+
+def _draw_loci(ax: Axes, boundary: Boundary, first: dict) -> None:
+    """The boundary's loci, kinds in the order of :data:`BOUNDARY_KEY`."""
+    for kind in _LOCUS_KINDS:
+        for locus_kind, curve in boundary.loci.values():
+            if locus_kind == kind:
+                _plot_polyline(ax, curve, kind, first, zorder=3)
+
+
+def _set_map_limits(ax: Axes, boundary: Boundary | None, grid: LinearGrid | None) -> None:
+    """Grid extent; else loci extent (polygons if no loci) with a margin; else leave as is."""
+    if grid is not None and len(grid.x) and len(grid.y):
+        ax.set_xlim(float(np.min(grid.x)), float(np.max(grid.x)))
+        ax.set_ylim(float(np.min(grid.y)), float(np.max(grid.y)))
+        return
+    if boundary is None:
+        return
+    curves = [np.asarray(c, dtype=float) for kind, c in boundary.loci.values()
+              if kind in _LOCUS_KINDS]
+    if not any(c.ndim == 2 and len(c) >= 2 for c in curves):
+        curves = [np.asarray(p, dtype=float) for p in boundary.polygons]
+    points = [c for c in curves if c.ndim == 2 and c.shape[1] == 2 and len(c)]
+    if not points:
+        return
+    xy = np.concatenate(points)
+    xy = xy[np.isfinite(xy).all(axis=1)]
+    if not len(xy):
+        return
+    for setter, low, high in ((ax.set_xlim, xy[:, 0].min(), xy[:, 0].max()),
+                              (ax.set_ylim, xy[:, 1].min(), xy[:, 1].max())):
+        pad = _LIMIT_MARGIN * (high - low)
+        if pad > 0:
+            setter(float(low - pad), float(high + pad))
+
+
+def _draw_cases(ax: Axes, cases: Sequence[float]) -> None:
+    """Dotted horizontal lines at the case values, labelled "case k" right of the axes."""
+    for k, value in enumerate(cases, 1):
+        ax.axhline(float(value), color=_BLACK, linestyle=":", linewidth=0.8, zorder=1,
+                   label=f"_case {k}")
+    bottom, top = ax.get_ylim()
+    low, high = sorted((bottom, top))
+    shown = sorted(((float(v) - bottom) / (top - bottom) if top != bottom else 0.5, k)
+                   for k, v in enumerate(cases, 1) if low <= float(v) <= high)
+    position = -np.inf
+    for fraction, k in shown:  # in axes fractions, pushed up to keep close labels apart
+        position = max(fraction, position + _CASE_LABEL_GAP)
+        ax.text(1.01, position, f"case {k}", transform=ax.transAxes, ha="left", va="center",
+                fontsize="small")
+
+
+def slice_continuation(continuation: ContinuationResult, index: int) -> ContinuationResult:
+    """The one-parameter continuation of slice ``index`` of a two-parameter continuation.
+
+    Its branches are those named ``slice_<index>.<branch>``, renamed ``<branch>``, and its
+    special points those on them (branch renamed likewise). Named
+    ``<continuation>.slice_<index>``, kind "one-parameter"."""
+    prefix = f"slice_{index}."
+    branches = tuple(replace(b, name=b.name[len(prefix):]) for b in continuation.branches
+                     if b.name.startswith(prefix))
+    points = tuple(replace(p, branch=p.branch[len(prefix):]) for p in continuation.special_points
+                   if p.branch.startswith(prefix))
+    return ContinuationResult(f"{continuation.name}.slice_{index}", "one-parameter", branches,
+                              points)
+
+
+def slice_index(boundary: Boundary, slice_value: float) -> int:
+    """Index of ``slice_value`` in ``boundary.slices`` (equal within 1e-12); WhirlError if
+    absent."""
+    for k, value in enumerate(boundary.slices):
+        if abs(float(value) - float(slice_value)) <= _SLICE_TOLERANCE:
+            return k
+    raise WhirlError(f"{slice_value!r} is not a slice of boundary {boundary.name!r} "
+                     f"(slices: {list(boundary.slices)})")
+
+
+def overhang_diagram(continuation: ContinuationResult, boundary: Boundary | None,
+                     slice_value: float, state: str = "theta", which: Sequence[str] = ("max",),
+                     ax: Axes | None = None, degrees: bool = True) -> Figure:
+    """Bifurcation diagram of one slice with its unsafe (overhang) intervals shaded.
+
+    For a two-parameter ``continuation`` the diagram is :func:`bifurcation_diagram` of
+    :func:`slice_continuation` at the index of ``slice_value`` in ``boundary.slices`` (a
+    ``boundary`` is then required); a one-parameter continuation is drawn as it is. Every
+    interval of ``boundary.intervals`` on this slice (``slice_value`` equal within 1e-12) is a
+    red vertical band (alpha 0.25) from ``lower`` to ``upper``, with one legend entry
+    "unsafe (overhang)". ``state``, ``which``, ``degrees`` and ``ax`` as in
+    :func:`bifurcation_diagram`. Title: ``"<continuation>: <second parameter> = <value>"``
+    (just the continuation's name without a boundary). Returns the figure.
+    """
+    if continuation.kind == "two-parameter":
+        if boundary is None:
+            raise WhirlError(f"continuation {continuation.name!r} is two-parameter: an "
+                             "overhang diagram needs its boundary to find the slice")
+        diagram = slice_continuation(continuation, slice_index(boundary, slice_value))
+    else:
+        diagram = continuation
+    which, branches = _checked_branches(diagram, state, which)
+    if ax is None:
+        ax = _new_figure().add_subplot()
+    handles, labels = _draw_bifurcation(ax, diagram, branches, state, which, degrees)
+    band = None
+    intervals = () if boundary is None else boundary.intervals
+    for interval in intervals:
+        if abs(float(interval.slice_value) - float(slice_value)) <= _SLICE_TOLERANCE:
+            span = ax.axvspan(float(interval.lower), float(interval.upper), color="red",
+                              alpha=_BAND_ALPHA, linewidth=0, zorder=0, label="_unsafe")
+            band = band or span
+    if band is not None:
+        handles.append(band)
+        labels.append(_UNSAFE_LABEL)
+    if handles:
+        ax.legend(handles, labels, fontsize="small")
+    title = continuation.name
+    if boundary is not None:
+        title += f": {boundary.parameter_names[1]} = {float(slice_value):g}"
+    ax.set_title(title)
+    return ax.figure
+

@@ -1,0 +1,125 @@
+"""Study files: YAML in, a frozen and validated :class:`Study` out.
+
+:func:`load_study` (a file) and :func:`validate_text` (a string) are the validating entry points.
+They report every problem at once, as ``<file>:<line>: <key.path>: <reason>`` lines in a
+:class:`~whirl_cli.errors.StudyError`, and never let a traceback escape for bad input.
+
+How a file is read:
+
+1. bytes: at most :data:`MAX_BYTES`, UTF-8 (:mod:`~whirl_cli.study.source`);
+2. YAML, composed with a SafeLoader subclass into nodes (for line numbers): anchors, aliases,
+   tags beyond the core ones (str, int, float, bool, null, seq, map) and nesting deeper than
+   :data:`~whirl_cli.study.source.MAX_DEPTH` are refused. Two YAML 1.1 surprises are switched
+   off: only ``true`` and ``false`` are booleans (``yes``, ``on`` stay strings) and ``1e-6`` is
+   a number; dates stay strings and ``<<`` is a plain key (:mod:`~whirl_cli.study.source`);
+3. plain Python data from the nodes, scalars built by the safe constructors; duplicate keys are
+   reported (:mod:`~whirl_cli.study.source`);
+4. structure: the pydantic models of :mod:`~whirl_cli.study.schema` (``extra="forbid"``), their
+   errors translated into the reasons that tests/unit/test_study.py spells out
+   (:mod:`~whirl_cli.study.messages`);
+5. meaning, on the raw data so that it adds to the structural problems: parameter names known
+   to the model variant, ``K2``/``K3`` only under ``nonlinearity``, ``dof`` a degree of freedom
+   of the model, unique continuation names, ``start`` inside ``range``
+   (:mod:`~whirl_cli.study.checks`).
+
+Validation also fills the model-dependent defaults (:mod:`~whirl_cli.study.resolve`):
+``nonlinearity.dof`` (the family's default), ``continuations[].parameter`` and
+``linear.sweeps[].parameter`` become canonical names (``K_theta`` -> ``K1``), and
+``continuations[].start`` gets the parameter's study value when the file leaves it out.
+``Study.model_validate`` applies these fills too, but only the two entry points check parameter
+names and ranges against the model.
+
+Modules, lowest first (each imports only those above it, and :mod:`whirl_cli.models`):
+
+* :mod:`~whirl_cli.study.source` -- the file as YAML nodes and data, with line numbers;
+* :mod:`~whirl_cli.study.resolve` -- model-dependent defaults filled on the raw data;
+* :mod:`~whirl_cli.study.schema` -- value checks and the pydantic models;
+* :mod:`~whirl_cli.study.messages` -- pydantic errors as (key path, reason), the report;
+* :mod:`~whirl_cli.study.checks` -- meaning checks against the model variant;
+* :mod:`~whirl_cli.study.reference` -- the YAML reference table, read off the schema.
+
+This package exports its entry points and the schema's models; everything else is imported
+from its module.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from pathlib import Path
+
+from pydantic import ValidationError
+
+from ..errors import StudyError
+from .checks import _meaning_problems
+from .messages import _report, _translate
+from .reference import schema_reference
+from .schema import (
+    AutoSettings,
+    Linear,
+    LinearSpec,
+    LinearSweepSpec,
+    OneParameterContinuation,
+    Polynomial,
+    Study,
+    TwoParameterContinuation,
+)
+from .source import MAX_BYTES, Problem, _compose, _read_text, _too_large, _Tree
+
+__all__ = [
+    "MAX_BYTES",
+    "AutoSettings",
+    "Linear",
+    "LinearSpec",
+    "LinearSweepSpec",
+    "OneParameterContinuation",
+    "Polynomial",
+    "Study",
+    "TwoParameterContinuation",
+    "load_study",
+    "schema_reference",
+    "validate_text",
+]
+
+
+def load_study(path: str | os.PathLike[str], label: str | None = None) -> Study:
+    """Read, check and return the study at ``path``; StudyError lists every problem, each
+    line starting with ``label`` (default: the file's name)."""
+    path = Path(path)
+    label = path.name if label is None else label
+    return _validate(_read_text(path, label), label, str(path))
+
+
+def validate_text(text: str, filename: str = "<study>") -> Study:
+    """Check the study YAML ``text``; messages name it ``filename``."""
+    return _validate(text, filename, filename)
+
+
+def _validate(text: str, name: str, path: str) -> Study:
+    try:
+        encoded = text.encode("utf-8")
+    except UnicodeEncodeError as error:
+        code, offset = ord(text[error.start]), error.start
+        reason = f"not UTF-8 text (character U+{code:04X} at offset {offset})"
+        raise StudyError(f"{name}: {reason}") from None
+    if len(encoded) > MAX_BYTES:
+        raise StudyError(_too_large(name, len(encoded)))
+    tree = _Tree(_compose(text, name))
+    study, problems = _check(tree)
+    if problems:
+        raise StudyError(_report(problems, tree, name))
+    study._source, study._sha256, study._path = text, hashlib.sha256(encoded).hexdigest(), path
+    return study
+
+
+def _check(tree: _Tree) -> tuple[Study | None, list[Problem]]:
+    """The study (None if its structure is invalid) and every problem found."""
+    problems = []
+    try:
+        study = Study.model_validate(tree.data)
+    except ValidationError as error:
+        study = None
+        problems = [_translate(e, tree) for e in error.errors(include_url=False)]
+    problems += _meaning_problems(tree.data)
+    return study, tree.problems + [p for p in problems if p[0] not in tree.unreadable]
+

@@ -1,0 +1,226 @@
+"""Meaning checks of a study against its model variant, on the raw data.
+
+They add to the structural problems (malformed parts are left to those): parameter names known
+to the variant, ``K2``/``K3`` only under ``nonlinearity``, ``dof`` a degree of freedom of the
+model, a parameter given once, values and ranges inside the physical bounds, unique
+continuation names, ``start``, ``slices`` and ``orbits_at`` inside ``range``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+
+from ..models import FAMILIES, Model
+from .messages import _choice_reason
+from .resolve import _LAW_PARAMETERS, _finite, _study_values, _variant_of
+from .source import Loc, Problem
+
+
+def _meaning_problems(data: dict) -> list[Problem]:
+    """Checks against the model variant, on the raw data; malformed parts are skipped."""
+    family = data.get("model")
+    if not isinstance(family, str) or family not in FAMILIES:
+        return []
+    block = data.get("nonlinearity")
+    dof = block.get("dof") if isinstance(block, dict) else None
+    dofs = FAMILIES[family][1]
+    if isinstance(dof, str) and dof not in dofs:
+        return [(("nonlinearity", "dof"), _choice_reason(dofs, repr(dof)))]
+    variant = _variant_of(data)
+    if variant is None:
+        return []
+    values = _study_values(data, variant)
+    problems = _override_problems(data.get("parameters"), variant, family)
+    for name in _LAW_PARAMETERS if isinstance(block, dict) else ():
+        if name in block:
+            problems += _bound_problems(("nonlinearity", name), name, block[name], variant)
+    items = data.get("continuations")
+    problems += _continuation_problems(items, variant, family, values)
+    linear = data.get("linear")
+    sweeps = linear.get("sweeps") if isinstance(linear, dict) else None
+    for i, sweep in _dict_items(sweeps):
+        problems += _sweep_problems(("linear", "sweeps", i), sweep, variant, family)
+    grid = linear.get("grid") if isinstance(linear, dict) else None
+    for axis in ("x", "y"):
+        spec = grid.get(axis) if isinstance(grid, dict) else None
+        if isinstance(spec, dict):
+            problems += _sweep_problems(("linear", "grid", axis), spec, variant, family)
+    return problems
+
+
+def _sweep_problems(loc: Loc, spec: dict, variant: Model, family: str) -> list[Problem]:
+    """The parameter and range of a linear sweep or grid axis."""
+    name = spec.get("parameter")
+    found = _parameter_problems(loc + ("parameter",), name, variant, family)
+    if found or not isinstance(name, str):
+        return found
+    return _range_problems(loc + ("range",), variant.canonical(name), spec.get("range"),
+                           variant, "swept")
+
+
+def _dict_items(items: Any) -> Iterator[tuple[int, dict]]:
+    """(index, item) for the mapping items of a list; nothing if ``items`` is no list."""
+    if isinstance(items, list):
+        yield from ((i, item) for i, item in enumerate(items) if isinstance(item, dict))
+
+
+def _parameter_problems(loc: Loc, name: Any, variant: Model, family: str) -> list[Problem]:
+    if not isinstance(name, str) or name in variant.known_parameter_names():
+        return []
+    known = ", ".join(variant.known_parameter_names())
+    return [(loc, f"unknown parameter {name!r} for model {family} (known: {known})")]
+
+
+def _override_problems(parameters: Any, variant: Model, family: str) -> list[Problem]:
+    problems: list[Problem] = []
+    spelled: dict[str, str] = {}  # canonical name -> the key that gave it first
+    for name, value in parameters.items() if isinstance(parameters, dict) else ():
+        loc = ("parameters", name)
+        found = _parameter_problems(loc, name, variant, family)
+        if not found and variant.canonical(name) in _LAW_PARAMETERS:
+            found = [(loc, f"set {name} under nonlinearity (type: polynomial)")]
+        if not found:
+            canonical = variant.canonical(name)
+            if canonical in spelled:
+                found = [(loc, _twice(name, spelled[canonical], canonical))]
+            spelled.setdefault(canonical, name)
+            found = found or _bound_problems(loc, canonical, value, variant)
+        problems += found
+    return problems
+
+
+def _twice(name: str, other: str, canonical: str) -> str:
+    """Why a parameter given under two spellings is refused."""
+    same = f"both name {canonical}" if canonical not in (name, other) else \
+        f"{(other if name == canonical else name)!r} is an alias of {canonical}"
+    return f"{name!r} and {other!r} are the same parameter ({same}); give it once"
+
+
+def _bound_problems(loc: Loc, canonical: str, value: Any, variant: Model) -> list[Problem]:
+    """A value outside the parameter's physical bounds (malformed values are reported as
+    structural problems)."""
+    number = _finite(value)
+    parameter = variant.parameter(canonical)
+    if number is None or parameter.bounds.contains(number):
+        return []
+    return [(loc, f"{canonical} must be {parameter.bounds.text(parameter.unit)}, got "
+             f"{value!r}")]
+
+
+def _range_problems(loc: Loc, canonical: str, bounds: Any, variant: Model,
+                    swept: str) -> list[Problem]:
+    """A continuation or sweep range reaching outside the parameter's physical bounds, or a
+    parameter that takes whole numbers only (which cannot be continued or swept)."""
+    parameter = variant.parameter(canonical)
+    if parameter.bounds.integer:
+        return [(loc, f"{canonical} takes whole numbers only ({parameter.bounds.text()}) and "
+                 f"cannot be {swept}")]
+    ends = [_finite(b) for b in bounds] if isinstance(bounds, list) and len(bounds) == 2 else []
+    outside = [e for e in ends if e is not None and not parameter.bounds.contains(e)]
+    if not outside:
+        return []
+    return [(loc, f"the range reaches {outside[0]!r}, outside the bounds of {canonical} "
+             f"({parameter.bounds.text(parameter.unit)})")]
+
+
+def _continuation_problems(
+    items: Any, variant: Model, family: str, values: dict[str, float]
+) -> list[Problem]:
+    problems: list[Problem] = []
+    names: set[str] = set()
+    for i, item in _dict_items(items):
+        loc = ("continuations", i)
+        name, parameter = item.get("name"), item.get("parameter")
+        if isinstance(name, str) and name in names:
+            problems.append((loc + ("name",), f"duplicate continuation name {name!r}"))
+        if isinstance(name, str):
+            names.add(name)
+        if item.get("type") == "two-parameter":
+            problems += _pair_problems(loc, item, variant, family, values)
+            continue
+        found = _parameter_problems(loc + ("parameter",), parameter, variant, family)
+        if not found and isinstance(parameter, str):
+            canonical = variant.canonical(parameter)
+            found = _range_problems(loc + ("range",), canonical, item.get("range"), variant,
+                                    "continued")
+            found = found or _start_problems(loc, item, values[canonical])
+            found += _orbits_problems(loc, item)
+        problems += found
+    return problems
+
+
+def _orbits_problems(loc: Loc, item: dict) -> list[Problem]:
+    """``orbits_at`` values outside the continuation's range."""
+    bounds, orbits = item.get("range"), item.get("orbits_at")
+    if not (isinstance(bounds, list) and len(bounds) == 2 and isinstance(orbits, list)):
+        return []
+    lower, upper = (_finite(b) for b in bounds)
+    if lower is None or upper is None or not lower < upper:
+        return []
+    return [(loc + ("orbits_at", k), f"{number!r} is outside the range [{lower!r}, {upper!r}]")
+            for k, number in enumerate(map(_finite, orbits))
+            if number is not None and not lower <= number <= upper]
+
+
+def _pair_problems(loc: Loc, item: dict, variant: Model, family: str,
+                   values: dict[str, float]) -> list[Problem]:
+    """Parameters, range keys, start and slices of a two-parameter continuation."""
+    pair = item.get("parameters")
+    if not isinstance(pair, list) or len(pair) != 2:
+        return []
+    problems: list[Problem] = []
+    for k, name in enumerate(pair):
+        problems += _parameter_problems(loc + ("parameters", k), name, variant, family)
+    if problems or not all(isinstance(p, str) for p in pair):
+        return problems
+    first, second = (variant.canonical(p) for p in pair)
+    if first == second:
+        return [(loc + ("parameters",), f"expected two different parameters, got {pair!r}")]
+    bounds = item.get("range")
+    if not isinstance(bounds, dict):
+        return problems
+    canonical: dict[str, str] = {}
+    for key in (k for k in bounds if isinstance(k, str)):
+        name = variant.canonical(key) if key in variant.known_parameter_names() else key
+        if name in canonical:
+            return [(loc + ("range", key), _twice(key, canonical[name], name))]
+        canonical[name] = key
+    if set(canonical) != {first, second}:
+        return [(loc + ("range",), f"expected the keys {first}, {second}, got "
+                 f"{', '.join(map(str, bounds)) or 'none'}")]
+    for name in (first, second):
+        problems += _range_problems(loc + ("range", canonical[name]), name,
+                                    bounds[canonical[name]], variant, "continued")
+    if problems:
+        return problems
+    start_item = {"range": bounds[canonical[first]], "start": item.get("start")}
+    problems += _start_problems(loc, start_item, values[first])
+    limits = bounds[canonical[second]]
+    slices = item.get("slices")
+    if isinstance(limits, list) and len(limits) == 2 and isinstance(slices, list):
+        lower, upper = (_finite(b) for b in limits)
+        for k, value in enumerate(slices):
+            number = _finite(value)
+            if None not in (lower, upper, number) and lower < upper and not (
+                    lower <= number <= upper):
+                problems.append((loc + ("slices", k), f"slice {number!r} is outside the range "
+                                 f"[{lower!r}, {upper!r}] of {second}"))
+    return problems
+
+
+def _start_problems(loc: Loc, item: dict, study_value: float) -> list[Problem]:
+    """``start`` (or the study value when unset) outside ``range``."""
+    bounds = item.get("range")
+    if not isinstance(bounds, list) or len(bounds) != 2:
+        return []
+    lower, upper = (_finite(b) for b in bounds)
+    written = item.get("start") is not None
+    start = _finite(item["start"]) if written else study_value
+    if lower is None or upper is None or start is None or not lower < upper:
+        return []  # reported as a structural problem
+    if lower <= start <= upper:
+        return []
+    key = "start" if written else "range"
+    return [(loc + (key,), f"start {start!r} is outside the range [{lower!r}, {upper!r}]")]
+

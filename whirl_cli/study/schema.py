@@ -1,0 +1,408 @@
+"""The study schema: value checks and the pydantic models of a study file.
+
+Every model forbids unknown keys and is frozen. A value check rejects a value with the reason a
+message shows (``{got}`` becomes the value as written in the YAML, see
+:mod:`whirl_cli.study.messages`); the Annotated types (``Name``, ``Number``, ``Range``, ...)
+attach the checks to the fields. :class:`Study` fills the model-dependent defaults before it
+validates (:mod:`whirl_cli.study.resolve`).
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+import re
+from collections.abc import Callable
+from typing import Annotated, Any, Literal, NoReturn
+
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    model_validator,
+)
+from pydantic_core import PydanticCustomError
+
+from ..models import FAMILIES, Model, get_model
+from .resolve import _LAW_PARAMETERS, _finite, _is_number, _resolved
+
+NAME_MAX = 64
+#: Largest integer AUTO-07p reads into its (32-bit) INTEGER constants (NMX, NTST, ITNW).
+FORTRAN_INT_MAX = 2**31 - 1
+#: Most values in ``orbits_at``: AUTO reads at most 2048 characters per constants line (UZR).
+ORBITS_MAX = 64
+_NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
+_NAME_REASON = (
+    "expected letters, digits, '_', '.', '-' (starting with a letter or digit), got {got}"
+)
+
+
+def _fail(reason: str) -> NoReturn:
+    """Reject a value; ``{got}`` in ``reason`` becomes the value as written in the YAML."""
+    raise PydanticCustomError("whirl", "{reason}", {"reason": reason})
+
+
+def _as_string(value: Any) -> str:
+    if not isinstance(value, str):
+        _fail("expected a string, got {got}")
+    return value
+
+
+def _as_number(value: Any) -> float:
+    if not _is_number(value):
+        _fail("expected a number, got {got}")
+    if not math.isfinite(value):
+        _fail("expected a finite number, got {got}")
+    return float(value)
+
+
+def _as_integer(value: Any) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        _fail("expected an integer, got {got}")
+    return value
+
+
+def _as_boolean(value: Any) -> bool:
+    if not isinstance(value, bool):
+        _fail("expected true or false, got {got}")
+    return value
+
+
+def _as_name(value: Any) -> str:
+    if not _NAME_RE.fullmatch(_as_string(value)):
+        _fail(_NAME_REASON)
+    if len(value) > NAME_MAX:
+        _fail(f"must be at most {NAME_MAX} characters, got {len(value)}")
+    return value
+
+
+def _as_range(value: Any) -> tuple[float, float]:
+    bounds = [_finite(v) for v in value] if isinstance(value, list | tuple) else []
+    if len(bounds) != 2 or None in bounds or not bounds[0] < bounds[1]:
+        _fail("expected [lower, upper] with lower < upper, got {value}")
+    lower, upper = bounds
+    if not (math.isfinite(upper - lower) and math.isfinite(lower - (upper - lower))
+            and math.isfinite(upper + (upper - lower))):  # AUTO's bounds lie 5 % beyond
+        _fail("the range is too wide: its width overflows double precision, got {value}")
+    return lower, upper
+
+
+def _at_most_orbits(values: tuple) -> tuple:
+    if len(values) > ORBITS_MAX:
+        _fail(f"at most {ORBITS_MAX} values, got {len(values)}")
+    return values
+
+
+def _as_model_family(value: str) -> str:
+    if value not in FAMILIES:
+        _fail(f"unknown model {{got}} (known: {', '.join(FAMILIES)})")
+    return value
+
+
+def _bound(symbol: str, limit: float) -> AfterValidator:
+    """A check that the value is ``symbol`` (>=, >, <=) ``limit``."""
+    compare: Callable[[Any, Any], bool] = {
+        ">=": operator.ge,
+        ">": operator.gt,
+        "<=": operator.le,
+    }[symbol]
+
+    def check(value: Any) -> Any:
+        if not compare(value, limit):
+            _fail(f"must be {symbol} {limit}, got {{got}}")
+        return value
+
+    return AfterValidator(check)
+
+
+Text = Annotated[str, BeforeValidator(_as_string)]
+Name = Annotated[str, BeforeValidator(_as_name)]
+Number = Annotated[float, BeforeValidator(_as_number)]
+Integer = Annotated[int, BeforeValidator(_as_integer)]
+Boolean = Annotated[bool, BeforeValidator(_as_boolean)]
+Range = Annotated[tuple[float, float], BeforeValidator(_as_range)]
+Positive = Annotated[Number, _bound(">", 0)]
+ModelFamily = Annotated[Text, AfterValidator(_as_model_family)]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+_TYPE_DOC = (
+    "Stiffness law: `linear` (linear springs; the polynomial law with K2 = K3 = 0) or "
+    "`polynomial` (restoring moment K1 x + K2 x^3 + K3 x^5 on `dof`, x in rad)."
+)
+_DOF_DOC = (
+    "Degree of freedom the law acts on (classical: `theta` pitch, `psi` yaw); unset: the "
+    "model's default (classical: `theta`)."
+)
+
+
+class Linear(_Strict):
+    """Linear springs: the polynomial law with K2 = K3 = 0 (one AUTO executable for both)."""
+
+    type: Literal["linear"] = Field(description=_TYPE_DOC)
+    dof: Text | None = Field(None, description=_DOF_DOC)
+
+
+class Polynomial(_Strict):
+    """Restoring moment K1 x + K2 x^3 + K3 x^5 on one degree of freedom."""
+
+    type: Literal["polynomial"] = Field(description=_TYPE_DOC)
+    dof: Text | None = Field(None, description=_DOF_DOC)
+    K2: Number = Field(0.0, description="Cubic stiffness coefficient, N m/rad^3 (polynomial only).")
+    K3: Number = Field(
+        0.0, description="Quintic stiffness coefficient, N m/rad^5 (polynomial only)."
+    )
+
+
+class OneParameterContinuation(_Strict):
+    """Equilibria in one parameter, with the branches that hang off them.
+
+    After validation ``parameter`` is the canonical name and ``start`` is filled.
+    """
+
+    name: Name = Field(
+        description="Run name, unique within the study (same characters as the study name)."
+    )
+    type: Literal["one-parameter"] = Field(
+        description="`one-parameter`: equilibria in one parameter (AUTO-07p continuation)."
+    )
+    parameter: Text = Field(
+        description="Continuation parameter, by name or alias, in its SI unit (stored as the "
+        "canonical name: `K_theta` -> `K1`)."
+    )
+    start: Number | None = Field(
+        None,
+        description="Starting value, in the parameter's unit; must lie within `range`. Unset: "
+        "the study value (`parameters`, else the model's datum).",
+    )
+    range: Range = Field(
+        description="[lower, upper] bounds of the parameter, in its unit; AUTO stops at either."
+    )
+    periodic: Boolean = Field(
+        False, description="Continue periodic orbits from every Hopf point (main and secondary)."
+    )
+    branch_points: Boolean = Field(
+        True, description="Switch at branch points (pitchforks) to follow secondary equilibria."
+    )
+    orbits_at: Annotated[tuple[Number, ...], AfterValidator(_at_most_orbits)] = Field(
+        (),
+        description="Parameter values (in its unit) at which every branch stores a labelled "
+        "solution: orbit profiles for phase-plane plots (AUTO UZR).",
+    )
+
+    def start_value(self, study: Study) -> float:
+        """``start``, or the study value of the parameter when unset (models built by hand)."""
+        if self.start is not None:
+            return self.start
+        variant = study.variant()
+        name = variant.canonical(self.parameter)
+        return study.parameter_values().get(name, variant.defaults()[name])
+
+
+LocusKind = Literal["hopf", "branch_point", "fold", "fold_of_cycles"]
+
+
+class TwoParameterContinuation(_Strict):
+    """Loci of Hopf points, branch points, folds and folds of cycles in two parameters, the
+    stability boundary they draw and the unsafe (overhang) region.
+
+    After validation ``parameters`` are canonical names and ``start`` and ``slices`` are filled;
+    ``bounds(model)`` gives ``range`` by canonical names.
+    """
+
+    name: Name = Field(
+        description="Run name, unique within the study (same characters as the study name)."
+    )
+    type: Literal["two-parameter"] = Field(
+        description="`two-parameter`: loci of special points in two parameters."
+    )
+    parameters: tuple[Text, Text] = Field(
+        description="[first, second]: the first is continued along each slice of the second; "
+        "both are free on the loci (names or aliases, stored canonical)."
+    )
+    range: dict[str, Range] = Field(
+        description="{first: [lower, upper], second: [lower, upper]}: the region, in the "
+        "parameters' units; loci stop at its edges."
+    )
+    start: Number | None = Field(
+        None,
+        description="Starting value of the first parameter for the one-parameter runs; unset: "
+        "its study value.",
+    )
+    slices: tuple[Number, ...] = Field(
+        (),
+        description="Values of the second parameter at which one-parameter runs find the "
+        "special points the loci start from, and at which unsafe intervals are reported; "
+        "unset: its study value.",
+    )
+    loci: tuple[LocusKind, ...] = Field(
+        ("hopf", "branch_point", "fold", "fold_of_cycles"),
+        description="Which loci to continue: `hopf`, `branch_point` (pitchfork), `fold` (of "
+        "equilibria), `fold_of_cycles` (needs the periodic branches, computed for it).",
+    )
+    method: Literal["loci", "slices"] = Field(
+        "loci",
+        description="How the unsafe region is drawn: `loci` (between the Hopf and fold-of-cycles "
+        "loci, and between the pitchfork and fold loci) or `slices` (the thesis' method: from "
+        "one-parameter runs with periodic branches at every slice).",
+    )
+    resolution: Annotated[Integer, _bound(">=", 3), _bound("<=", 2001)] = Field(
+        101, description="Rows across the second parameter's range for the unsafe polygons."
+    )
+
+    def bounds(self, model: Model) -> dict[str, tuple[float, float]]:
+        """``range`` keyed by canonical parameter names."""
+        return {model.canonical(key): tuple(value) for key, value in self.range.items()}
+
+
+PlotKind = Literal["bifurcation", "linear", "projections", "period", "phase", "boundary"]
+Continuation = Annotated[OneParameterContinuation | TwoParameterContinuation,
+                        Field(discriminator="type")]
+
+
+class LinearSweepSpec(_Strict):
+    """Eigenvalues along one parameter, on an even grid."""
+
+    parameter: Text = Field(
+        description="Swept parameter, by name or alias (stored as the canonical name)."
+    )
+    range: Range = Field(description="[lower, upper] of the sweep, in the parameter's unit.")
+    points: Annotated[Integer, _bound(">=", 2), _bound("<=", 100000)] = Field(
+        201, description="Number of equally spaced values, 2 to 100000."
+    )
+
+
+class LinearGridSpec(_Strict):
+    """Linear stability over a grid of two parameters."""
+
+    x: LinearSweepSpec = Field(description="First grid axis: parameter, range, points.")
+    y: LinearSweepSpec = Field(description="Second grid axis: parameter, range, points.")
+
+
+class LinearSpec(_Strict):
+    """Linear (eigenvalue) analysis, done with numpy, without AUTO."""
+
+    sweeps: tuple[LinearSweepSpec, ...] = Field(
+        (), description="Eigenvalue sweeps (damping ratio, frequency, whirl direction)."
+    )
+    grid: LinearGridSpec | None = Field(
+        None,
+        description="Max real part of the eigenvalues of y = 0 over a grid, with its zero "
+        "contour split into flutter and divergence parts; unset: none.",
+    )
+
+
+class AutoSettings(_Strict):
+    """AUTO-07p settings under readable names; unset ones use whirl's defaults."""
+
+    max_steps: Annotated[Integer, _bound(">=", 1), _bound("<=", FORTRAN_INT_MAX)] | None = Field(
+        None, description="Maximum continuation steps per run (AUTO NMX), >= 1."
+    )
+    step_initial: Positive | None = Field(
+        None, description="Initial step (AUTO DS), fraction of the continuation range width, > 0."
+    )
+    step_min: Positive | None = Field(
+        None, description="Smallest step (AUTO DSMIN), fraction of the range width, > 0."
+    )
+    step_max: Positive | None = Field(
+        None, description="Largest step (AUTO DSMAX), fraction of the range width, > 0."
+    )
+    mesh_intervals: Annotated[
+        Integer, _bound(">=", 2), _bound("<=", FORTRAN_INT_MAX)] | None = Field(
+        None, description="Mesh intervals for periodic orbits (AUTO NTST), >= 2."
+    )
+    collocation_points: Annotated[Integer, _bound(">=", 2), _bound("<=", 7)] | None = Field(
+        None, description="Collocation points per mesh interval (AUTO NCOL), 2 to 7."
+    )
+    newton_max_iterations: Annotated[
+        Integer, _bound(">=", 1), _bound("<=", FORTRAN_INT_MAX)] | None = Field(
+        None, description="Maximum Newton iterations per step (AUTO ITNW), >= 1."
+    )
+    tolerance: Positive | None = Field(
+        None, description="Newton convergence tolerance, dimensionless (AUTO EPSL = EPSU), > 0."
+    )
+    timeout: Positive | None = Field(None, description="Wall-clock limit per AUTO run, s, > 0.")
+    max_amplitude: Positive | None = Field(
+        None, description="Amplitude at which branches are stopped, rad, > 0."
+    )
+
+
+class Study(_Strict):
+    """One study file, validated. ``source``, ``sha256`` and ``path`` are not YAML keys."""
+
+    name: Name = Field(
+        description="Study name: letters, digits, `_`, `.`, `-`, starting with a letter or "
+        f"digit; at most {NAME_MAX} characters."
+    )
+    description: Text = Field("", description="Free text, kept with the results.")
+    model: ModelFamily = Field(description="Model family (`whirl models` lists them).")
+    parameters: dict[str, Number] = Field(
+        default_factory=dict,
+        description="Overrides of the model's datum parameter values, by name or alias, in SI "
+        "units (angles in rad; `whirl models` lists units). K2 and K3 go under `nonlinearity`.",
+    )
+    nonlinearity: Linear | Polynomial = Field(
+        default=Linear(type="linear"),
+        discriminator="type",
+        description="Structural stiffness law on one degree of freedom.",
+    )
+    continuations: tuple[Continuation, ...] = Field(
+        (), description="AUTO-07p continuation runs, in order."
+    )
+    linear: LinearSpec | None = Field(
+        None, description="Linear (eigenvalue) analysis without AUTO; unset: none."
+    )
+    plots: tuple[PlotKind, ...] = Field(
+        ("bifurcation",), description="Figures drawn after the runs."
+    )
+    cross_check: Boolean = Field(
+        False,
+        description="Check stable periodic orbits and equilibria by time simulation (scipy) and "
+        "store the outcome with the results.",
+    )
+    auto: AutoSettings = Field(
+        default_factory=AutoSettings, description="AUTO-07p numerical settings."
+    )
+
+    _source: str = PrivateAttr("")
+    _sha256: str = PrivateAttr("")
+    _path: str = PrivateAttr("")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _fill_model_defaults(cls, data: Any) -> Any:
+        return _resolved(data) if isinstance(data, dict) else data
+
+    @property
+    def source(self) -> str:
+        """The YAML text the study was read from."""
+        return self._source
+
+    @property
+    def sha256(self) -> str:
+        """sha256 (hex) of the UTF-8 YAML text."""
+        return self._sha256
+
+    @property
+    def path(self) -> str:
+        """The path the study was loaded from, as given (or the name given to validate_text)."""
+        return self._path
+
+    def variant(self) -> Model:
+        """The model variant: every study uses the polynomial law (linear is K2 = K3 = 0)."""
+        return get_model(self.model, "polynomial", self.nonlinearity.dof)
+
+    def parameter_values(self) -> dict[str, float]:
+        """Canonical name -> value for every override, plus K2 and K3 of the nonlinearity."""
+        variant = self.variant()
+        values = {variant.canonical(k): v for k, v in self.parameters.items()}
+        for name in _LAW_PARAMETERS:
+            values[name] = getattr(self.nonlinearity, name, 0.0)
+        return values
+

@@ -1,0 +1,44 @@
+"""``whirl sweep``: plan, execute and report a sweep (:func:`run_sweep`).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+from ..auto.runner import interruptible
+from .execute import execute
+from .executors import dask_pool, local_pool, prepare_workers
+from .plan import RUN, plan
+from .report import Reporter, Tally
+
+
+def run_sweep(paths: Sequence[str | os.PathLike[str]], out_dir: Path, jobs: int = 1,
+              dask_address: str | None = None, force: bool = False, plots: bool = True,
+              console=None) -> Tally:
+    """Plan, execute and report a sweep (what ``whirl sweep`` does): the tally of outcomes.
+
+    The summary is printed in every case; a KeyboardInterrupt propagates after it.
+    """
+    items = plan(paths, out_dir, force, plots)
+    if any(item.action == RUN for item in items):
+        Path(out_dir).mkdir(parents=True, exist_ok=True)
+    reporter = Reporter(len(items), console)
+    interrupted = False
+    try:
+        with interruptible():  # SIGTERM (a batch system's cancel) stops a sweep like Ctrl-C
+            if dask_address:
+                pool = dask_pool(dask_address)
+            else:
+                prepare_workers(items)
+                pool = local_pool(jobs)
+            with pool as executor, reporter:
+                execute(items, executor, plots=plots, report=reporter)
+    except KeyboardInterrupt:
+        interrupted = True
+        raise
+    finally:
+        reporter.console.print(reporter.tally.summary(interrupted), markup=False, soft_wrap=True)
+    return reporter.tally
+
