@@ -4,13 +4,16 @@
   :func:`whirl_cli.auto.runner.interruptible`); it survives pickling, so it can travel back from a
   worker process.
 * :func:`quiet_worker` is the initializer of every worker process whirl forks (cross-check
-  simulations, sweep studies); :func:`end_processes` ends such workers after an interrupt.
+  simulations, sweep studies), which are forked inside :func:`forking`; :func:`end_processes`
+  ends such workers after an interrupt.
 """
 
 from __future__ import annotations
 
 import os
 import signal
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 
 class Interrupted(KeyboardInterrupt):
@@ -38,7 +41,26 @@ def quiet_worker() -> None:
     with its parent (Linux parent-death signal), so none outlives a SIGKILLed whirl."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD)  # blocked while forking: see below
     die_with_parent()
+
+
+#: The signals whirl handles: held back while worker processes are forked.
+HELD = frozenset({signal.SIGINT, signal.SIGTERM})
+
+
+@contextmanager
+def forking() -> Iterator[None]:
+    """Fork worker processes inside this: SIGINT and SIGTERM are blocked in the calling
+    thread, so a child starts with them blocked and none can arrive (and run the parent's
+    inherited handler in the child, e.g. inside the interpreter's fork hooks) before
+    :func:`quiet_worker` has set the child's own handlers and unblocked them. In the parent a
+    signal that arrived meanwhile is delivered once the block ends."""
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, HELD)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def die_with_parent() -> None:

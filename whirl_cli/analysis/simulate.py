@@ -15,7 +15,7 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from ..interrupts import end_processes, quiet_worker
+from ..interrupts import end_processes, forking, quiet_worker
 from ..models import Model
 from ..results import Branch, BranchKind, CrossCheck, Orbit, PointType
 from .global_bifurcations import BLOWUP_FACTOR
@@ -129,7 +129,9 @@ def cross_check(model: Model, overrides: dict[str, float], branches: tuple[Branc
             pool = ProcessPoolExecutor(min(jobs, len(tasks)), mp_context=context,
                                        initializer=quiet_worker)
             try:
-                return tuple(pool.map(_run_check, tasks))
+                with forking():  # map submits every task (and forks the workers) at once
+                    results = pool.map(_run_check, tasks)
+                return tuple(results)
             except BaseException:  # e.g. Ctrl-C: the workers hold nothing worth waiting for
                 workers = list((getattr(pool, "_processes", None) or {}).values())
                 pool.shutdown(wait=False, cancel_futures=True)

@@ -13,6 +13,7 @@ from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import contextmanager
 
 from ..errors import WhirlError
+from ..interrupts import forking
 from .execute import _init_worker
 from .plan import RUN, SweepItem
 
@@ -58,8 +59,10 @@ class LocalPool(ProcessPoolExecutor):
 
     def start(self) -> None:
         """Start every worker now (before a progress display thread exists: fork is safe)."""
-        for started in [self.submit(os.getpid) for _ in range(self.jobs)]:
-            started.result()
+        with forking():
+            started = [self.submit(os.getpid) for _ in range(self.jobs)]
+        for future in started:
+            future.result()
 
     def close(self, timeout: float) -> None:
         """Shut down after an interrupt without risking a hang: workers not gone after
