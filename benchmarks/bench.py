@@ -335,7 +335,7 @@ class FoldBySimulation:
         ``k1`` survives ``periods`` periods; (False, start) once it decays."""
         from whirl_cli.analysis.simulate import integrate
 
-        params = self.model.parameter_vector({**self.overrides, "K1": k1})
+        params = self.model.parameter_vector({**self.overrides, "K_theta": k1})
         amplitude, state, chunk = abs(start[0]), start, 10
         for _ in range(max(1, periods // chunk)):
             _, states = integrate(self.model, params, state, chunk * self.period,

@@ -83,20 +83,24 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
                       f"{outcome.wall_seconds:7.3f} s{detail}", soft_wrap=True)
 
     console.print(f"whirl {__version__}: {study.path} -> {output}", soft_wrap=True)
-    if keep_runs:
-        keep_runs.mkdir(parents=True, exist_ok=True)
-        workroot = Path(tempfile.mkdtemp(prefix=f"{study.name}-", dir=keep_runs))
-    else:
-        workroot = Path(tempfile.mkdtemp(prefix="whirl-"))
-    try:
-        result = run_study(study, workroot, jobs=jobs, on_run=report)
-    finally:
-        if not keep_runs:
-            shutil.rmtree(workroot, ignore_errors=True)
+    from .interrupts import catching, held_signals
     from .output.study_files import publish_study
     from .verdict import verdict
 
-    published = publish_study(result, output, study.plots if plots else (), overwrite)
+    with catching():  # an interrupt while plots are drawn is never lost either
+        with held_signals():  # the work directory is made and removed whole
+            if keep_runs:
+                keep_runs.mkdir(parents=True, exist_ok=True)
+                workroot = Path(tempfile.mkdtemp(prefix=f"{study.name}-", dir=keep_runs))
+            else:
+                workroot = Path(tempfile.mkdtemp(prefix="whirl-"))
+        try:
+            result = run_study(study, workroot, jobs=jobs, on_run=report)
+        finally:
+            with held_signals():
+                if not keep_runs:
+                    shutil.rmtree(workroot, ignore_errors=True)
+        published = publish_study(result, output, study.plots if plots else (), overwrite)
     for path in published.paths:
         console.print(f"wrote {path}", soft_wrap=True)
     found = verdict(result, published.plot_error)
@@ -116,28 +120,34 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 def check(result_file: Path) -> None:
     """Check the stable orbits and equilibria of a result file by time simulation."""
+    from dataclasses import replace
+
     from .analysis import simulate
     from .output import store
     from .study import validate_text
 
     result = store.read(result_file)
     study = validate_text(str(result.attributes.get("study_yaml", "")), result_file.name)
-    model, parameters = study.variant(), study.parameter_values()
-    unit = model.states[model.state_names.index(model.dof)].unit
+    model, parameters, names = study.variant(), study.parameter_values(), study.names()
 
     def compared(x) -> str:  # what expected and simulated are (results.CrossCheck)
         if x.kind == "equilibrium":
-            return (f"perturbation {x.expected:.6g} rad, final deviation {x.simulated:.6g} "
-                    "rad")
-        return f"max {model.dof} AUTO {x.expected:.6g} {unit}, simulation {x.simulated:.6g} " \
+            return (f"perturbation {x.expected:.6g}, final deviation {x.simulated:.6g} "
+                    "(typical amplitudes)")
+        unit = model.states[model.state_names.index(x.state)].unit
+        return f"max {x.state} AUTO {x.expected:.6g} {unit}, simulation {x.simulated:.6g} " \
             f"{unit}"
 
     wrong = 0
     for continuation in result.continuations:
-        for x in simulate.cross_check(model, parameters, continuation.branches):
+        # files of older whirl may name parameters by the study's aliases (K1): canonical here
+        branches = tuple(replace(b, parameter_names=tuple(names.canonical(p)
+                                                          for p in b.parameter_names))
+                         for b in continuation.branches)
+        for x in simulate.cross_check(model, parameters, branches):
             mark = "ok  " if x.passed else "FAIL"
             click.echo(f"{mark} {continuation.name}/{x.branch}[{x.index}] {x.kind:<11} "
-                       f"{continuation.branches[0].parameter_names[0]} = {x.parameter:.6g}: "
+                       f"{branches[0].parameter_names[0]} = {x.parameter:.6g}: "
                        f"{compared(x)}")
             wrong += not x.passed
     if wrong:

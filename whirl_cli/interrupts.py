@@ -12,7 +12,9 @@ from __future__ import annotations
 
 import os
 import signal
-from collections.abc import Iterator
+import sys
+import threading
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
 
@@ -86,3 +88,74 @@ def end_processes(processes) -> None:
             process.kill()
     for process in processes:
         process.join(5)
+
+
+#: Signals that arrived while :func:`catching` is in force, the first one being raised.
+_pending: list[int] = []
+
+
+@contextmanager
+def catching(on_first: Callable[[], None] | None = None) -> Iterator[None]:
+    """While inside (main thread only; elsewhere a no-op): SIGINT and SIGTERM raise
+    :class:`Interrupted` in the main thread, after ``on_first()`` (e.g. kill the running AUTO
+    processes) for the first of them; later ones do not interrupt the clean-up.
+
+    Python discards an exception raised inside a weakref callback or a ``__del__`` (a signal
+    can land in one, e.g. while matplotlib draws), printing "Exception ignored". So the
+    signal is also remembered, and raised again when the block would end normally: an
+    interrupt is never lost."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    _pending.clear()
+
+    def handler(signum: int, frame: object) -> None:
+        first = not _pending
+        _pending.append(signum)
+        if first:
+            if on_first is not None:
+                on_first()
+            raise Interrupted(signum)
+
+    def unraisable(hook: sys.UnraisableHookArgs) -> None:  # the "Exception ignored" print
+        if not isinstance(hook.exc_value, Interrupted):  # ours is raised again (see above)
+            default(hook)
+
+    previous = {number: signal.signal(number, handler) for number in HELD}
+    default, sys.unraisablehook = sys.unraisablehook, unraisable
+    try:
+        yield
+    except Interrupted:
+        _pending.clear()  # delivered
+        raise
+    finally:
+        sys.unraisablehook = default
+        for number, old in previous.items():
+            signal.signal(number, old)
+    if _pending:  # swallowed on its way (see above): raise it now
+        signum = _pending[0]
+        _pending.clear()
+        raise Interrupted(signum)
+
+
+@contextmanager
+def held_signals() -> Iterator[None]:
+    """SIGINT and SIGTERM are held back while inside (main thread only; elsewhere a no-op):
+    one that arrives is recorded, and raised again on leaving, so that the handler that was
+    in place (Python's KeyboardInterrupt, :func:`catching`'s, or the default action) deals
+    with it then. (Blocking the signals would not do: the kernel hands a process-directed
+    signal to any thread that does not block it.)"""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    arrived: list[int] = []
+    held = (signal.SIGINT, signal.SIGTERM)
+    previous = {number: signal.signal(number, lambda signum, _frame: arrived.append(signum))
+                for number in held}
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+        for number in dict.fromkeys(arrived):
+            signal.raise_signal(number)

@@ -47,7 +47,8 @@ def _run_study(study: Study, workroot: Path, jobs: int,
     for spec in study.continuations:
         assert engine is not None
         if spec.type == "two-parameter":
-            continuation, boundary = _two_parameter(engine, model, spec, parameters, numerics)
+            continuation, boundary = _two_parameter(engine, study, spec, parameters,
+                                                    numerics)
             continuations.append(continuation)
             found_boundaries.append(boundary)
             continue
@@ -74,11 +75,12 @@ def _run_study(study: Study, workroot: Path, jobs: int,
         attributes=provenance(study), boundaries=tuple(found_boundaries), linear_grid=grid)
 
 
-def _two_parameter(engine: Engine, model, spec, parameters: dict[str, float],
+def _two_parameter(engine: Engine, study: Study, spec, parameters: dict[str, float],
                    numerics: Numerics) -> tuple[ContinuationResult, Boundary]:
     """Loci and the unsafe region of a two-parameter continuation."""
+    model = engine.model
     pair = tuple(spec.parameters)
-    bounds = spec.bounds(model)
+    bounds = spec.bounds(study.names())
     continuation, curves = two_parameter(engine, spec.name, pair, bounds, spec.start,
                                          tuple(spec.slices), tuple(spec.loci), parameters,
                                          numerics)

@@ -287,9 +287,11 @@ class RunRecord:
 class CrossCheck:
     """One time-simulation check of a point of a branch (``whirl_cli.analysis.simulate``).
 
-    ``kind``: "orbit" (expected/simulated: max over the orbit of the state the stiffness law
-    acts on, SI units) or "equilibrium" (expected: initial perturbation, simulated: final
-    deviation, rad).
+    ``kind``: "orbit" (expected/simulated: max over the orbit of ``state``, the dof that
+    moves most relative to its typical amplitude, SI units) or "equilibrium" (expected: the
+    initial perturbation of every dof, simulated: the largest final deviation of one, both in
+    units of the dofs' typical amplitudes; for the classical model rad). ``state``: "" in
+    files written before whirl recorded it.
     """
 
     branch: str
@@ -299,6 +301,7 @@ class CrossCheck:
     expected: float
     simulated: float
     passed: bool
+    state: str = ""
 
 
 @dataclass(frozen=True)

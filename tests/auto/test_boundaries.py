@@ -61,7 +61,7 @@ def test_linear_loci_coincide_with_the_eigenvalue_boundary(results):
     assert kinds == {"hopf", "branch_point"}
     checked = 0
     for kind, curve in boundary.loci.values():
-        points = _on_boundary(model, study.parameter_values(), curve, "K1", "K_psi")
+        points = _on_boundary(model, study.parameter_values(), curve, "K_theta", "K_psi")
         points = points[(points >= 0).all(axis=1) & (points <= 0.5).all(axis=1)]
         for point in points:
             assert np.abs(contour - point).max(axis=1).min() < 0.01 * 0.5, (kind, point)
@@ -126,7 +126,7 @@ def test_hardening_sliver_left_of_the_left_hopf(results):
     assert 0.0807 - sliver.lower > 0.01
     model = get_model("classical")
     k1 = 0.5 * (sliver.lower + sliver.upper)
-    params = model.parameter_vector({**study.parameter_values(), "K_psi": 0.3, "K1": k1})
+    params = model.parameter_vector({**study.parameter_values(), "K_psi": 0.3, "K_theta": k1})
     eigenvalues = np.linalg.eigvals(model.jacobian_numpy(np.zeros(4), params))
     assert eigenvalues.real.max() < 0  # linear analysis: stable
     _, small = simulate.integrate(model, params, np.radians([0.05, 0, 0, 0]), 60.0, 600)
@@ -135,7 +135,7 @@ def test_hardening_sliver_left_of_the_left_hopf(results):
     assert np.degrees(large[-1000:, 0].max()) > 3.0  # ... yet a stable LCO is reached
     (family,) = [b for b in result.continuations[0].branches
                  if b.kind == BranchKind.PERIODIC and "0.288" in b.origin]
-    stable = family.stable & (np.abs(family.parameter("K1") - k1) < 2e-3)
+    stable = family.stable & (np.abs(family.parameter("K_theta") - k1) < 2e-3)
     assert stable.any()
     assert np.degrees(large[-1000:, 0].max()) == pytest.approx(
         np.degrees(family.state_max[stable, 0].max()), rel=0.05)
@@ -152,8 +152,8 @@ def test_loci_and_slices_methods_agree(results, name):
     curves = [b for b in continuation.branches if b.kind.endswith("_locus")]
     per_slice = [tuple(b for b in continuation.branches if b.name.startswith("slice_0."))]
     model = get_model("classical")
-    by_slices = boundaries.boundary("x", model, study.parameter_values(), ("K1", "K_psi"),
-                                    spec.bounds(model), "slices",
+    by_slices = boundaries.boundary("x", model, study.parameter_values(), ("K_theta", "K_psi"),
+                                    spec.bounds(study.names()), "slices",
                                     (0.3,), 3, curves, per_slice)
     by_loci = _slice_intervals(result.boundaries[0], 0.3)
     assert len(by_loci) == len(by_slices.intervals) > 0

@@ -40,7 +40,7 @@ def test_case2_hopf_and_pitchfork_match_thesis_and_eigenvalues(run_thesis, varia
     assert hopf == pytest.approx([0.08, 0.28], abs=0.01)
     assert pitchfork == pytest.approx(0.03, abs=0.01)
     model = get_model("classical")
-    eigen = linear.critical_points(model, {"K_psi": 0.3}, "K1", -0.3, 0.5)
+    eigen = linear.critical_points(model, {"K_psi": 0.3}, "K_theta", -0.3, 0.5)
     assert hopf == pytest.approx([c.value for c in eigen if c.kind == "hopf"], abs=1e-4)
     assert pitchfork == pytest.approx(
         next(c.value for c in eigen if c.kind == "branch_point"), abs=1e-4)
@@ -66,10 +66,10 @@ def test_secondary_equilibria_are_symmetric(run_thesis, variant):
     """The two branches from the pitchfork are mirror images: (theta, psi) -> (-theta, -psi)."""
     first, second = _branches(run_thesis(f"{variant}_case2"), "secondary")
     assert first.status == second.status == "ok"
-    grid = np.linspace(*sorted(first.parameter("K1")[[0, -1]]), 25)
+    grid = np.linspace(*sorted(first.parameter("K_theta")[[0, -1]]), 25)
     for state in ("theta", "psi"):
-        a = np.interp(grid, *_sorted(first.parameter("K1"), first.state(state)))
-        b = np.interp(grid, *_sorted(second.parameter("K1"), second.state(state)))
+        a = np.interp(grid, *_sorted(first.parameter("K_theta"), first.state(state)))
+        b = np.interp(grid, *_sorted(second.parameter("K_theta"), second.state(state)))
         np.testing.assert_allclose(a, -b, atol=1e-8)
         away = np.abs(grid - 0.0359815) > 1e-4
         assert np.all(np.abs(a[away]) > 1e-3)  # genuinely deflected away from the pitchfork
@@ -84,10 +84,10 @@ def test_hardening_secondary_equilibria_closed_form_and_stability(run_thesis):
     """models.md 2.4: K1 + K2 theta^2 = K_eff, psi = k_c theta / (K_psi - k_d); the branches
     are stable just below the (supercritical) pitchfork, down to their Hopf point."""
     model = get_model("classical")
-    params = model.parameter_vector({"K_psi": 0.3, "K2": 10.0})
+    params = model.parameter_vector({"K_psi": 0.3, "K2_theta": 10.0})
     k_eff = 0.0359815  # pitchfork value = k_d - k_c^2 / (K_psi - k_d)
     for branch in _branches(run_thesis("hardening_case2"), "secondary"):
-        k1, theta, psi = branch.parameter("K1"), branch.state("theta"), branch.state("psi")
+        k1, theta, psi = branch.parameter("K_theta"), branch.state("theta"), branch.state("psi")
         np.testing.assert_allclose(k1 + 10.0 * theta**2, k_eff, atol=2e-6)
         # psi/theta is the same constant everywhere: rows of the static stiffness equation
         ratio = psi[1:] / theta[1:]
@@ -108,10 +108,10 @@ def test_auto_eigenvalues_equal_numpy_eigenvalues(run_thesis):
     model = get_model("classical")
     (branch,) = [b for b in _branches(run_thesis("combined_case2"), "secondary_1a")]
     rows = np.flatnonzero(np.all(np.isfinite(branch.eigenvalues), axis=1))[::7]
-    params = model.parameter_vector({"K_psi": 0.3, "K2": -10.0, "K3": 350.0})
+    params = model.parameter_vector({"K_psi": 0.3, "K2_theta": -10.0, "K3_theta": 350.0})
     for k in rows:
         p = params.copy()
-        p[0] = branch.parameter("K1")[k]
+        p[0] = branch.parameter("K_theta")[k]
         y = np.array([branch.state("theta")[k], branch.state("psi")[k], 0.0, 0.0])
         expected = np.sort_complex(np.linalg.eigvals(model.jacobian_numpy(y, p)))
         np.testing.assert_allclose(np.sort_complex(branch.eigenvalues[k]), expected,
@@ -131,7 +131,7 @@ def test_combined_secondary_fold_matches_closed_form(run_thesis):
 def test_linear_variant_divergence_is_a_vertical_line(run_thesis):
     """With a linear spring the pitchfork carries a line of equilibria at fixed K1."""
     for branch in _branches(run_thesis("linear_case2"), "secondary"):
-        np.testing.assert_allclose(branch.parameter("K1"), 0.0359815, atol=1e-6)
+        np.testing.assert_allclose(branch.parameter("K_theta"), 0.0359815, atol=1e-6)
         assert abs(branch.state("theta")).max() == pytest.approx(1.5, abs=1e-6)  # amplitude stop
     assert _points(run_thesis("linear_case2"), PointType.LP, "") == []
 
@@ -142,15 +142,15 @@ def test_every_hopf_crossing_along_every_branch_is_found(run_thesis, case):
     of sign changes of the oscillatory growth rate from numpy eigenvalues at the same points."""
     model = get_model("classical")
     result = run_thesis(case)
-    study_params = {"hardening": {"K2": 10.0}, "softening": {"K2": -10.0},
-                    "combined": {"K2": -10.0, "K3": 350.0}}[case.split("_")[0]]
+    study_params = {"hardening": {"K2_theta": 10.0}, "softening": {"K2_theta": -10.0},
+                    "combined": {"K2_theta": -10.0, "K3_theta": 350.0}}[case.split("_")[0]]
     k_psi = {"2": 0.3, "3": 0.2, "5": 0.037}[case[-1]]
     params = model.parameter_vector({**study_params, "K_psi": k_psi})
     for branch in result.continuations[0].branches:
         if branch.kind != "equilibrium" or len(branch) < 3:
             continue
         p = np.repeat(params[:, None], len(branch), axis=1)
-        p[0] = branch.parameter("K1")
+        p[0] = branch.parameter("K_theta")
         eigenvalues = np.linalg.eigvals(model.jacobian_numpy(branch.state_max.T, p))
         oscillatory = np.abs(eigenvalues.imag) > 1e-6
         growth = np.where(oscillatory, eigenvalues.real, -np.inf).max(axis=1)

@@ -23,7 +23,7 @@ from whirl_cli.continuation.periodic import periodic_constants
 from whirl_cli.models import get_model
 from whirl_cli.results import BranchKind, PointType
 
-CASE = {"K2": 10.0, "K3": 0.0, "K_psi": 0.3}
+CASE = {"K2_theta": 10.0, "K3_theta": 0.0, "K_psi": 0.3}
 BOUNDS = (-0.3, 0.5)
 
 
@@ -33,23 +33,23 @@ def runs(tmp_path_factory):
     model = get_model("classical")
     engine = Engine(model, tmp_path_factory.mktemp("roundtrip"), jobs=2)
     numerics = Numerics(orbits_at=(0.45, 0.35, 0.2, -0.1, -0.2))
-    main = equilibrium_constants(model, numerics, "K1", BOUNDS, -1)
-    main["PAR"] = {**CASE, "K1": 0.5}
+    main = equilibrium_constants(model, numerics, "K_theta", BOUNDS, -1)
+    main["PAR"] = {**CASE, "K_theta": 0.5}
     (first,) = engine.run_many([RunSpec("rt/main", main, BranchKind.EQUILIBRIUM, "start",
-                                        ("K1",))])
+                                        ("K_theta",))])
     solutions = parse_s(first.file("s").read_text())
     (pitchfork,) = [s for s in solutions if PointType.from_auto(s.ty) == PointType.BP]
     (hopf,) = [s for s in solutions if PointType.from_auto(s.ty) == PointType.HB
                and abs(s.par[0] - 0.2888) < 1e-3]
-    secondary = equilibrium_constants(model, numerics, "K1", BOUNDS, -1)
+    secondary = equilibrium_constants(model, numerics, "K_theta", BOUNDS, -1)
     secondary["ISW"] = -1
-    periodic = periodic_constants(model, numerics, "K1", BOUNDS,
+    periodic = periodic_constants(model, numerics, "K_theta", BOUNDS,
                                   float(hopf.par[PERIOD_INDEX - 1]))
     periodic.update(NMX=41, NPR=10)
     second, third = engine.run_many([
-        RunSpec("rt/secondary", secondary, BranchKind.EQUILIBRIUM, "BP", ("K1",),
+        RunSpec("rt/secondary", secondary, BranchKind.EQUILIBRIUM, "BP", ("K_theta",),
                 restart=("rt.main", pitchfork.lab)),
-        RunSpec("rt/periodic", periodic, BranchKind.PERIODIC, "HB", ("K1",),
+        RunSpec("rt/periodic", periodic, BranchKind.PERIODIC, "HB", ("K_theta",),
                 restart=("rt.main", hopf.lab))])
     outcomes = {"main": first, "secondary": second, "periodic": third}
     assert all(o.status == "ok" for o in outcomes.values()), outcomes
@@ -115,7 +115,7 @@ def test_equilibrium_rows_at_labels_are_the_s_file_solutions(runs, run):
     for solution in solutions:
         k = _row(segment, solution.lab)
         assert segment.ty[k] == solution.ty and solution.ips == 1 and solution.u.shape == (1, 4)
-        assert segment.column("K1")[k] == pytest.approx(solution.par[0], rel=1e-9, abs=1e-12)
+        assert segment.column("K_theta")[k] == pytest.approx(solution.par[0], rel=1e-9, abs=1e-12)
         for i, name in enumerate(model.state_names):
             for column in (f"max_{name}", f"min_{name}"):
                 assert segment.column(column)[k] == pytest.approx(solution.u[0, i], rel=1e-9,
@@ -136,7 +136,7 @@ def test_d_file_eigenvalues_are_the_model_jacobian_eigenvalues(runs, run):
     model, outcomes = runs
     segment, solutions, diagnostics = _files(outcomes[run])
     branch = read_branch(outcomes[run], model, name=run, kind=BranchKind.EQUILIBRIUM,
-                         origin="", parameter_names=("K1",))
+                         origin="", parameter_names=("K_theta",))
     scale = np.asarray(model.state_scale)
     for solution in solutions:
         k = _row(segment, solution.lab)
@@ -164,7 +164,7 @@ def test_periodic_rows_at_labels_are_the_s_file_profiles(runs):
     for solution in orbits:
         k = _row(segment, solution.lab)
         assert segment.br[k] < 0 and segment.ty[k] == solution.ty
-        assert segment.column("K1")[k] == pytest.approx(solution.par[0], rel=1e-9)
+        assert segment.column("K_theta")[k] == pytest.approx(solution.par[0], rel=1e-9)
         assert segment.column("PERIOD")[k] == pytest.approx(solution.par[PERIOD_INDEX - 1],
                                                             rel=1e-9)
         for i, name in enumerate(model.state_names):
@@ -186,7 +186,7 @@ def test_d_file_multipliers_are_the_monodromy_eigenvalues(runs):
     model, outcomes = runs
     segment, solutions, diagnostics = _files(outcomes["periodic"])
     branch = read_branch(outcomes["periodic"], model, name="periodic",
-                         kind=BranchKind.PERIODIC, origin="", parameter_names=("K1",))
+                         kind=BranchKind.PERIODIC, origin="", parameter_names=("K_theta",))
     scale = np.asarray(model.state_scale)
     orbits = [s for s in solutions if s.ips == 2]
     assert len(branch.orbits) == len(orbits)

@@ -58,8 +58,8 @@ def test_hardening_case2_flutter_branch_joins_the_two_hopf_points(run_thesis):
     (flutter,) = main
     # both ends at the Hopf points of the eigenvalues (models.md 4: 0.0807 and 0.2888)
     left, right = (c.value for c in linear.critical_points(
-        get_model("classical"), {"K_psi": 0.3}, "K1", -0.3, 0.5) if c.kind == "hopf")
-    k1, amplitude = flutter.parameter("K1"), _pitch_amplitude(flutter)
+        get_model("classical"), {"K_psi": 0.3}, "K_theta", -0.3, 0.5) if c.kind == "hopf")
+    k1, amplitude = flutter.parameter("K_theta"), _pitch_amplitude(flutter)
     assert k1[0] == pytest.approx(right, abs=1e-6) and amplitude[0] < 1e-9
     # the other end: the orbit has shrunk onto the left Hopf point; with the Hopf normal form
     # (K1 - K1_H proportional to the squared amplitude) the last two orbits extrapolate to it
@@ -71,7 +71,7 @@ def test_hardening_case2_flutter_branch_joins_the_two_hopf_points(run_thesis):
     # a fold of cycles left of the left Hopf point, and an unstable part there
     folds = [p for p in _points(result, PointType.LPC) if p.branch == flutter.name]
     assert any(p.parameters[0] < 0.0807 - 0.01 for p in folds)
-    k1, stable = flutter.parameter("K1"), flutter.stable
+    k1, stable = flutter.parameter("K_theta"), flutter.stable
     assert not stable[k1 < 0.075].all()
     # the rest (well right of the left Hopf) is stable
     assert stable[(k1 > 0.09) & (np.arange(len(k1)) > 0)].all()
@@ -89,7 +89,7 @@ def test_hardening_case2_secondary_flutter(run_thesis):
         assert len(hopfs) == 2
         (family,) = [b for b in _periodic(result) if b.origin.endswith(f"on {side}")]
         assert family.end.startswith("returns to HB") and family.end.endswith(side)
-        ends = sorted([family.parameter("K1")[0], family.parameter("K1")[-1]])
+        ends = sorted([family.parameter("K_theta")[0], family.parameter("K_theta")[-1]])
         np.testing.assert_allclose(ends, hopfs, atol=2e-3)
         assert family.stable[1:-1].mean() > 0.9
 
@@ -164,7 +164,7 @@ def test_softening_case2_coexisting_limit_cycle_by_simulation(softening_at_04, c
     AUTO's unstable orbit (the separatrix) ends on the stable one, just inside it decays."""
     study, result = softening_at_04
     model = get_model("classical")
-    params = model.parameter_vector({**study.parameter_values(), "K1": 0.4})
+    params = model.parameter_vector({**study.parameter_values(), "K_theta": 0.4})
     (flutter,) = [b for b in _periodic(result) if "0.288" in b.origin]
     at = [o for o in flutter.orbits if abs(o.parameters[0] - 0.4) < 1e-6]
     stable = [o for o in at if flutter.stable[o.index]]
@@ -301,7 +301,7 @@ def test_parallel_cross_check_equals_the_serial_one(run_thesis):
     result = run_thesis("combined_case2")
     (continuation,) = result.continuations
     model = get_model("classical")
-    parameters = {"K2": -10.0, "K3": 350.0, "K_psi": 0.3}
+    parameters = {"K2_theta": -10.0, "K3_theta": 350.0, "K_psi": 0.3}
     serial = simulate.cross_check(model, parameters, continuation.branches, jobs=1)
     parallel = simulate.cross_check(model, parameters, continuation.branches, jobs=2)
     assert len(serial) >= 4
@@ -313,7 +313,7 @@ def test_cross_check_fails_for_a_wrong_orbit(run_thesis):
 
     result = run_thesis("hardening_case2")
     model = get_model("classical")
-    parameters = {"K_psi": 0.3, "K2": 10.0, "K3": 0.0}
+    parameters = {"K_psi": 0.3, "K2_theta": 10.0, "K3_theta": 0.0}
     (flutter,) = [b for b in _periodic(result) if "0.288" in b.origin]
     orbit = next(o for o in flutter.orbits if 0 < o.index and flutter.stable[o.index])
     assert simulate.check_orbit(model, parameters, flutter, orbit).passed
@@ -375,8 +375,8 @@ def _departure(model, params, source, target, sign, start=1e-7, duration=4.0):
     return side, float(distance[closest])
 
 
-GLOBAL_CASES = {"hardening_case3": {"K2": 10.0, "K3": 0.0, "K_psi": 0.2},
-                "combined_case3": {"K2": -10.0, "K3": 350.0, "K_psi": 0.2}}
+GLOBAL_CASES = {"hardening_case3": {"K2_theta": 10.0, "K3_theta": 0.0, "K_psi": 0.2},
+                "combined_case3": {"K2_theta": -10.0, "K3_theta": 350.0, "K_psi": 0.2}}
 
 
 @cache
@@ -391,7 +391,7 @@ def _simulated_connection(case: str, estimate: float, saddle: tuple[float, ...])
     target = source if not source.any() else -source
 
     def at(k1, sign):
-        params = model.parameter_vector({**GLOBAL_CASES[case], "K1": k1})
+        params = model.parameter_vector({**GLOBAL_CASES[case], "K_theta": k1})
         return _departure(model, params, source, target, sign)
 
     sign = 1.0 if at(estimate, 1.0)[1] <= at(estimate, -1.0)[1] else -1.0
@@ -481,7 +481,8 @@ def test_homoclinic_orbit_located_by_homcont_and_by_simulation(run_thesis):
     side = float(np.sign(secondary.state_max[-1, 0]))  # the loop circles this focus
 
     def distance(k1: float) -> float:
-        params = model.parameter_vector({"K1": k1, "K2": 10.0, "K3": 0.0, "K_psi": 0.2})
+        params = model.parameter_vector({"K_theta": k1, "K2_theta": 10.0, "K3_theta": 0.0,
+                                         "K_psi": 0.2})
         return _return_distance(model, params, side)
 
     at, left, right = distance(value), distance(value - 5e-4), distance(value + 5e-4)
@@ -502,7 +503,8 @@ def test_airspeed_continuation_overhang(run_thesis, capsys):
     family = next(b for b in result.continuations[0].branches if b.name == fold.branch)
     d = 2e-3 * 1.3
     side, inside, beyond = _fold_of_cycles_by_simulation(
-        get_model("classical"), {"K2": -10.0, "K3": 350.0}, family, fold, d, periods=600)
+        get_model("classical"), {"K2_theta": -10.0, "K3_theta": 350.0}, family, fold, d,
+        periods=600)
     with capsys.disabled():
         print(f"\ncombined airspeed fold of cycles: AUTO V = {fold.parameters[0]:.5f} m/s; by "
               f"simulation in [{fold.parameters[0] - d:.5f}, {fold.parameters[0] + d:.5f}]: "

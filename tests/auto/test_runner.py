@@ -27,8 +27,8 @@ def executable(model):
 
 @pytest.fixture()
 def constants(model):
-    return equilibrium_constants(model, Numerics(), "K1", (-0.3, 0.5), -1) | {
-        "PAR": {"K1": 0.5, "K_psi": 0.3, "K2": 10.0}}
+    return equilibrium_constants(model, Numerics(), "K_theta", (-0.3, 0.5), -1) | {
+        "PAR": {"K_theta": 0.5, "K_psi": 0.3, "K2_theta": 10.0}}
 
 
 def test_compiled_once_then_cached(model, executable):
@@ -52,8 +52,8 @@ def test_successful_run_and_parser_round_trip(executable, constants, tmp_path, m
     for solution in solutions:
         row = int(np.flatnonzero(segment.lab == solution.lab)[0])
         assert solution.ty == segment.ty[row]
-        assert solution.par[layout.parameters["K1"] - 1] == pytest.approx(
-            segment.column("K1")[row], rel=1e-9, abs=1e-12)
+        assert solution.par[layout.parameters["K_theta"] - 1] == pytest.approx(
+            segment.column("K_theta")[row], rel=1e-9, abs=1e-12)
         for i, name in enumerate(model.state_names):
             assert solution.u[0, i] == pytest.approx(segment.column(f"max_{name}")[row],
                                                      abs=1e-9)
@@ -73,7 +73,7 @@ def test_analytic_jacobian_agrees_with_finite_differences(executable, constants,
         outcome = runner.run(executable.path, constants | {"JAC": jac}, tmp_path / f"j{jac}", "j")
         (segment,) = parse_b(outcome.file("b").read_text())
         special = np.isin(segment.ty, (1, 3))
-        found[jac] = segment.column("K1")[special]
+        found[jac] = segment.column("K_theta")[special]
     np.testing.assert_allclose(found[1], found[0], atol=1e-7)
     assert len(found[1]) == 3
 
@@ -81,7 +81,7 @@ def test_analytic_jacobian_agrees_with_finite_differences(executable, constants,
 @pytest.mark.parametrize(("change", "status", "message"), [
     ({"IRS": 7}, "error", "restart solution file could not be found"),
     ({"NDIM": 3}, "crashed", "AUTO crashed with SIGSEGV"),
-    ({"PAR": {"K1": 0.5, "R": float("nan")}}, "error", "NaN or Inf in the equations"),
+    ({"PAR": {"K_theta": 0.5, "R": float("nan")}}, "error", "NaN or Inf in the equations"),
     ({"EPSL": 1e-17, "EPSU": 1e-17, "ITNW": 3, "U": {"theta": 1e-3}}, "mx", "no convergence"),
     ({"NMX": 10**7, "DS": -1e-9, "DSMIN": 1e-12, "DSMAX": 1e-9}, "timeout",
      "did not finish within 0.5 s"),

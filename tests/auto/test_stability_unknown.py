@@ -22,7 +22,7 @@ from whirl_cli.results import BranchKind
 
 from ..conftest import ROOT
 
-REFERENCE = ROOT / "tests" / "regression" / "references" / "hardening_case2.h5"
+REFERENCE = ROOT / "tests" / "data" / "legacy_hardening_case2.h5"  # written before stability_known
 
 
 @pytest.fixture(scope="module")

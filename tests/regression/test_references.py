@@ -76,7 +76,7 @@ def test_compare_catches_a_moved_hopf_point(reference_copy):
         table["parameters"][...] = parameters
     result = compare_cli(source, copy)
     assert result.exit_code == 1
-    assert f"/continuations/k1/special_points/parameters[{row}]: K1 = " in result.output
+    assert f"/continuations/k1/special_points/parameters[{row}]: K_theta = " in result.output
     assert "HB on main_down" in result.output
 
 

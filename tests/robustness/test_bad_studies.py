@@ -172,7 +172,7 @@ def mutate(kind: str, data: dict, draw) -> tuple[bytes, tuple]:
         ]
         for i, item in enumerate(data.get("continuations") or []):
             key = "parameter" if "parameter" in item else "parameters"
-            value = "K_phi" if key == "parameter" else ["K1", "K_phi"]
+            value = "K_phi" if key == "parameter" else ["K_theta", "K_phi"]
             choices += [(("continuations", i, key), value),
                         (("continuations", i, "type"), "three-parameter"),
                         (("continuations", i, "name"), "-dash")]

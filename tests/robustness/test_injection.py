@@ -91,7 +91,7 @@ def test_injection_strings_are_refused_by_validation(slot, tmp_path, monkeypatch
     monkeypatch.chdir(tmp_path)
     (tmp_path / "victim").write_text("still here")
     for value in INJECTIONS:
-        if slot == "parameters" and value in ("K1", ""):
+        if slot == "parameters" and value in ("K_theta", ""):
             continue
         study = tmp_path / "s.yaml"
         study.write_text(study_text(slot, value))
@@ -112,7 +112,7 @@ def test_injection_strings_are_refused_by_validation(slot, tmp_path, monkeypatch
 FORTRAN_WORDS = {
     # statements and attributes the generator writes
     "subroutine", "end", "implicit", "none", "integer", "intent", "in", "out", "inout",
-    "double", "precision", "external", "if", "return",
+    "double", "precision", "external", "if", "return", "do",
     # intrinsics sympy's fcode may emit for these models
     "sqrt", "asinh", "max", "min", "abs", "exp", "log", "sin", "cos", "tan", "sinh", "cosh",
     "tanh", "atan", "atan2", "asin", "acos", "sign",
@@ -144,12 +144,14 @@ def undeclared(source: str, model) -> set[str]:
     assert set(strings) <= {"'MAX'", "'MIN'"}, strings
     declared = set()
     for line in code:
-        if line.strip().upper().startswith("DOUBLE PRECISION ::"):
-            declared |= {n.strip().lower() for n in line.split("::", 1)[1].split(",")}
+        if line.strip().upper().startswith(("DOUBLE PRECISION ::", "INTEGER ::")):
+            listed = re.sub(r"\([^)]*\)", "", line.split("::", 1)[1])  # drop array shapes
+            declared |= {n.strip().lower() for n in listed.split(",")}
     names = {n.lower() for n in model.state_names + model.parameter_names}
     assert names <= declared
     temporaries = declared - names
-    assert all(re.fullmatch(r"w_[fup]\d+", n) for n in temporaries), temporaries
+    work = {"wm", "wa", "wj", "wp", "i"}  # mass matrix, right-hand sides, loop index
+    assert all(re.fullmatch(r"w_[fupm]\d+", n) or n in work for n in temporaries), temporaries
     return {word for line in code for word in _IDENTIFIER.findall(_NUMBER.sub(" ", line))
             if word.lower() not in FORTRAN_WORDS | AUTO_NAMES | declared}
 
@@ -163,7 +165,7 @@ def test_generated_fortran_holds_only_numbers_and_declared_names(model):
                               "  CALL EXECUTE_COMMAND_LINE('x') ! x\n  IF (IJAC == 0) RETURN")
     with pytest.raises(AssertionError):
         undeclared(injected, model)
-    assert undeclared(source.replace("IF (IJAC == 0) RETURN", "K1 = 0; CALL EXIT"),
+    assert undeclared(source.replace("IF (IJAC == 0) RETURN", "K_theta = 0; CALL EXIT"),
                       model) == {"CALL", "EXIT"}
 
 
@@ -172,7 +174,8 @@ def test_generated_fortran_refuses_line_breaks_and_non_finite_numbers():
     from dataclasses import replace
 
     with pytest.raises(CodegenError, match="line break"):
-        codegen.fortran_source(replace(model, description="ok\nCALL EXIT"))
+        family = replace(model.family, description="ok\nCALL EXIT")
+        codegen.fortran_source(replace(model, family=family))
     for value in (float("nan"), float("inf"), -float("inf")):
         with pytest.raises(CodegenError, match="Fortran number"):
             codegen.fortran_number(value)

@@ -26,13 +26,14 @@ def test_check_labels_each_kind_of_cross_check_truthfully():
     orbits = [line for line in lines if " orbit " in line]
     assert len(equilibria) == 6 and len(orbits) == 6 and len(lines) == 12, result.output
     for line in equilibria:
-        assert re.fullmatch(rf"ok   k1/\w+\[\d+\] equilibrium K1 = {NUMBER}: perturbation "
-                            rf"{NUMBER} rad, final deviation {NUMBER} rad", line), line
+        assert re.fullmatch(rf"ok   k1/\w+\[\d+\] equilibrium K_theta = {NUMBER}: "
+                            rf"perturbation {NUMBER}, final deviation {NUMBER} \(typical "
+                            r"amplitudes\)", line), line
     for line in orbits:
-        assert re.fullmatch(rf"ok   k1/periodic_\d+\[\d+\] orbit +K1 = {NUMBER}: max theta "
+        assert re.fullmatch(rf"ok   k1/periodic_\d+\[\d+\] orbit +K_theta = {NUMBER}: max theta "
                             rf"AUTO {NUMBER} rad, simulation {NUMBER} rad", line), line
     assert "AUTO" not in "".join(equilibria)
     # the perturbation of main_down[1] is whirl's default, decayed by orders of magnitude
     default = inspect.signature(simulate.check_equilibrium).parameters["perturbation"].default
-    first = re.search(rf"perturbation ({NUMBER}) rad, final deviation ({NUMBER})", lines[0])
+    first = re.search(rf"perturbation ({NUMBER}), final deviation ({NUMBER})", lines[0])
     assert float(first.group(1)) == default and float(first.group(2)) < 1e-2 * default

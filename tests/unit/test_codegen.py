@@ -26,7 +26,8 @@ def test_fortran_is_deterministic_and_complete(model):
     assert first == second
     for routine in ("FUNC", "STPNT", "BCND", "ICND", "FOPT", "PVLS"):
         assert f"SUBROUTINE {routine}" in first and f"END SUBROUTINE {routine}" in first
-    assert "DFDU(3,1)" in first and "DFDP(4,5)" in first  # analytic Jacobians
+    assert "WJ(1,1)" in first and "DFDU(3,1:4)" in first  # analytic Jacobians
+    assert "DFDP(4," in first and "WP(2," in first
     assert "GETP('MAX', 1, U)" in first
     assert codegen.model_hash(model) in first
 
@@ -37,7 +38,7 @@ def test_par_layout_avoids_auto_reserved_slots(model):
             layout.amplitude]
     assert len(set(used)) == len(used)
     assert not set(used) & set(range(10, 37))  # PAR(11) period, HomCont 10..36
-    assert layout.parameters["K1"] == 1 and layout.npar == max(used)
+    assert layout.parameters["K_theta"] == 1 and layout.npar == max(used)
 
 
 @pytest.mark.parametrize("value", [0.4, 1e-16, 2.0 * 3.141592653589793, 4.0, -10.0, 1.78e-4])
@@ -70,11 +71,11 @@ def test_committed_files_match_the_models():
 def test_generate_check_detects_drift(tmp_path):
     copy = tmp_path / "auto_equations"
     shutil.copytree(ROOT / "auto_equations", copy)
-    target = copy / "classical_poly_theta" / "classical_poly_theta.f90"
+    target = copy / "classical_poly" / "classical_poly.f90"
     target.write_text(target.read_text().replace("F(1) =", "F(1) = 2*"))
     result = CliRunner().invoke(cli, ["generate", "--check", "--dir", str(copy)])
     assert result.exit_code == 1
-    assert "classical_poly_theta/classical_poly_theta.f90" in result.output
+    assert "classical_poly/classical_poly.f90" in result.output
     repaired = CliRunner().invoke(cli, ["generate", "--dir", str(copy)])
     assert repaired.exit_code == 0 and "wrote" in repaired.output
     assert CliRunner().invoke(cli, ["generate", "--check", "--dir", str(copy)]).exit_code == 0

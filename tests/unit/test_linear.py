@@ -138,16 +138,16 @@ def test_stiffness_sweep_critical_points(model, k_psi, reference):
 def test_divergence_matches_closed_form(model):
     """models.md 2.4: K_theta,BP = k_d - k_c^2 / (K_psi - k_d) for K_psi = 0.2, 0.3, 0.4."""
     for k_psi, expected in ((0.2, 0.02908), (0.3, 0.03598), (0.4, 0.03898)):
-        found = [c for c in linear.critical_points(model, {"K_psi": k_psi}, "K1", -0.3, 0.5)
+        found = [c for c in linear.critical_points(model, {"K_psi": k_psi}, "K_theta", -0.3, 0.5)
                  if c.kind == "branch_point"]
         assert found[0].value == pytest.approx(expected, abs=1e-5)
 
 
 def test_vectorised_sweep_equals_point_by_point(model):
     values = np.linspace(-0.3, 0.5, 37)
-    sweep = linear.sweep(model, {"K_psi": 0.3}, "K1", values)
+    sweep = linear.sweep(model, {"K_psi": 0.3}, "K_theta", values)
     for k, value in enumerate(values):
-        single = linear.sweep(model, {"K_psi": 0.3}, "K1", np.array([value]))
+        single = linear.sweep(model, {"K_psi": 0.3}, "K_theta", np.array([value]))
         np.testing.assert_allclose(single.eigenvalues[0], sweep.eigenvalues[k], rtol=1e-12)
 
 

@@ -62,7 +62,7 @@ def test_criticality_sign_convention():
 
 def test_derivative_tensors_of_the_classical_model():
     model = get_model("classical")
-    params = model.parameter_vector({"K1": 0.2, "K2": 10.0, "K3": 0.0})
+    params = model.parameter_vector({"K_theta": 0.2, "K2_theta": 10.0, "K3_theta": 0.0})
     rng = np.random.default_rng(1)
     state = rng.normal(scale=0.1, size=model.n_states)
     second, third = model.derivative_tensors(state, params)

@@ -114,13 +114,13 @@ STATE_COLUMNS = [f"{m}_{s}" for m in ("max", "min") for s in ("theta", "psi", "d
 
 def b_segment(br: int, columns: list[str], rows: list[tuple[int, float]]) -> str:
     """A b-file segment in AUTO's layout (title: 20 characters, then 19 per column); each row
-    (PT, K1) has the value k/1000 in the k-th column after K1 and L2-NORM = 0.5."""
+    (PT, K_theta) has the value k/1000 in the k-th column after K_theta and L2-NORM = 0.5."""
     title = "   0    PT  TY  LAB " + "".join(f"{c:>14}     " for c in columns)
     lines = ["   0   NDIM=   4   IPS =   1   IRS =   0   ILP =   1",
-             "   0   Active continuation parameter:   'K1'", title]
+             "   0   Active continuation parameter:   'K_theta'", title]
     for pt, k1 in rows:
-        values = {"K1": k1, "L2-NORM": 0.5, **{c: (k + 1) / 1000 for k, c in enumerate(
-            c for c in columns if c not in ("K1", "L2-NORM"))}}
+        values = {"K_theta": k1, "L2-NORM": 0.5, **{c: (k + 1) / 1000 for k, c in enumerate(
+            c for c in columns if c not in ("K_theta", "L2-NORM"))}}
         lines.append(f"{br:4d}{pt:6d}   0    0" + "".join(f"  {values[c]:.10E}"
                                                         for c in columns))
     return "\n".join(lines) + "\n"
@@ -134,20 +134,20 @@ def read_fragment(tmp_path, text: str):
     (tmp_path / "b.k1.main").write_text(text)
     outcome = RunOutcome("k1.main", "ok", "ok", tmp_path, "", 0, 0.1, text.count("\n"))
     return read_branch(outcome, get_model("classical"), name="main", kind="equilibrium",
-                       origin="start", parameter_names=("K1",))
+                       origin="start", parameter_names=("K_theta",))
 
 
 def test_segments_with_different_columns_keep_every_row(tmp_path):
     """A second segment with one more column (and its columns in another order): all rows
     are read, each shared column by its name."""
-    first = b_segment(1, ["K1", "L2-NORM", *STATE_COLUMNS], [(-1, 0.4), (-2, 0.39)])
-    second = b_segment(2, ["K1", "L2-NORM", "PERIOD", *reversed(STATE_COLUMNS)],
+    first = b_segment(1, ["K_theta", "L2-NORM", *STATE_COLUMNS], [(-1, 0.4), (-2, 0.39)])
+    second = b_segment(2, ["K_theta", "L2-NORM", "PERIOD", *reversed(STATE_COLUMNS)],
                        [(3, 0.2), (4, 0.1), (5, 0.0)])
     (a, b) = parse_b(first + second)
     assert a.columns != b.columns
     branch = read_fragment(tmp_path, first + second)
     assert branch.status == "ok" and len(branch) == 5
-    np.testing.assert_allclose(branch.parameter("K1"), [0.4, 0.39, 0.2, 0.1, 0.0])
+    np.testing.assert_allclose(branch.parameter("K_theta"), [0.4, 0.39, 0.2, 0.1, 0.0])
     assert list(branch.stable) == [True, True, False, False, False]
     # max_theta is the 1st state column of the first segment, the 9th of the second
     np.testing.assert_allclose(branch.state("theta"), [0.001, 0.001, 0.009, 0.009, 0.009])
@@ -156,8 +156,8 @@ def test_segments_with_different_columns_keep_every_row(tmp_path):
 
 
 def test_a_segment_without_a_column_whirl_needs_fails_the_branch_with_a_message(tmp_path):
-    first = b_segment(1, ["K1", "L2-NORM", *STATE_COLUMNS], [(-1, 0.4), (-2, 0.39)])
-    second = b_segment(2, ["K1", "L2-NORM", *STATE_COLUMNS[:-1]], [(3, 0.2)])
+    first = b_segment(1, ["K_theta", "L2-NORM", *STATE_COLUMNS], [(-1, 0.4), (-2, 0.39)])
+    second = b_segment(2, ["K_theta", "L2-NORM", *STATE_COLUMNS[:-1]], [(3, 0.2)])
     branch = read_fragment(tmp_path, first + second)
     assert branch.status == "error" and len(branch) == 0
     assert branch.message == "AUTO's b-file lacks column(s) min_dpsi in some of its 2 segments"

@@ -12,7 +12,7 @@ from whirl_cli.analysis import simulate
 from whirl_cli.models import get_model
 from whirl_cli.results import Branch, BranchKind, PointType
 
-HARDENING_CASE2 = {"K2": 10.0, "K3": 0.0, "K_psi": 0.3}
+HARDENING_CASE2 = {"K2_theta": 10.0, "K3_theta": 0.0, "K_psi": 0.3}
 
 
 @pytest.fixture(scope="module")
@@ -24,7 +24,7 @@ def one_point_branch(model, k1: float, state: np.ndarray) -> Branch:
     """A stable equilibrium branch of one row at ``k1`` with the stored ``state``."""
     nan = np.full((1, model.n_states), np.nan + 0j)
     return Branch(
-        name="hand", kind=BranchKind.EQUILIBRIUM, origin="by hand", parameter_names=("K1",),
+        name="hand", kind=BranchKind.EQUILIBRIUM, origin="by hand", parameter_names=("K_theta",),
         parameter_units=("N m/rad",), state_names=model.state_names,
         state_units=tuple(s.unit for s in model.states), parameters=np.array([[k1]]),
         state_max=state[None, :].copy(), state_min=state[None, :].copy(),
@@ -36,7 +36,7 @@ def one_point_branch(model, k1: float, state: np.ndarray) -> Branch:
 def equilibrium(model, k1: float, guess: np.ndarray) -> np.ndarray:
     """The equilibrium of hardening case 2 at ``k1`` nearest ``guess``, by Newton's method on
     the numpy right-hand side (to machine precision), checked stable."""
-    params = model.parameter_vector({**HARDENING_CASE2, "K1": k1})
+    params = model.parameter_vector({**HARDENING_CASE2, "K_theta": k1})
     state = np.asarray(guess, dtype=float)
     for _ in range(50):
         step = np.linalg.solve(model.jacobian_numpy(state, params), model.rhs_numpy(state, params))

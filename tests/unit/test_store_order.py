@@ -15,7 +15,7 @@ from whirl_cli.results import Boundary, LinearGrid, Orbit, RunRecord, UnsafeInte
 from ..conftest import ROOT
 from .test_compare import equilibrium_branch, make_result, periodic_branch
 
-REFERENCE = ROOT / "tests" / "regression" / "references" / "hardening_case2.h5"
+REFERENCE = ROOT / "tests" / "data" / "legacy_hardening_case2.h5"  # written 2026-11-25
 
 
 def orbit(label: int, index: int) -> Orbit:

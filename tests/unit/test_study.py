@@ -52,7 +52,8 @@ MODELS: tuple[type[BaseModel], ...] = (
     AutoSettings,
 )
 KNOWN = (
-    "C_l_alpha, C_psi, C_theta, I_x, I_y, K1, K2, K3, K_psi, K_theta, N, Omega, R, V, a, c, rho"
+    "C_l_alpha, C_psi, C_theta, I_x, I_y, K1, K2, K2_psi, K2_theta, K3, K3_psi, K3_theta, "
+    "K_psi, K_theta, N, Omega, R, V, a, c, rho"
 )
 
 
@@ -68,18 +69,18 @@ def test_smoke_study_loads_with_defaults():
     study = validate_text(SMOKE, "smoke.yaml")
     assert (study.name, study.description, study.model) == ("smoke-linear-case2", "", "classical")
     assert study.parameters == {"K_psi": 0.3}
-    assert study.nonlinearity == Linear(type="linear", dof="theta")
+    assert study.nonlinearity == (Linear(type="linear", dof="theta"),)  # one law: a list of one
     assert study.linear is None
     assert study.plots == ("bifurcation",)
     assert study.auto == AutoSettings()
     assert study.auto.max_steps is None and study.auto.timeout is None
     (run,) = study.continuations
     assert run == OneParameterContinuation(
-        name="ktheta", type="one-parameter", parameter="K1", start=0.5, range=(-0.3, 0.5)
+        name="ktheta", type="one-parameter", parameter="K_theta", start=0.5, range=(-0.3, 0.5)
     )
     assert (run.periodic, run.branch_points) == (False, True)
-    assert study.parameter_values() == {"K_psi": 0.3, "K2": 0.0, "K3": 0.0}
-    assert study.variant().name == "classical_poly_theta"
+    assert study.parameter_values() == {"K_psi": 0.3, "K2_theta": 0.0, "K3_theta": 0.0}
+    assert study.variant().name == "classical_poly"
     assert study.source == SMOKE
     assert study.sha256 == hashlib.sha256(SMOKE.encode()).hexdigest()
     assert study.path == "smoke.yaml"
@@ -123,31 +124,37 @@ def test_canonical_names_and_filled_starts():
         "plots: [bifurcation, linear]\n"
     )
     assert study.parameters == {"K_theta": 0.3, "V": 5.0}  # keys as written
-    assert study.nonlinearity == Polynomial(type="polynomial", dof="theta", K2=-10.0, K3=350.0)
+    assert study.nonlinearity == (
+        Polynomial(type="polynomial", dof="theta", K2=-10.0, K3=350.0),)
     assert [(c.parameter, c.start) for c in study.continuations] == [
-        ("K1", 0.3),  # the override, by its alias
+        ("K_theta", 0.3),  # the override
         ("V", 5.0),
-        ("K3", 350.0),  # from the nonlinearity
+        ("K3_theta", 350.0),  # from the nonlinearity, by its thesis name K3
         ("K_psi", 0.4),  # the model's datum
     ]
     assert study.continuations[1].periodic is True
     assert study.linear.sweeps == (
-        LinearSweepSpec(parameter="K1", range=(0.0, 1.0), points=201),
+        LinearSweepSpec(parameter="K_theta", range=(0.0, 1.0), points=201),
         LinearSweepSpec(parameter="V", range=(0.0, 10.0), points=11),
     )
     assert study.plots == ("bifurcation", "linear")
-    assert study.parameter_values() == {"K1": 0.3, "V": 5.0, "K2": -10.0, "K3": 350.0}
+    assert study.parameter_values() == {"K_theta": 0.3, "V": 5.0, "K2_theta": -10.0,
+                                        "K3_theta": 350.0}
 
 
-def test_dof_psi_makes_K_psi_the_alias_of_K1():
+def test_dof_psi_makes_K1_the_alias_of_K_psi():
+    """With one law, K1, K2, K3 (the thesis' names) are its dof's stiffness and coefficients;
+    what leaves the study is named by dof."""
     study = validate_text(
-        HEAD + "parameters: {K_theta: 0.5, K_psi: 0.2}\nnonlinearity: {type: linear, dof: psi}\n"
-        "continuations: [{name: k, type: one-parameter, parameter: K_psi, range: [0, 1]}]\n"
+        HEAD + "parameters: {K_theta: 0.5, K1: 0.2}\nnonlinearity: {type: polynomial, dof: psi, "
+        "K2: 3}\ncontinuations: [{name: k, type: one-parameter, parameter: K1, range: [0, 1]},"
+        " {name: c, type: one-parameter, parameter: K2, range: [0, 4]}]\n"
     )
-    assert study.variant().name == "classical_poly_psi"
-    assert study.continuations[0].parameter == "K1"
-    assert study.continuations[0].start == 0.2
-    assert study.parameter_values() == {"K_theta": 0.5, "K1": 0.2, "K2": 0.0, "K3": 0.0}
+    assert study.variant().name == "classical_poly"  # one program for laws on either dof
+    assert [(c.parameter, c.start) for c in study.continuations] == [("K_psi", 0.2),
+                                                                     ("K2_psi", 3.0)]
+    assert study.parameter_values() == {"K_theta": 0.5, "K_psi": 0.2, "K2_psi": 3.0,
+                                        "K3_psi": 0.0}
 
 
 def test_start_value_fills_a_start_left_unset():
@@ -195,7 +202,7 @@ def test_nulls_mean_unset_where_a_key_is_optional():
     study = validate_text(HEAD + "linear: null\nnonlinearity: {type: linear, dof: ~}\n"
                           "auto: {timeout: null}\n")
     assert study.linear is None
-    assert study.nonlinearity.dof == "theta"
+    assert study.nonlinearity[0].dof == "theta"
     assert study.auto.timeout is None
 
 
@@ -205,8 +212,8 @@ def test_model_validate_fills_the_same_defaults():
          "continuations": [{"name": "k", "type": "one-parameter", "parameter": "K_theta",
                             "range": [0, 1]}]}
     )
-    assert study.nonlinearity.dof == "theta"
-    assert study.continuations[0].parameter == "K1"
+    assert study.nonlinearity[0].dof == "theta"
+    assert study.continuations[0].parameter == "K_theta"
     assert study.continuations[0].start == 0.4
 
 
@@ -231,7 +238,8 @@ def test_model_validate_fills_the_same_defaults():
         ("description: null\n", "s.yaml:3: description: expected a string, got null"),
         ("parameters: [V]\n", "s.yaml:3: parameters: expected a mapping, got a list"),
         ("auto: 5\n", "s.yaml:3: auto: expected a mapping, got 5"),
-        ("nonlinearity: linear\n", "s.yaml:3: nonlinearity: expected a mapping, got 'linear'"),
+        ("nonlinearity: linear\n", "s.yaml:3: nonlinearity: expected a mapping (one law) or a "
+         "list of mappings (one law per dof), got 'linear'"),
         ("continuations: {a: 1}\n", "s.yaml:3: continuations: expected a list, got a mapping"),
         ("continuations: [5]\n", "s.yaml:3: continuations[0]: expected a mapping, got 5"),
         ("plots: bifurcation\n", "s.yaml:3: plots: expected a list, got 'bifurcation'"),
@@ -276,11 +284,11 @@ def test_model_validate_fills_the_same_defaults():
         ),
         (
             "parameters: {K2: 1}\n",
-            "s.yaml:3: parameters.K2: set K2 under nonlinearity (type: polynomial)",
+            "s.yaml:3: parameters.K2: set K2 under nonlinearity (type: polynomial, dof: theta)",
         ),
         (
             "parameters:\n  V: 3\n  K3: 1\n",
-            "s.yaml:5: parameters.K3: set K3 under nonlinearity (type: polynomial)",
+            "s.yaml:5: parameters.K3: set K3 under nonlinearity (type: polynomial, dof: theta)",
         ),
         (
             "linear:\n  sweeps:\n    - {parameter: V, range: [0, 10]}\n"
@@ -436,7 +444,7 @@ def test_study_name_reasons():
 
 def test_model_reasons():
     assert problems("name: s\nmodel: foo\n") == [
-        "s.yaml:2: model: unknown model 'foo' (known: classical)"
+        "s.yaml:2: model: unknown model 'foo' (known: classical, oscillators)"
     ]
     assert problems("# a comment\n\nname: s\n") == ["s.yaml:3: model: required key is missing"]
 
@@ -473,7 +481,7 @@ def test_problems_on_one_line_are_sorted_by_path():
 
 def test_the_file_name_is_the_one_given():
     assert problems("name: s\nmodel: foo\n", "studies/x.yaml") == [
-        "studies/x.yaml:2: model: unknown model 'foo' (known: classical)"
+        "studies/x.yaml:2: model: unknown model 'foo' (known: classical, oscillators)"
     ]
 
 
@@ -586,7 +594,8 @@ def test_huge_file(tmp_path):
 def test_file_problems_use_the_base_name(tmp_path):
     path = tmp_path / "bad.yaml"
     path.write_text("name: s\nmodel: foo\n")
-    assert load_problems(path) == ["bad.yaml:2: model: unknown model 'foo' (known: classical)"]
+    assert load_problems(path) == [
+        "bad.yaml:2: model: unknown model 'foo' (known: classical, oscillators)"]
 
 
 # --------------------------------------------------------------------------- no tracebacks
@@ -634,8 +643,8 @@ def test_schema_reference_lists_every_key_with_a_description():
     assert lines[0] == "| Key | Type | Default | Description |"
     rows = {line.split("|")[1].strip().strip("`"): line for line in lines[2:]}
     expected = {"name", "description", "model", "parameters", "nonlinearity", "continuations",
-                "linear", "plots", "cross_check", "auto", "nonlinearity.type", "nonlinearity.dof",
-                "nonlinearity.K2", "nonlinearity.K3", "linear.sweeps",
+                "linear", "plots", "cross_check", "auto", "nonlinearity[].type",
+                "nonlinearity[].dof", "nonlinearity[].K2", "nonlinearity[].K3", "linear.sweeps",
                 "linear.sweeps[].parameter", "linear.sweeps[].range", "linear.sweeps[].points",
                 "linear.grid", "linear.grid.x", "linear.grid.y"}
     expected |= {f"linear.grid.{axis}.{k}" for axis in "xy" for k in ("parameter", "range",
@@ -647,10 +656,10 @@ def test_schema_reference_lists_every_key_with_a_description():
     for line in lines[2:]:
         cells = [c.strip() for c in line.strip("|").split(" | ")]
         assert len(cells) == 4 and all(cells), line
-    assert "`linear` or `polynomial`" in rows["nonlinearity.type"]
+    assert "`linear` or `polynomial`" in rows["nonlinearity[].type"]
     assert "| required |" in rows["name"]
     assert "`201`" in rows["linear.sweeps[].points"]
-    assert "N m/rad^3" in rows["nonlinearity.K2"]
+    assert "N m/rad^3" in rows["nonlinearity[].K2"]
 
 
 def test_every_field_has_a_description():
@@ -675,13 +684,13 @@ HEAD = "name: s\nmodel: classical\n"
 def test_a_parameter_given_by_name_and_by_alias_is_refused():
     """Before, ``{K1: 0.1, K_theta: 0.4}`` was accepted and the last one won."""
     assert problems(HEAD + "parameters: {K1: 0.1, K_theta: 0.4}\n") == [
-        "s.yaml:3: parameters.K_theta: 'K_theta' and 'K1' are the same parameter ('K_theta' "
-        "is an alias of K1); give it once"]
+        "s.yaml:3: parameters.K_theta: 'K_theta' and 'K1' are the same parameter ('K1' "
+        "is an alias of K_theta); give it once"]
     pair = ("continuations:\n  - name: b\n    type: two-parameter\n    parameters: [K1, K_psi]\n"
             "    range: {K1: [-0.3, 0.5], K_psi: [0, 0.5], K_theta: [0, 1]}\n")
     assert problems(HEAD + pair) == [
         "s.yaml:7: continuations[0].range.K_theta: 'K_theta' and 'K1' are the same parameter "
-        "('K_theta' is an alias of K1); give it once"]
+        "('K1' is an alias of K_theta); give it once"]
 
 
 @pytest.mark.parametrize(("override", "reason"), [
@@ -702,7 +711,7 @@ def test_non_physical_parameters_are_refused(override, reason):
 
 def test_law_coefficients_have_bounds_too():
     assert problems(HEAD + "nonlinearity: {type: polynomial, K2: 1.0e+308}\n") == [
-        "s.yaml:3: nonlinearity.K2: K2 must be in [-1e+09, 1e+09] N m/rad^3, got 1e+308"]
+        "s.yaml:3: nonlinearity.K2: K2_theta must be in [-1e+09, 1e+09] N m/rad^3, got 1e+308"]
 
 
 def test_ranges_stay_within_the_bounds_and_whole_numbers_are_not_continued():

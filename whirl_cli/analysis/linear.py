@@ -59,12 +59,11 @@ def whirl_direction(model: Model, eigenvalues: np.ndarray, eigenvectors: np.ndar
                     ) -> np.ndarray:
     """"FW"/"BW"/"--" per eigenvalue: sense of the hub path relative to the spin (+x).
 
-    For a mode y = Re(v e^{i omega t}), the hub components Y, Z (from ``model.hub_plane``) trace
-    a path that turns about +x (with the spin, FW) when Im(conj(Y) Z) * omega < 0.
+    For a mode y = Re(v e^{i omega t}), the hub components Y, Z (``model.hub_matrix`` @ v)
+    trace a path that turns about +x (with the spin, FW) when Im(conj(Y) Z) * omega < 0.
     """
-    (iy, fy), (iz, fz) = model.hub_plane
-    hub_y = fy * eigenvectors[..., iy, :]
-    hub_z = fz * eigenvectors[..., iz, :]
+    hub = np.einsum("hi,...ik->...hk", model.hub_matrix, eigenvectors)
+    hub_y, hub_z = hub[..., 0, :], hub[..., 1, :]
     sense = np.imag(np.conj(hub_y) * hub_z) * np.sign(eigenvalues.imag)
     oscillatory = np.abs(eigenvalues.imag) > 1e-9 * np.maximum(np.abs(eigenvalues), 1.0)
     return np.where(~oscillatory, NON_OSCILLATORY, np.where(sense < 0, FORWARD, BACKWARD))

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..models.base import Model
+from ..models import Model
 
 
 def first_lyapunov_coefficient(jacobian: np.ndarray, second: np.ndarray,

@@ -50,9 +50,12 @@ def _parameters(model: Model, overrides: dict[str, float], names: tuple[str, ...
 
 def check_orbit(model: Model, overrides: dict[str, float], branch: Branch, orbit: Orbit,
                 periods: int = 10, tolerance: float = ORBIT_TOLERANCE) -> CrossCheck:
-    """Start on ``orbit`` and simulate ``periods`` periods; the max of the law's degree of
-    freedom over the last two periods must match AUTO's within ``tolerance``."""
-    dof = model.state_names.index(model.dof)
+    """Start on ``orbit`` and simulate ``periods`` periods; the max of the dof that moves most
+    (relative to its typical amplitude) over the last two periods must match AUTO's within
+    ``tolerance`` (relative to its half peak-to-peak amplitude)."""
+    dofs = len(model.dofs)
+    spans = np.ptp(orbit.states[:, :dofs], axis=0) / np.asarray(model.state_scale[:dofs])
+    dof = int(np.argmax(spans))
     params = _parameters(model, overrides, branch.parameter_names, orbit.parameters)
     time, states = integrate(model, params, orbit.states[0], periods * orbit.period,
                              samples=periods * 400)
@@ -61,7 +64,7 @@ def check_orbit(model: Model, overrides: dict[str, float], branch: Branch, orbit
     expected = float(branch.state_max[orbit.index, dof])
     error = abs(simulated - expected) / max(np.ptp(orbit.states[:, dof]) / 2, 1e-12)
     return CrossCheck(branch.name, orbit.index, "orbit", float(orbit.parameters[0]), expected,
-                      simulated, bool(error <= tolerance))
+                      simulated, bool(error <= tolerance), model.state_names[dof])
 
 
 def check_equilibrium(model: Model, overrides: dict[str, float], branch: Branch, index: int,
@@ -86,14 +89,16 @@ def check_equilibrium(model: Model, overrides: dict[str, float], branch: Branch,
     params = _parameters(model, overrides, branch.parameter_names, branch.parameters[index])
     eigenvalues, vectors = np.linalg.eig(model.jacobian_numpy(state, params))
     slowest = float(-eigenvalues.real.max())
-    angles = np.array([s.unit == "rad" for s in model.states])
-    deflection = np.abs(state[angles]).max()
+    # the dofs, in units of their typical amplitudes (rad for the classical model)
+    typical = np.asarray(model.state_scale, dtype=float)
+    angles = np.arange(model.n_states) < len(model.dofs)
+    deflection = np.abs(state / typical)[angles].max()
     if deflection > 0:  # stay within the basin (tiny next to a pitchfork) of the equilibrium
         perturbation = min(perturbation, 1e-3 * deflection)
-    start = state + perturbation * angles
+    start = state + perturbation * typical * angles
     duration = min(10.0 / max(slowest, 1e-3), 60.0)
     _, states = integrate(model, params, start, duration, samples=200)
-    final = float(np.abs(states[-1] - state)[angles].max())
+    final = float(np.abs((states[-1] - state) / typical)[angles].max())
     transient = 2.0 * float(np.linalg.cond(vectors)) * np.sqrt(angles.sum())
     floor = 1e-8  # rad: AUTO's Newton tolerance EPSU (whirl's default); LSODA adds far less
     allowed = min(transient * np.exp(-max(slowest, 0.0) * duration), 0.1) * perturbation + floor
@@ -205,8 +210,7 @@ def _spread(items: list, count: int) -> list:
 
 def whirl_sense(model: Model, states: np.ndarray) -> str:
     """"FW" or "BW": the sense in which the hub path of an orbit turns relative to the spin
-    (+x), from the signed area enclosed in the hub plane (``model.hub_plane``)."""
-    (iy, fy), (iz, fz) = model.hub_plane
-    hub_y, hub_z = fy * states[:, iy], fz * states[:, iz]
+    (+x), from the signed area enclosed in the hub plane (``model.hub_matrix``)."""
+    hub_y, hub_z = (states @ model.hub_matrix.T).T
     area = 0.5 * np.sum(hub_y * np.roll(hub_z, -1) - np.roll(hub_y, -1) * hub_z)
     return "FW" if area > 0 else "BW"

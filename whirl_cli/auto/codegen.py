@@ -3,38 +3,29 @@
 The generated ``.f90`` holds FUNC (right-hand side with the analytic Jacobians DFDU and DFDP),
 STPNT (datum parameters, start at the trivial equilibrium y = 0), PVLS (max and min of every
 state over the solution into spare PAR slots) and the required stubs BCND, ICND, FOPT. Output is
-deterministic: no dates, host names or library versions, only the model hash. The PAR slots are
-those of :func:`whirl_cli.auto.constants.par_layout`.
+deterministic: no dates, host names or library versions, only the variant key. The PAR slots
+are those of :func:`whirl_cli.auto.constants.par_layout`. sympy is imported only to generate a
+file (never to find a cached program: :func:`source_key` needs no symbolic work).
 """
 
 from __future__ import annotations
 
 import hashlib
 import math
+import re
 from pathlib import Path
-
-import sympy as sp
+from typing import TYPE_CHECKING
 
 from ..errors import CodegenError
 from ..models import Model
+from ..models.numeric import variant_key
 from .constants import AMPLITUDE, PERIOD_INDEX, par_layout
+
+if TYPE_CHECKING:
+    import sympy as sp
 
 _FCODE = dict(standard=2008, source_format="free", strict=True,
               user_functions={"asinh": "asinh"})
-
-
-def model_hash(model: Model) -> str:
-    """sha256 of everything that determines the generated files."""
-    text = "\n".join([model.name, sp.srepr(model.auto_rhs), repr(par_layout(model)),
-                      repr([(p.name, p.default) for p in model.parameters])])
-    return hashlib.sha256(text.encode()).hexdigest()
-
-
-def source_key(model: Model) -> str:
-    """Identifies :func:`fortran_source` output without generating it (the compile cache key):
-    the model hash plus the text of this generator."""
-    generator = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
-    return hashlib.sha256(f"{model_hash(model)}:{generator}".encode()).hexdigest()
 
 
 def fortran_number(value: float) -> str:
@@ -48,6 +39,8 @@ def fortran_number(value: float) -> str:
 def _assignments(targets: list[str], exprs: list[sp.Expr], temp_prefix: str
                  ) -> tuple[list[str], list[str]]:
     """Fortran lines computing ``targets = exprs`` through common subexpressions."""
+    import sympy as sp
+
     symbols = sp.numbered_symbols(temp_prefix)
     replacements, reduced = sp.cse(exprs, symbols=symbols, order="canonical")
     lines = [sp.fcode(e, assign_to=str(s), **_FCODE) for s, e in replacements]
@@ -62,37 +55,124 @@ def _declare(names: list[str]) -> list[str]:
     return out
 
 
-def fortran_source(model: Model) -> str:
-    """The complete AUTO-07p equations file for ``model`` (free-form Fortran 90)."""
-    layout = par_layout(model)
-    n = model.n_states
-    f = model.auto_rhs
-    states = model.state_symbols
-    params = model.parameter_symbols
-    jac_u = f.jacobian(states)
-    jac_p = f.jacobian(params)
+def source_key(model: Model) -> str:
+    """Identifies :func:`fortran_source` output without generating it (the compile cache key):
+    the variant's key (its declaration and the models package's code) plus this generator's
+    text. No sympy work: a run never builds the symbolic model."""
+    generator = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
+    return hashlib.sha256(f"{variant_key(model)}:{generator}".encode()).hexdigest()
 
-    f_temps, f_lines = _assignments([f"F({i + 1})" for i in range(n)], list(f), "w_f")
-    ju = [(i, j) for i in range(n) for j in range(n) if jac_u[i, j] != 0]
-    ju_temps, ju_lines = _assignments([f"DFDU({i + 1},{j + 1})" for i, j in ju],
-                                      [jac_u[i, j] for i, j in ju], "w_u")
-    jp = [(i, k) for k in range(len(params)) for i in range(n) if jac_p[i, k] != 0]
-    index = [layout.parameters[p.name] for p in model.parameters]
-    jp_temps, jp_lines = _assignments([f"DFDP({i + 1},{index[k]})" for i, k in jp],
-                                      [jac_p[i, k] for i, k in jp], "w_p")
+
+def _solve_lines(k: int, diagonal: bool, target: str, columns: str) -> list[str]:
+    """Fortran lines replacing ``target(1:k, 1:columns)`` by WM^-1 ``target`` in place: a
+    division by the diagonal where M is diagonal, else Gaussian elimination with partial
+    pivoting on a copy of WM (WL)."""
+    if diagonal:
+        return [f"  DO I = 1, {k}",
+                f"    {target}(I,1:{columns}) = {target}(I,1:{columns}) / WM(I,I)",
+                "  END DO"]
+    return [f"  CALL WHIRL_SOLVE({k}, WM, {target}, {columns})"]
+
+
+_SOLVER = """
+SUBROUTINE WHIRL_SOLVE(K, WM, B, NB)
+  ! B(1:K,1:NB) := WM^-1 B by Gaussian elimination with partial pivoting (WM is kept).
+  IMPLICIT NONE
+  INTEGER, INTENT(IN) :: K, NB
+  DOUBLE PRECISION, INTENT(IN) :: WM(K,K)
+  DOUBLE PRECISION, INTENT(INOUT) :: B(K,NB)
+  DOUBLE PRECISION :: A(K,K), ROW(K), BROW(NB), FACTOR
+  INTEGER :: I, J, P
+  A = WM
+  DO J = 1, K
+    P = J - 1 + MAXLOC(ABS(A(J:K,J)), 1)
+    IF (P /= J) THEN
+      ROW = A(J,:)
+      A(J,:) = A(P,:)
+      A(P,:) = ROW
+      BROW = B(J,:)
+      B(J,:) = B(P,:)
+      B(P,:) = BROW
+    END IF
+    DO I = J + 1, K
+      FACTOR = A(I,J) / A(J,J)
+      A(I,J:K) = A(I,J:K) - FACTOR * A(J,J:K)
+      B(I,:) = B(I,:) - FACTOR * B(J,:)
+    END DO
+  END DO
+  DO J = K, 1, -1
+    B(J,:) = (B(J,:) - MATMUL(A(J,J+1:K), B(J+1:K,:))) / A(J,J)
+  END DO
+END SUBROUTINE WHIRL_SOLVE
+"""
+
+
+def model_hash(model: Model) -> str:
+    """The variant's key (:func:`whirl_cli.models.numeric.variant_key`), printed in the file."""
+    return variant_key(model)
+
+
+def fortran_source(model: Model) -> str:
+    """The complete AUTO-07p equations file for ``model`` (free-form Fortran 90).
+
+    FUNC computes the physical state y = S U from AUTO's U, the forces R(y, p) of the mass
+    equation M v' = R and M itself, solves for the accelerations (a division where M is
+    diagonal, Gaussian elimination with partial pivoting otherwise: no mass matrix is inverted
+    symbolically) and returns F = f(y) / (S time_scale); DFDU and DFDP follow from dR/dy, dR/dp
+    and dM/dp the same way (M depends on the parameters only).
+    """
+    import sympy as sp
+
+    from ..models.symbolic import Symbolic
+
+    symbolic = Symbolic(model)
+    layout = par_layout(model)
+    k, n = len(symbolic.q), len(symbolic.states)
+    scale = [float(s) for s in model.state_scale]
+    rate = [fortran_number(1.0 / (scale[k + i] * model.time_scale)) for i in range(k)]
+    diagonal = symbolic.diagonal_mass
+
+    mass = [(i, j) for i in range(k) for j in range(k) if symbolic.mass[i, j] != 0]
+    m_temps, m_lines = _assignments([f"WM({i + 1},{j + 1})" for i, j in mass],
+                                    [symbolic.mass[i, j] for i, j in mass], "w_m")
+    f_temps, f_lines = _assignments([f"WA({i + 1},1)" for i in range(k)],
+                                    list(symbolic.residual), "w_f")
+    jac = symbolic.residual_jacobian
+    ju = [(i, j) for i in range(k) for j in range(n) if jac[i, j] != 0]
+    ju_temps, ju_lines = _assignments(
+        [f"WJ({i + 1},{j + 1})" for i, j in ju],
+        [jac[i, j] * sp.Rational(repr(scale[j])) for i, j in ju], "w_u")
+    slopes = dict(symbolic.mass_parameter_derivatives)
+    accelerations = [sp.Symbol(f"WA_{j + 1}") for j in range(k)]
+    jp: list[tuple[int, int]] = []
+    jp_exprs = []
+    for column, _ in enumerate(symbolic.parameters):
+        for i in range(k):
+            expr = symbolic.residual_parameter_jacobian[i, column]
+            if column in slopes:
+                expr -= sum(slopes[column][i, j] * accelerations[j] for j in range(k))
+            if expr != 0:
+                jp.append((i, column))
+                jp_exprs.append(expr)
+    used = sorted({column for _, column in jp})
+    position = {column: c + 1 for c, column in enumerate(used)}
+    jp_temps, jp_lines = _assignments([f"WP({i + 1},{position[c]})" for i, c in jp], jp_exprs,
+                                      "w_p")
+    jp_lines = [re.sub(r"\bWA_(\d+)\b", r"WA(\1,1)", line) for line in jp_lines]
+    n_p = max(len(used), 1)
 
     header = [
         "!" + "-" * 78,
         f"! whirl AUTO-07p equations: {model.name}",
         f"! {model.description}",
         "! Generated by `whirl generate` from the symbolic model; do not edit by hand.",
-        f"! model sha256: {model_hash(model)}",
+        f"! variant key: {model_hash(model)}",
         f"! Time is non-dimensional: tau = {model.time_scale:g} rad/s * t.",
         "! States (AUTO value -> SI value):",
     ]
-    for i, (s, scale) in enumerate(zip(model.states, model.state_scale, strict=True)):
+    for i, (s, factor) in enumerate(zip(model.states, scale, strict=True)):
         header.append(f"!   U({i + 1}) = {s.name}: {s.description} [{s.unit}] = "
-                      f"{scale:g} * U({i + 1})")
+                      f"{factor:g} * U({i + 1})")
     header.append("! Parameters:")
     for p in model.parameters:
         header.append(f"!   PAR({layout.parameters[p.name]}) = {p.name} [{p.unit}]: "
@@ -102,14 +182,20 @@ def fortran_source(model: Model) -> str:
                   "of each state over the solution (PVLS)")
     header.append(f"!   PAR({layout.amplitude}) = {AMPLITUDE}: largest half peak-to-peak value "
                   "of a state (PVLS)")
+    header.append(f"! M dv/dt = R(y, p): the accelerations M^-1 R are solved numerically "
+                  f"({'M diagonal' if diagonal else 'M full'}).")
     header.append("!" + "-" * 78)
     broken = [line for line in header if "\n" in line or "\r" in line]
     if broken:  # a line break would end the comment and start a Fortran statement
         raise CodegenError(f"model {model.name}: a line break in a description: {broken[0]!r}")
 
-    unpack = [f"  {s.name} = U({i + 1})" for i, s in enumerate(model.states)]
+    unpack = [f"  {s.name} = {fortran_number(factor)} * U({i + 1})"
+              for i, (s, factor) in enumerate(zip(model.states, scale, strict=True))]
     unpack += [f"  {p.name} = PAR({layout.parameters[p.name]})" for p in model.parameters]
     max_param_index = max(layout.parameters.values())
+
+    def indented(lines: list[str]) -> list[str]:
+        return ["  " + line for line in "\n".join(lines).splitlines()]
 
     body = [
         "",
@@ -120,20 +206,35 @@ def fortran_source(model: Model) -> str:
         "  DOUBLE PRECISION, INTENT(IN) :: U(NDIM), PAR(*)",
         "  DOUBLE PRECISION, INTENT(OUT) :: F(NDIM)",
         "  DOUBLE PRECISION, INTENT(INOUT) :: DFDU(NDIM,NDIM), DFDP(NDIM,*)",
+        f"  DOUBLE PRECISION :: WM({k},{k}), WA({k},1), WJ({k},{n}), WP({k},{n_p})",
+        "  INTEGER :: I",
         *_declare([s.name for s in model.states] + [p.name for p in model.parameters]),
-        *_declare(f_temps + ju_temps + jp_temps),
+        *_declare(m_temps + f_temps + ju_temps + jp_temps),
         "",
         *unpack,
         "",
-        *["  " + line for line in "\n".join(f_lines).splitlines()],
+        "  WM = 0d0",
+        *indented(m_lines),
+        *indented(f_lines),
+        *_solve_lines(k, diagonal, "WA", "1"),
+        *[f"  F({i + 1}) = U({k + i + 1})" for i in range(k)],
+        *[f"  F({k + i + 1}) = WA({i + 1},1) * {rate[i]}" for i in range(k)],
         "  IF (IJAC == 0) RETURN",
         "",
         "  DFDU(1:NDIM,1:NDIM) = 0d0",
-        *["  " + line for line in "\n".join(ju_lines).splitlines()],
+        *[f"  DFDU({i + 1},{k + i + 1}) = 1d0" for i in range(k)],
+        "  WJ = 0d0",
+        *indented(ju_lines),
+        *_solve_lines(k, diagonal, "WJ", str(n)),
+        *[f"  DFDU({k + i + 1},1:{n}) = WJ({i + 1},1:{n}) * {rate[i]}" for i in range(k)],
         "  IF (IJAC == 1) RETURN",
         "",
         f"  DFDP(1:NDIM,1:{max_param_index}) = 0d0",
-        *["  " + line for line in "\n".join(jp_lines).splitlines()],
+        "  WP = 0d0",
+        *indented(jp_lines),
+        *(_solve_lines(k, diagonal, "WP", str(len(used))) if used else []),
+        *[f"  DFDP({k + i + 1},{layout.parameters[model.parameters[c].name]}) = "
+          f"WP({i + 1},{position[c]}) * {rate[i]}" for c in used for i in range(k)],
         "END SUBROUTINE FUNC",
         "",
         "SUBROUTINE STPNT(NDIM,U,PAR,T)",
@@ -176,7 +277,8 @@ def fortran_source(model: Model) -> str:
         "",
         "SUBROUTINE FOPT",
         "END SUBROUTINE FOPT",
-        "",
     ]
+    if not diagonal:
+        body += _SOLVER.splitlines()
+    body.append("")
     return "\n".join(header + body)
-

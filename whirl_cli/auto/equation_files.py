@@ -27,10 +27,25 @@ def all_generated_files() -> dict[str, str]:
     return files
 
 
+def _stale(root: Path, files: dict[str, str]) -> list[Path]:
+    """Files under ``root`` that no shipped variant generates (e.g. of a removed variant)."""
+    if not root.is_dir():
+        return []
+    return sorted(p for p in root.rglob("*") if p.is_file()
+                  and p.relative_to(root).as_posix() not in files)
+
+
 def write_generated(root: Path) -> list[Path]:
-    """(Re)write ``auto_equations/`` under ``root``; returns the files that changed."""
+    """(Re)write ``auto_equations/`` under ``root`` (removing files no variant generates any
+    more); returns the files that changed."""
+    files = all_generated_files()
     changed = []
-    for rel, text in all_generated_files().items():
+    for path in _stale(root, files):
+        path.unlink()
+        changed.append(path)
+        if not any(path.parent.iterdir()):
+            path.parent.rmdir()
+    for rel, text in files.items():
         path = root / rel
         if not path.exists() or path.read_text() != text:
             path.parent.mkdir(parents=True, exist_ok=True)
@@ -40,7 +55,10 @@ def write_generated(root: Path) -> list[Path]:
 
 
 def drifted(root: Path) -> list[str]:
-    """Generated files under ``root`` that differ from what the models generate now."""
-    return [rel for rel, text in all_generated_files().items()
-            if not (root / rel).exists() or (root / rel).read_text() != text]
+    """Generated files under ``root`` that differ from what the models generate now, and
+    files there that no variant generates."""
+    files = all_generated_files()
+    return [rel for rel, text in files.items()
+            if not (root / rel).exists() or (root / rel).read_text() != text] + [
+        f"{p.relative_to(root).as_posix()} (no variant generates it)" for p in _stale(root, files)]
 

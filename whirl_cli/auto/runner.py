@@ -34,7 +34,7 @@ from functools import cache
 from pathlib import Path
 
 from ..errors import WhirlError
-from ..interrupts import Interrupted
+from ..interrupts import Interrupted, catching
 from .constants import constants_text
 
 #: stdout texts meaning AUTO did not do what was asked, although it exits 0 -> message shown.
@@ -69,27 +69,19 @@ def stop_all() -> None:
                 pass
 
 
-def _on_signal(signum: int, frame: object) -> None:
-    first = not _STOPPING.is_set()
-    stop_all()
-    if first:  # once: later signals must not interrupt the clean-up
-        raise Interrupted(signum)
-
-
 @contextmanager
 def interruptible() -> Iterator[None]:
     """While inside (main thread only): SIGINT and SIGTERM kill the AUTO runs and raise
-    :class:`Interrupted` (a KeyboardInterrupt) in the main thread."""
+    :class:`Interrupted` (a KeyboardInterrupt) in the main thread (:func:`whirl_cli.interrupts.
+    catching`, so an interrupt is never lost), and no new AUTO run starts."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     _STOPPING.clear()
-    previous = {s: signal.signal(s, _on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
-        yield
+        with catching(on_first=stop_all):
+            yield
     finally:
-        for number, handler in previous.items():
-            signal.signal(number, handler)
         _STOPPING.clear()
 
 

@@ -20,20 +20,13 @@ from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
+from ..cache import cache_dir
 from ..errors import ToolchainError
 
 AUTO_DIR = Path(os.environ.get("WHIRL_AUTO_DIR", "/usr/lib/auto-07p"))
 #: The flags of Debian's ``cmds/cmds.make`` (minus the build-path mapping).
 FFLAGS = ("-g", "-O2", "-fstack-protector-strong", "-fPIC", "-std=legacy", "-fopenmp")
 INSTALL_HINT = "install them with: sudo apt-get install auto-07p gfortran   (or: make setup)"
-
-
-def cache_dir() -> Path:
-    root = os.environ.get("WHIRL_CACHE_DIR")
-    if root:
-        return Path(root)
-    xdg = os.environ.get("XDG_CACHE_HOME")
-    return (Path(xdg) if xdg else Path.home() / ".cache") / "whirl"
 
 
 def runtime_objects() -> list[Path]:

@@ -21,11 +21,12 @@ MAX_SWITCH_DEPTH = 3
 
 
 def _stops(model: Model, parameter: str, bounds: tuple[float, float], amplitude: float) -> dict:
+    """UZSTOP: the range ends, and every dof at +/- ``amplitude`` (in the dof's unit; AUTO's
+    PVLS values are in units of the dof's typical amplitude)."""
     stops: dict = {parameter: [float(bounds[0]), float(bounds[1])]}
-    for state in model.states:
-        if state.unit == "rad":
-            stops[f"max_{state.name}"] = amplitude
-            stops[f"min_{state.name}"] = -amplitude
+    for dof in model.dofs:
+        stops[f"max_{dof.name}"] = amplitude / dof.amplitude
+        stops[f"min_{dof.name}"] = -amplitude / dof.amplitude
     return stops
 
 

@@ -31,6 +31,9 @@ ORBIT_EVERY = 20
 MAX_SEGMENTS = 24
 #: After MX, a family is restarted with a finer mesh and smaller steps at most this often.
 MAX_RETRIES = 2
+#: A family that came back onto its own Hopf point is computed again with this many times
+#: the mesh intervals.
+RETRACE_MESH_FACTOR = 2
 
 
 def periodic_constants(model: Model, numerics: Numerics, parameter: str,
@@ -84,16 +87,18 @@ def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
                        (parameter,), restart=(runs[hopf.branch], hopf.label))
         families.append(_Family(k, hopf, spec, []))
 
-    wave = [(family, family.spec) for family in families]
-    while wave:
-        outcomes = engine.run_many([spec for _, spec in wave])
-        following = []
-        for (family, spec), outcome in zip(wave, outcomes, strict=True):
-            family.pieces.append(_read(engine, spec, outcome))
-            step = _next_segment(family, model, hopfs, width)
-            if step is not None:
-                following.append((family, step))
-        wave = following
+    _continue(engine, families, hopfs, width)
+    # On too coarse a mesh AUTO can turn back along a family of long orbits and retrace it to
+    # its own Hopf point (combined case 5 at 40 mesh intervals): such families are computed
+    # once more on a finer mesh, kept if they then do not come back
+    again = [_Family(f.index, f.hopf, replace(
+        f.spec, name=f"{name}/periodic_{f.index}m.0",
+        constants=dict(f.spec.constants, NTST=RETRACE_MESH_FACTOR * f.spec.constants["NTST"])),
+        []) for f in families if _back_at_own_hopf(f, hopfs, width, scale)]
+    _continue(engine, again, hopfs, width)
+    for family in again:
+        if not _back_at_own_hopf(family, hopfs, width, scale):
+            families[family.index - 1] = family
 
     kept: list[Branch] = []
     found: list[SpecialPoint] = []
@@ -125,6 +130,29 @@ def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
             parameters), strict=True):
         found[row] = point
     return kept, found
+
+
+def _continue(engine: Engine, families: list[_Family], hopfs: list[SpecialPoint],
+              width: float) -> None:
+    """Run every family's segments, wave by wave (a wave's runs in parallel)."""
+    wave = [(family, family.spec) for family in families]
+    while wave:
+        outcomes = engine.run_many([spec for _, spec in wave])
+        following = []
+        for (family, spec), outcome in zip(wave, outcomes, strict=True):
+            family.pieces.append(_read(engine, spec, outcome))
+            step = _next_segment(family, engine.model, hopfs, width)
+            if step is not None:
+                following.append((family, step))
+        wave = following
+
+
+def _back_at_own_hopf(family: _Family, hopfs: list[SpecialPoint], width: float,
+                      scale: np.ndarray) -> bool:
+    """True if the family, grown, has come back onto the Hopf point it started from."""
+    whole = _assemble(family, hopfs, width, scale)
+    return len(whole) > 3 and _hopf_at(whole, len(whole) - 1, hopfs, width,
+                                       scale) == family.index - 1
 
 
 def _assemble(family: _Family, hopfs: list[SpecialPoint], width: float,
@@ -251,9 +279,9 @@ def _periodic_end(family: Branch, model: Model, hopfs: list[SpecialPoint],
         return "period cap", None
     if min(abs(value - bounds[0]), abs(value - bounds[1])) < 1e-6 * width:
         return "range", None
-    angles = [i for i, s in enumerate(model.states) if s.unit == "rad"]
-    reach = np.abs(np.concatenate([family.state_max[-1, angles],
-                                   family.state_min[-1, angles]])).max()
+    dofs = list(range(len(model.dofs)))
+    reach = np.abs(np.concatenate([family.state_max[-1, dofs],
+                                   family.state_min[-1, dofs]])).max()
     if reach >= 0.999 * numerics.max_amplitude:
         return "amplitude bound", None
     if len(state.pieces) >= MAX_SEGMENTS:

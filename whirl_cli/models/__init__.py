@@ -1,40 +1,47 @@
-"""Model registry: every model variant whirl can build, generate and run.
+"""Models: each defined once, as data, from which everything downstream is generated.
 
-A variant is a model family with one stiffness law on one degree of freedom. Variants are built
-lazily and cached, because building means sympy work.
+Modules, lowest first:
+
+* :mod:`~whirl_cli.models.declaration` -- what a model family declares: degrees of freedom,
+  parameters with bounds, its equations (M q'' = G - S); no sympy;
+* :mod:`~whirl_cli.models.laws` -- structural stiffness laws on a dof (polynomial);
+* :mod:`~whirl_cli.models.classical`, :mod:`~whirl_cli.models.oscillators` -- the families;
+* :mod:`~whirl_cli.models.variant` -- a family with a law on each dof, as whirl runs it
+  (names, scales, numeric functions);
+* :mod:`~whirl_cli.models.symbolic` -- a variant's sympy equations (code generation only);
+* :mod:`~whirl_cli.models.numeric` -- the numeric module generated from them, cached.
+
+:func:`get_model` builds variants (cheap: no sympy); :data:`SHIPPED` lists the variants the
+shipped studies use, whose AUTO files are committed under ``auto_equations/``.
 """
 
 from __future__ import annotations
 
 from functools import cache
 
-from . import classical
-from .base import Model, Parameter, State
-from .nonlinearities import LAWS
+from . import classical, oscillators
+from .declaration import Bounds, Dof, Family, Parameter, State
+from .laws import LAWS
+from .variant import Model
 
-__all__ = ["Model", "Parameter", "State", "FAMILIES", "get_model", "all_variants", "LAWS"]
+__all__ = ["Bounds", "Dof", "Family", "Model", "Parameter", "State", "FAMILIES", "LAWS",
+           "SHIPPED", "get_model", "all_variants"]
 
-#: family name -> (module with build(law, dof), degrees of freedom a law may act on, default dof)
-FAMILIES = {
-    "classical": (classical, tuple(classical.DOFS), "theta"),
-}
+#: Model families by the name a study gives as ``model``.
+FAMILIES: dict[str, Family] = {f.name: f for f in (classical.FAMILY, oscillators.FAMILY)}
+
+#: The variants the shipped studies use: (family, law per dof).
+SHIPPED: tuple[tuple[str, tuple[str, ...]], ...] = (("classical", ("polynomial", "polynomial")),)
 
 
 @cache
-def get_model(family: str, law: str = "polynomial", dof: str | None = None) -> Model:
-    """The variant of ``family`` with stiffness ``law`` on ``dof`` (default: the family's)."""
-    module, dofs, default_dof = FAMILIES[family]
-    dof = dof or default_dof
-    if dof not in dofs:
-        raise KeyError(f"model {family!r} has no degree of freedom {dof!r}")
-    return module.build(LAWS[law], dof)
+def get_model(family: str, laws: tuple[str, ...] | None = None) -> Model:
+    """The variant of ``family`` with ``laws[i]`` on its i-th dof (default: the polynomial law
+    on every dof, which with zero coefficients is the linear model)."""
+    declared = FAMILIES[family]
+    return Model(declared, tuple(laws) if laws else ("polynomial",) * len(declared.dofs))
 
 
 def all_variants() -> list[Model]:
-    """Every registered variant, in a fixed order (the contents of ``auto_equations/``)."""
-    return [
-        get_model(family, law, dof)
-        for family, (_, dofs, _) in FAMILIES.items()
-        for law in LAWS
-        for dof in dofs
-    ]
+    """The shipped variants, in a fixed order (the contents of ``auto_equations/``)."""
+    return [get_model(family, laws) for family, laws in SHIPPED]

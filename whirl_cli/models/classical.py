@@ -7,12 +7,12 @@ the equations; an independent quasi-steady strip-theory derivation for every coe
 Datum parameters: Reed's 1965 tabletop model (thesis Table 3.1), with C_l_alpha = 2 pi (the
 table's "2" gives an onset of 14.9 m/s instead of 7.8) and rho = 1.225 kg/m^3 (not printed).
 
-Equations (thesis/Riso sign convention), state y = [theta, psi, theta_dot, psi_dot]::
+Equations (thesis/Riso sign convention), dofs q = [theta, psi], M = diag(I_y, I_y)::
 
-    I_y theta'' = -M_theta(theta) + k_d theta - k_c psi - (C_theta + c_a) theta' + I_x Omega psi'
-    I_y psi''   =  k_c theta - M_psi(psi) + k_d psi - I_x Omega theta' - (C_psi + c_a) psi'
+    I_y theta'' = -S_theta + k_d theta - k_c psi - (C_theta + c_a) theta' + I_x Omega psi'
+    I_y psi''   = -S_psi + k_c theta + k_d psi - I_x Omega theta' - (C_psi + c_a) psi'
 
-    M_theta = K_theta theta, M_psi = K_psi psi unless a stiffness law replaces one of them;
+    S_theta = K_theta theta, S_psi = K_psi psi, or the stiffness law's restoring moment;
     k_d = Q a A'_1 (direct aerodynamic stiffness), k_c = Q A'_2 (cross aerodynamic stiffness),
     c_a = Q (A_3 + a^2 A_1) / Omega (aerodynamic damping), Q = N rho C_l_alpha R^5 Omega^2 / 4,
     mu = V / (Omega R) and, with c/R constant,
@@ -33,30 +33,20 @@ from __future__ import annotations
 
 import math
 
-import sympy as sp
-
-from .base import NON_NEGATIVE, POSITIVE, Bounds, Model, Parameter, State
-from .nonlinearities import StiffnessLaw
+from .declaration import NON_NEGATIVE, POSITIVE, Bounds, Dof, Family, Parameter
 
 #: AUTO's time: tau = TIME_SCALE * t, with the datum rotor speed (the BW mode is ~34 rad/s).
 TIME_SCALE = 40.0
 
-STATES = (
-    State("theta", "rad", "nacelle pitch about the pivot"),
-    State("psi", "rad", "nacelle yaw about the pivot"),
-    State("dtheta", "rad/s", "pitch rate"),
-    State("dpsi", "rad/s", "yaw rate"),
+DOFS = (
+    Dof("theta", "dtheta", "rad", "nacelle pitch about the pivot", amplitude=1.0,
+        stiffness="K_theta"),
+    Dof("psi", "dpsi", "rad", "nacelle yaw about the pivot", amplitude=1.0, stiffness="K_psi"),
 )
 
-#: Degrees of freedom a stiffness law may act on, and the name of their linear stiffness.
-DOFS = {"theta": "K_theta", "psi": "K_psi"}
-
-_STIFFNESS = {
-    "K_theta": Parameter("K_theta", 0.4, "N m/rad", "pitch spring stiffness"),
-    "K_psi": Parameter("K_psi", 0.4, "N m/rad", "yaw spring stiffness"),
-}
-#: Parameters after the stiffness ones, in PAR order (the first nine PAR slots are 1..9).
-_OTHER = (
+PARAMETERS = (
+    Parameter("K_theta", 0.4, "N m/rad", "pitch spring stiffness"),
+    Parameter("K_psi", 0.4, "N m/rad", "yaw spring stiffness"),
     Parameter("V", 6.7, "m/s", "free-stream airspeed", bounds=NON_NEGATIVE),
     Parameter("C_theta", 0.001, "N m s/rad", "pitch viscous damping", bounds=NON_NEGATIVE),
     Parameter("C_psi", 0.001, "N m s/rad", "yaw viscous damping", bounds=NON_NEGATIVE),
@@ -80,60 +70,49 @@ NOTES = (
 )
 
 
-def aerodynamic_coefficients(sym: dict[str, sp.Symbol]) -> tuple[sp.Expr, sp.Expr, sp.Expr]:
-    """(k_d, k_c, c_a): direct and cross aerodynamic stiffness [N m/rad], damping [N m s/rad]."""
-    V, Omega, R, c = sym["V"], sym["Omega"], sym["R"], sym["c"]
+def aerodynamic_coefficients(p: dict):
+    """(k_d, k_c, c_a): direct and cross aerodynamic stiffness [N m/rad], damping [N m s/rad],
+    as sympy expressions of the parameter symbols ``p`` (by name)."""
+    import sympy as sp
+
+    V, Omega, R, c = p["V"], p["Omega"], p["R"], p["c"]
     mu = sp.sqrt((V / (Omega * R)) ** 2 + sp.Float(1e-16))
     ash = sp.asinh(1 / mu)
     root = sp.sqrt(1 + mu**2)
     a1 = (c / R) * mu**2 * ash
     a2 = (c / R) * (mu / 2) * (root - mu**2 * ash)
     a3 = (c / R) * ((2 - 3 * mu**2) * root + 3 * mu**4 * ash) / 8
-    q = sym["N"] * sym["rho"] * sym["C_l_alpha"] * R**5 * Omega**2 / 4
-    k_d = q * sym["a"] * mu * a1
+    q = p["N"] * p["rho"] * p["C_l_alpha"] * R**5 * Omega**2 / 4
+    k_d = q * p["a"] * mu * a1
     k_c = q * mu * a2
-    c_a = q * (a3 + sym["a"] ** 2 * a1) / Omega
+    c_a = q * (a3 + p["a"] ** 2 * a1) / Omega
     return k_d, k_c, c_a
 
 
-def build(law: StiffnessLaw, dof: str) -> Model:
-    """The classical model with ``law`` replacing the linear spring of ``dof``."""
-    if dof not in DOFS:
-        raise ValueError(f"classical model has no degree of freedom {dof!r}")
-    replaced = _STIFFNESS[DOFS[dof]]
-    state = {s.name: sp.Symbol(s.name, real=True) for s in STATES}
-    moment, law_params = law.build(state[dof], replaced)
-    kept = tuple(p for name, p in _STIFFNESS.items() if name != replaced.name)
-    parameters = law_params + kept + _OTHER
-    sym = {p.name: sp.Symbol(p.name, real=True) for p in parameters}
+def equations(q: dict, v: dict, p: dict):
+    """(M, G) of the classical model (see the module doc)."""
+    import sympy as sp
 
-    moments = {
-        d: moment if d == dof else sym[DOFS[d]] * state[d] for d in DOFS
-    }
-    k_d, k_c, c_a = aerodynamic_coefficients(sym)
-    theta, psi, dtheta, dpsi = (state[s.name] for s in STATES)
-    gyro = sym["I_x"] * sym["Omega"]
-    rhs = sp.Matrix(
-        [
-            dtheta,
-            dpsi,
-            (-moments["theta"] + k_d * theta - k_c * psi - (sym["C_theta"] + c_a) * dtheta
-             + gyro * dpsi) / sym["I_y"],
-            (k_c * theta - moments["psi"] + k_d * psi - gyro * dtheta
-             - (sym["C_psi"] + c_a) * dpsi) / sym["I_y"],
-        ]
-    )
-    return Model(
-        name=f"classical_{law.name[:4]}_{dof}",
-        family="classical",
-        law=law.name,
-        dof=dof,
-        description=f"Reed/Bielawa pitch-yaw rotor-nacelle, {law.name} stiffness on {dof}",
-        states=STATES,
-        parameters=parameters,
-        rhs=rhs,
-        time_scale=TIME_SCALE,
-        state_scale=(1.0, 1.0, TIME_SCALE, TIME_SCALE),
-        notes=NOTES,
-        hub_plane=((1, -1.0), (0, -1.0)),  # (y, z) = (-a R psi, -a R theta)
-    )
+    k_d, k_c, c_a = aerodynamic_coefficients(p)
+    theta, psi, dtheta, dpsi = q["theta"], q["psi"], v["theta"], v["psi"]
+    gyro = p["I_x"] * p["Omega"]
+    mass = sp.diag(p["I_y"], p["I_y"])
+    forces = sp.Matrix([
+        k_d * theta - k_c * psi - (p["C_theta"] + c_a) * dtheta + gyro * dpsi,
+        k_c * theta + k_d * psi - gyro * dtheta - (p["C_psi"] + c_a) * dpsi,
+    ])
+    return mass, forces
+
+
+FAMILY = Family(
+    name="classical",
+    description="Reed/Bielawa pitch-yaw rotor-nacelle (thesis chapter 3)",
+    dofs=DOFS,
+    parameters=PARAMETERS,
+    equations=equations,
+    time_scale=TIME_SCALE,
+    hub=(((1, -1.0),), ((0, -1.0),)),  # (y, z) = (-a R psi, -a R theta), up to the factor a R
+    symmetric=True,
+    linear=True,
+    notes=NOTES,
+)

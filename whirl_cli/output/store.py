@@ -22,7 +22,7 @@ Layout (units in a ``units`` attribute on every physical dataset)::
                                     lyapunov (first Lyapunov coefficient of Hopf points)
         cross_checks/               (study `cross_check: true`) columns: branch, index, kind
                                     (orbit | equilibrium), parameter, expected, simulated,
-                                    passed
+                                    passed, state (the dof an orbit check compares)
     /linear/sweeps/<parameter>/     values, eigenvalues [1/s], damping_ratio, frequency [rad/s],
                                     whirl (FW | BW | --)
     /linear/grid/                   x, y, max_real (Ny, Nx) [1/s], oscillatory (Ny, Nx),
@@ -151,6 +151,7 @@ def _write_cross_checks(group: h5py.Group, checks: tuple[CrossCheck, ...]) -> No
     for key in ("parameter", "expected", "simulated"):
         group.create_dataset(key, data=np.array([getattr(c, key) for c in checks], dtype=float))
     group.create_dataset("passed", data=np.array([c.passed for c in checks], dtype=bool))
+    group.create_dataset("state", data=_strings(c.state for c in checks), dtype=_STR)
 
 
 def _read_cross_checks(group: h5py.Group) -> tuple[CrossCheck, ...]:
@@ -159,7 +160,8 @@ def _read_cross_checks(group: h5py.Group) -> tuple[CrossCheck, ...]:
         CrossCheck(_text(columns["branch"][k]), int(columns["index"][k]),
                    _text(columns["kind"][k]), float(columns["parameter"][k]),
                    float(columns["expected"][k]), float(columns["simulated"][k]),
-                   bool(columns["passed"][k]))
+                   bool(columns["passed"][k]),
+                   _text(columns["state"][k]) if "state" in columns else "")
         for k in range(len(columns["index"])))
 
 

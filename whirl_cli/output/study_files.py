@@ -21,14 +21,12 @@
 
 from __future__ import annotations
 
-import signal
-import threading
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 from ..errors import OutputError
+from ..interrupts import held_signals
 from ..results import StudyResult
 from . import atomic, store
 
@@ -121,26 +119,3 @@ def missing_plots(output: Path, kinds: Sequence[str]) -> list[str]:
 
         names = tuple(plot_names(store.read(output), tuple(kinds), Path(output).stem))
     return [name for name in names if not (Path(output).parent / name).exists()]
-
-
-@contextmanager
-def held_signals() -> Iterator[None]:
-    """SIGINT and SIGTERM are held back while inside (main thread only; elsewhere a no-op):
-    one that arrives is recorded, and raised again on leaving, so that the handler that was
-    in place (Python's KeyboardInterrupt, :func:`whirl_cli.auto.runner.interruptible`'s, or the
-    default action) deals with it then. (Blocking the signals would not do: the kernel hands
-    a process-directed signal to any thread that does not block it.)"""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    arrived: list[int] = []
-    held = (signal.SIGINT, signal.SIGTERM)
-    previous = {number: signal.signal(number, lambda signum, _frame: arrived.append(signum))
-                for number in held}
-    try:
-        yield
-    finally:
-        for number, handler in previous.items():
-            signal.signal(number, handler)
-        for number in dict.fromkeys(arrived):
-            signal.raise_signal(number)

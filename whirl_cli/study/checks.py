@@ -1,8 +1,10 @@
 """Meaning checks of a study against its model variant, on the raw data.
 
-They add to the structural problems (malformed parts are left to those): parameter names known
-to the variant, ``K2``/``K3`` only under ``nonlinearity``, ``dof`` a degree of freedom of the
-model, a parameter given once, values and ranges inside the physical bounds, unique
+They add to the structural problems (malformed parts are left to those): parameter names the
+study may use (:class:`~whirl_cli.study.resolve.Names`), law coefficients only under
+``nonlinearity``, each law on a dof of the model and each dof with at most one law (every law
+of a list naming its dof), a parameter given once, values and ranges inside the physical
+bounds, unique
 continuation names, ``start``, ``slices`` and ``orbits_at`` inside ``range``.
 """
 
@@ -11,9 +13,17 @@ from __future__ import annotations
 from collections.abc import Iterator
 from typing import Any
 
-from ..models import FAMILIES, Model
-from .messages import _choice_reason
-from .resolve import _LAW_PARAMETERS, _finite, _study_values, _variant_of
+from ..models import FAMILIES
+from .messages import _choice_reason, _dotted
+from .resolve import (
+    Names,
+    _finite,
+    _is_single,
+    _names_of_data,
+    _study_values,
+    block_dof,
+    law_blocks,
+)
 from .source import Loc, Problem
 
 
@@ -22,41 +32,71 @@ def _meaning_problems(data: dict) -> list[Problem]:
     family = data.get("model")
     if not isinstance(family, str) or family not in FAMILIES:
         return []
-    block = data.get("nonlinearity")
-    dof = block.get("dof") if isinstance(block, dict) else None
-    dofs = FAMILIES[family][1]
-    if isinstance(dof, str) and dof not in dofs:
-        return [(("nonlinearity", "dof"), _choice_reason(dofs, repr(dof)))]
-    variant = _variant_of(data)
-    if variant is None:
+    problems = _law_problems(data, family)
+    if problems:
+        return problems
+    names = _names_of_data(data)
+    if names is None:
         return []
-    values = _study_values(data, variant)
-    problems = _override_problems(data.get("parameters"), variant, family)
-    for name in _LAW_PARAMETERS if isinstance(block, dict) else ():
-        if name in block:
-            problems += _bound_problems(("nonlinearity", name), name, block[name], variant)
+    values = _study_values(data, names)
+    problems = _override_problems(data.get("parameters"), names, family)
+    for loc, block in law_blocks(data):
+        if not isinstance(block, dict):
+            continue
+        dof = block_dof(block, family, _is_single(data))
+        for key, name in names.model.coefficient_names(dof).items():
+            if key in block:
+                problems += _bound_problems(loc + (key,), name, block[key], names)
     items = data.get("continuations")
-    problems += _continuation_problems(items, variant, family, values)
+    problems += _continuation_problems(items, names, family, values)
     linear = data.get("linear")
     sweeps = linear.get("sweeps") if isinstance(linear, dict) else None
     for i, sweep in _dict_items(sweeps):
-        problems += _sweep_problems(("linear", "sweeps", i), sweep, variant, family)
+        problems += _sweep_problems(("linear", "sweeps", i), sweep, names, family)
     grid = linear.get("grid") if isinstance(linear, dict) else None
     for axis in ("x", "y"):
         spec = grid.get(axis) if isinstance(grid, dict) else None
         if isinstance(spec, dict):
-            problems += _sweep_problems(("linear", "grid", axis), spec, variant, family)
+            problems += _sweep_problems(("linear", "grid", axis), spec, names, family)
     return problems
 
 
-def _sweep_problems(loc: Loc, spec: dict, variant: Model, family: str) -> list[Problem]:
+def _law_problems(data: dict, family: str) -> list[Problem]:
+    """Each law on a dof of the model, each dof with at most one law, and a dof named by every
+    law of a list."""
+    dofs = FAMILIES[family].dof_names
+    single = _is_single(data)
+    problems: list[Problem] = []
+    seen: dict[str, tuple] = {}
+    for loc, block in law_blocks(data):
+        if not isinstance(block, dict):
+            continue
+        dof = block_dof(block, family, single)
+        if dof is None:
+            if block.get("type") is not None:
+                problems.append((loc + ("dof",), "required in a list of laws (each law names "
+                                 f"its dof: {', '.join(dofs)})"))
+            continue
+        if not isinstance(dof, str):
+            continue  # a structural problem
+        if dof not in dofs:
+            problems.append((loc + ("dof",), _choice_reason(dofs, repr(dof))))
+        elif dof in seen:
+            problems.append((loc + ("dof",), f"a second law on {dof} (the first is at "
+                             f"{_dotted(seen[dof])}); a dof takes at most one law"))
+        else:
+            seen[dof] = loc
+    return problems
+
+
+def _sweep_problems(loc: Loc, spec: dict, names: Names, family: str) -> list[Problem]:
     """The parameter and range of a linear sweep or grid axis."""
     name = spec.get("parameter")
-    found = _parameter_problems(loc + ("parameter",), name, variant, family)
+    found = _parameter_problems(loc + ("parameter",), name, names, family)
     if found or not isinstance(name, str):
         return found
-    return _range_problems(loc + ("range",), variant.canonical(name), spec.get("range"),
-                           variant, "swept")
+    return _range_problems(loc + ("range",), names.canonical(name), spec.get("range"),
+                           names, "swept")
 
 
 def _dict_items(items: Any) -> Iterator[tuple[int, dict]]:
@@ -65,29 +105,41 @@ def _dict_items(items: Any) -> Iterator[tuple[int, dict]]:
         yield from ((i, item) for i, item in enumerate(items) if isinstance(item, dict))
 
 
-def _parameter_problems(loc: Loc, name: Any, variant: Model, family: str) -> list[Problem]:
-    if not isinstance(name, str) or name in variant.known_parameter_names():
+def _parameter_problems(loc: Loc, name: Any, names: Names, family: str) -> list[Problem]:
+    if not isinstance(name, str) or name in names.known_parameter_names():
         return []
-    known = ", ".join(variant.known_parameter_names())
+    known = ", ".join(names.known_parameter_names())
     return [(loc, f"unknown parameter {name!r} for model {family} (known: {known})")]
 
 
-def _override_problems(parameters: Any, variant: Model, family: str) -> list[Problem]:
+def _override_problems(parameters: Any, names: Names, family: str) -> list[Problem]:
     problems: list[Problem] = []
     spelled: dict[str, str] = {}  # canonical name -> the key that gave it first
     for name, value in parameters.items() if isinstance(parameters, dict) else ():
         loc = ("parameters", name)
-        found = _parameter_problems(loc, name, variant, family)
-        if not found and variant.canonical(name) in _LAW_PARAMETERS:
-            found = [(loc, f"set {name} under nonlinearity (type: polynomial)")]
+        found = _parameter_problems(loc, name, names, family)
+        if not found and names.canonical(name) in names.model.law_parameter_names():
+            found = [(loc, _law_coefficient_reason(name, names))]
         if not found:
-            canonical = variant.canonical(name)
+            canonical = names.canonical(name)
             if canonical in spelled:
                 found = [(loc, _twice(name, spelled[canonical], canonical))]
             spelled.setdefault(canonical, name)
-            found = found or _bound_problems(loc, canonical, value, variant)
+            found = found or _bound_problems(loc, canonical, value, names)
         problems += found
     return problems
+
+
+def _law_coefficient_reason(name: str, names: Names) -> str:
+    """Where a law coefficient given under ``parameters`` belongs."""
+    canonical = names.canonical(name)
+    for dof in names.model.family.dof_names:
+        for key, coefficient in names.model.coefficient_names(dof).items():
+            if coefficient == canonical:
+                law = names.model.law_on(dof).name
+                there = "" if key == name else f" as {key}"
+                return f"set {name} under nonlinearity (type: {law}, dof: {dof}){there}"
+    return f"set {name} under nonlinearity"
 
 
 def _twice(name: str, other: str, canonical: str) -> str:
@@ -97,22 +149,22 @@ def _twice(name: str, other: str, canonical: str) -> str:
     return f"{name!r} and {other!r} are the same parameter ({same}); give it once"
 
 
-def _bound_problems(loc: Loc, canonical: str, value: Any, variant: Model) -> list[Problem]:
+def _bound_problems(loc: Loc, canonical: str, value: Any, names: Names) -> list[Problem]:
     """A value outside the parameter's physical bounds (malformed values are reported as
     structural problems)."""
     number = _finite(value)
-    parameter = variant.parameter(canonical)
+    parameter = names.parameter(canonical)
     if number is None or parameter.bounds.contains(number):
         return []
     return [(loc, f"{canonical} must be {parameter.bounds.text(parameter.unit)}, got "
              f"{value!r}")]
 
 
-def _range_problems(loc: Loc, canonical: str, bounds: Any, variant: Model,
+def _range_problems(loc: Loc, canonical: str, bounds: Any, names: Names,
                     swept: str) -> list[Problem]:
     """A continuation or sweep range reaching outside the parameter's physical bounds, or a
     parameter that takes whole numbers only (which cannot be continued or swept)."""
-    parameter = variant.parameter(canonical)
+    parameter = names.parameter(canonical)
     if parameter.bounds.integer:
         return [(loc, f"{canonical} takes whole numbers only ({parameter.bounds.text()}) and "
                  f"cannot be {swept}")]
@@ -125,24 +177,24 @@ def _range_problems(loc: Loc, canonical: str, bounds: Any, variant: Model,
 
 
 def _continuation_problems(
-    items: Any, variant: Model, family: str, values: dict[str, float]
+    items: Any, names: Names, family: str, values: dict[str, float]
 ) -> list[Problem]:
     problems: list[Problem] = []
-    names: set[str] = set()
+    taken: set[str] = set()
     for i, item in _dict_items(items):
         loc = ("continuations", i)
         name, parameter = item.get("name"), item.get("parameter")
-        if isinstance(name, str) and name in names:
+        if isinstance(name, str) and name in taken:
             problems.append((loc + ("name",), f"duplicate continuation name {name!r}"))
         if isinstance(name, str):
-            names.add(name)
+            taken.add(name)
         if item.get("type") == "two-parameter":
-            problems += _pair_problems(loc, item, variant, family, values)
+            problems += _pair_problems(loc, item, names, family, values)
             continue
-        found = _parameter_problems(loc + ("parameter",), parameter, variant, family)
+        found = _parameter_problems(loc + ("parameter",), parameter, names, family)
         if not found and isinstance(parameter, str):
-            canonical = variant.canonical(parameter)
-            found = _range_problems(loc + ("range",), canonical, item.get("range"), variant,
+            canonical = names.canonical(parameter)
+            found = _range_problems(loc + ("range",), canonical, item.get("range"), names,
                                     "continued")
             found = found or _start_problems(loc, item, values[canonical])
             found += _orbits_problems(loc, item)
@@ -163,7 +215,7 @@ def _orbits_problems(loc: Loc, item: dict) -> list[Problem]:
             if number is not None and not lower <= number <= upper]
 
 
-def _pair_problems(loc: Loc, item: dict, variant: Model, family: str,
+def _pair_problems(loc: Loc, item: dict, names: Names, family: str,
                    values: dict[str, float]) -> list[Problem]:
     """Parameters, range keys, start and slices of a two-parameter continuation."""
     pair = item.get("parameters")
@@ -171,10 +223,10 @@ def _pair_problems(loc: Loc, item: dict, variant: Model, family: str,
         return []
     problems: list[Problem] = []
     for k, name in enumerate(pair):
-        problems += _parameter_problems(loc + ("parameters", k), name, variant, family)
+        problems += _parameter_problems(loc + ("parameters", k), name, names, family)
     if problems or not all(isinstance(p, str) for p in pair):
         return problems
-    first, second = (variant.canonical(p) for p in pair)
+    first, second = (names.canonical(p) for p in pair)
     if first == second:
         return [(loc + ("parameters",), f"expected two different parameters, got {pair!r}")]
     bounds = item.get("range")
@@ -182,7 +234,7 @@ def _pair_problems(loc: Loc, item: dict, variant: Model, family: str,
         return problems
     canonical: dict[str, str] = {}
     for key in (k for k in bounds if isinstance(k, str)):
-        name = variant.canonical(key) if key in variant.known_parameter_names() else key
+        name = names.canonical(key) if key in names.known_parameter_names() else key
         if name in canonical:
             return [(loc + ("range", key), _twice(key, canonical[name], name))]
         canonical[name] = key
@@ -191,7 +243,7 @@ def _pair_problems(loc: Loc, item: dict, variant: Model, family: str,
                  f"{', '.join(map(str, bounds)) or 'none'}")]
     for name in (first, second):
         problems += _range_problems(loc + ("range", canonical[name]), name,
-                                    bounds[canonical[name]], variant, "continued")
+                                    bounds[canonical[name]], names, "continued")
     if problems:
         return problems
     start_item = {"range": bounds[canonical[first]], "start": item.get("start")}

@@ -35,6 +35,8 @@ _LIST_ERRORS = {"tuple_type", "list_type"}
 def _translate(error: Any, tree: _Tree) -> Problem:
     """One pydantic error as (key path, reason)."""
     loc, owner, annotation = _walk(error["loc"])
+    if loc[:2] == ("nonlinearity", 0) and isinstance(tree.data.get("nonlinearity"), dict):
+        loc = loc[:1] + loc[2:]  # one law mapping counts as a list of one: report at it
     kind = error["type"]
     if kind == "whirl":
         template = error["ctx"]["reason"]

@@ -18,7 +18,9 @@ def schema_reference() -> str:
     """Markdown table of every study key: path, type, default, description."""
     rows: dict[str, list[str]] = {}
     for path, field in _fields(Study, ""):
-        row = [_type_text(field.annotation), _default_text(field), field.description or ""]
+        shown = (field.json_schema_extra or {}).get("type_text")  # a type the YAML spells so
+        row = [shown or _type_text(field.annotation), _default_text(field),
+               field.description or ""]
         if path in rows and rows[path][0] != row[0]:
             rows[path][0] += " or " + row[0]
         rows.setdefault(path, row)

@@ -1,24 +1,29 @@
 """Model-dependent defaults of a study, filled on the raw data before the schema checks it.
 
-``nonlinearity.dof`` (the family's default), canonical parameter names of continuations and
-linear sweeps (``K_theta`` -> ``K1``), ``start`` (the parameter's study value) and the
-``slices`` of a two-parameter continuation. :class:`whirl_cli.study.schema.Study` applies them
-(a before-validator) and the meaning checks (:mod:`whirl_cli.study.checks`) read the study
-values, so this module imports neither; it also holds what both share, the test for a finite
-number and the stiffness law's parameter names.
+``nonlinearity`` (one law mapping, or a list of them) gets its ``dof`` where a single law leaves
+it out (the family's first dof); continuations and linear sweeps get canonical parameter names
+(``K1`` -> ``K_theta``), ``start`` (the parameter's study value) and the ``slices`` of a
+two-parameter continuation. :class:`whirl_cli.study.schema.Study` applies them (a
+before-validator) and the meaning checks (:mod:`whirl_cli.study.checks`) read the study values,
+so this module imports neither; it also holds what both share: the test for a finite number,
+the law blocks of raw data and :class:`Names`, the parameter names a study may use.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 from pydantic import BaseModel
 
-from ..models import FAMILIES, Model, get_model
+from ..models import FAMILIES, LAWS, Model, Parameter, get_model
 
-#: Parameters of the stiffness law, set under ``nonlinearity`` rather than ``parameters``.
-_LAW_PARAMETERS = ("K2", "K3")
+#: Study law types: ``linear`` is the polynomial law with zero coefficients.
+LAW_TYPES = ("linear", *LAWS)
+#: The thesis' names of the single law's coefficients (``K1`` its dof's linear stiffness).
+THESIS_NAMES = ("K1", "K2", "K3")
 
 
 def _is_number(value: Any) -> bool:
@@ -30,69 +35,165 @@ def _finite(value: Any) -> float | None:
     return float(value) if _is_number(value) and math.isfinite(value) else None
 
 
-def _variant_of(data: dict) -> Model | None:
-    """The variant the raw study data asks for, or None when its model or dof is invalid."""
+def law_blocks(data: dict) -> list[tuple[tuple, Any]]:
+    """(key path, block) of every law of raw study data: the ``nonlinearity`` mapping, or the
+    items of its list; ``[((), None)]`` when there is none (linear springs)."""
+    block = data.get("nonlinearity")
+    if isinstance(block, list | tuple):
+        return [(("nonlinearity", i), item) for i, item in enumerate(block)]
+    if block is None:
+        return [((), None)]
+    return [(("nonlinearity",), block)]
+
+
+def _is_single(data: dict) -> bool:
+    """True if the study gives its law as one mapping (or none), not as a list."""
+    return not isinstance(data.get("nonlinearity"), list | tuple)
+
+
+def _get(block: Any, key: str) -> Any:
+    """A key of a law block given as a mapping or as a validated model."""
+    if isinstance(block, dict):
+        return block.get(key)
+    return getattr(block, key, None)
+
+
+def block_dof(block: Any, family: str, single: bool) -> Any:
+    """The dof a law block names; a law given as a single mapping without one acts on the
+    family's first dof (in a list every law names its dof)."""
+    dof = _get(block, "dof")
+    return FAMILIES[family].dofs[0].name if dof is None and single else dof
+
+
+@dataclass(frozen=True)
+class Names:
+    """The parameter names a study may use: its variant's, and with one law the thesis' names
+    ``K1``, ``K2``, ``K3`` for that law's dof (``K1`` = ``K_theta`` for a law on pitch).
+    Duck-types the name lookups of :class:`whirl_cli.models.Model`."""
+
+    model: Model
+    aliases: tuple[tuple[str, str], ...] = ()
+
+    @cached_property
+    def _table(self) -> dict[str, str]:
+        table = {name: self.model.canonical(name) for name in self.model.known_parameter_names()}
+        return {**table, **dict(self.aliases)}
+
+    def canonical(self, name: str) -> str:
+        return self._table[name]
+
+    def known_parameter_names(self) -> tuple[str, ...]:
+        return tuple(sorted(self._table))
+
+    def parameter(self, name: str) -> Parameter:
+        return self.model.parameter(self.canonical(name))
+
+    def defaults(self) -> dict[str, float]:
+        return self.model.defaults()
+
+
+def names_of(family: str, laws: list[tuple[str, Any]]) -> Names | None:
+    """The :class:`Names` of a study of ``family`` with these (dof, block) laws, or None when
+    a dof is unknown, named twice or a law type unknown."""
+    declared = FAMILIES[family]
+    dofs = [dof for dof, _ in laws]
+    if not set(dofs) <= set(declared.dof_names) or len(set(dofs)) != len(dofs):
+        return None
+    types = {dof: _get(block, "type") for dof, block in laws}
+    if not set(types.values()) <= set(LAW_TYPES):
+        return None
+    per_dof = tuple("polynomial" if types.get(d, "linear") == "linear" else types[d]
+                    for d in declared.dof_names)
+    model = get_model(family, per_dof)
+    aliases: tuple[tuple[str, str], ...] = ()
+    if len(laws) == 1:
+        (dof, _), = laws
+        coefficients = model.coefficient_names(dof)
+        aliases = (("K1", declared.dof(dof).stiffness),) + tuple(
+            (key, coefficients[key]) for key in THESIS_NAMES[1:] if key in coefficients)
+    return Names(model, aliases)
+
+
+def _names_of_data(data: dict) -> Names | None:
+    """The :class:`Names` the raw study data asks for, or None when its model or laws are
+    invalid (reported by the checks)."""
     family = data.get("model")
     if not isinstance(family, str) or family not in FAMILIES:
         return None
-    _, dofs, default = FAMILIES[family]
-    block = data.get("nonlinearity")
-    dof = block.get("dof") if isinstance(block, dict) else getattr(block, "dof", None)
-    dof = default if dof is None else dof
-    return get_model(family, "polynomial", dof) if dof in dofs else None
+    blocks = law_blocks(data)
+    single = _is_single(data)
+    laws = []
+    for _, block in blocks:
+        if block is None:
+            laws.append((FAMILIES[family].dofs[0].name, {"type": "linear"}))
+            continue
+        if not isinstance(block, dict | BaseModel):
+            return None
+        dof = block_dof(block, family, single)
+        if not isinstance(dof, str):
+            return None
+        laws.append((dof, block))
+    return names_of(family, laws)
 
 
-def _study_values(data: dict, variant: Model) -> dict[str, float]:
-    """Canonical name -> value: datum values, then valid overrides and K2/K3 from raw data."""
-    values = variant.defaults()
-    known = variant.known_parameter_names()
+def _study_values(data: dict, names: Names) -> dict[str, float]:
+    """Canonical name -> value: datum values, then valid overrides and the law coefficients
+    from raw data."""
+    values = names.defaults()
+    known = names.known_parameter_names()
     parameters = data.get("parameters")
     for name, value in parameters.items() if isinstance(parameters, dict) else ():
         if name in known and _finite(value) is not None:
-            values[variant.canonical(name)] = float(value)
-    block = data.get("nonlinearity")
-    if isinstance(block, dict) and block.get("type") == "polynomial":
-        for name in _LAW_PARAMETERS:
-            if _finite(block.get(name)) is not None:
-                values[name] = float(block[name])
+            values[names.canonical(name)] = float(value)
+    blocks = law_blocks(data)
+    for _, block in blocks:
+        if not isinstance(block, dict):
+            continue
+        dof = block_dof(block, data["model"], _is_single(data))
+        if dof not in names.model.family.dof_names:
+            continue
+        for key, name in names.model.coefficient_names(dof).items():
+            if _finite(block.get(key)) is not None:
+                values[name] = float(block[key])
     return values
 
 
 def _resolved(data: dict) -> dict:
     """``data`` with dof, canonical parameter names and start values filled where possible."""
-    variant = _variant_of(data)
-    if variant is None:
+    names = _names_of_data(data)
+    if names is None:
         return data
     data = dict(data)
     block = data.get("nonlinearity", {"type": "linear"})
+    first = names.model.family.dofs[0].name
     if isinstance(block, dict) and block.get("dof") is None:
-        data["nonlinearity"] = {**block, "dof": variant.dof}
-    elif isinstance(block, BaseModel) and block.dof is None:
-        data["nonlinearity"] = block.model_copy(update={"dof": variant.dof})
-    values = _study_values(data, variant)
+        data["nonlinearity"] = {**block, "dof": first}
+    elif isinstance(block, BaseModel) and getattr(block, "dof", None) is None:
+        data["nonlinearity"] = block.model_copy(update={"dof": first})
+    values = _study_values(data, names)
     items = data.get("continuations")
     if isinstance(items, list | tuple):
-        data["continuations"] = [_resolved_item(c, variant, values) for c in items]
+        data["continuations"] = [_resolved_item(c, names, values) for c in items]
     linear = data.get("linear")
     if isinstance(linear, dict) and isinstance(linear.get("sweeps"), list | tuple):
-        sweeps = [_resolved_item(s, variant, None) for s in linear["sweeps"]]
+        sweeps = [_resolved_item(s, names, None) for s in linear["sweeps"]]
         data["linear"] = {**linear, "sweeps": sweeps}
     linear = data.get("linear")
     if isinstance(linear, dict) and isinstance(linear.get("grid"), dict):
-        grid = {k: _resolved_item(v, variant, None) for k, v in linear["grid"].items()}
+        grid = {k: _resolved_item(v, names, None) for k, v in linear["grid"].items()}
         data["linear"] = {**linear, "grid": grid}
     return data
 
 
-def _resolved_pair(item: dict, variant: Model, values: dict[str, float] | None) -> dict:
+def _resolved_pair(item: dict, names: Names, values: dict[str, float] | None) -> dict:
     """A two-parameter continuation with canonical parameter names, ``start`` and ``slices``
     filled; the keys of ``range`` stay as written (see ``TwoParameterContinuation.bounds``)."""
     pair = item.get("parameters")
-    known = variant.known_parameter_names()
+    known = names.known_parameter_names()
     if not (isinstance(pair, list | tuple) and len(pair) == 2
             and all(isinstance(p, str) and p in known for p in pair)):
         return item
-    first, second = (variant.canonical(p) for p in pair)
+    first, second = (names.canonical(p) for p in pair)
     item = {**item, "parameters": [first, second]}  # range keys stay as written (line numbers)
     if values is not None:
         if item.get("start") is None:
@@ -102,14 +203,14 @@ def _resolved_pair(item: dict, variant: Model, values: dict[str, float] | None) 
     return item
 
 
-def _resolved_item(item: Any, variant: Model, values: dict[str, float] | None) -> Any:
+def _resolved_item(item: Any, names: Names, values: dict[str, float] | None) -> Any:
     """A continuation or sweep with its canonical parameter name (and start, given values)."""
     if isinstance(item, dict) and item.get("type") == "two-parameter":
-        return _resolved_pair(item, variant, values)
+        return _resolved_pair(item, names, values)
     name = item.get("parameter") if isinstance(item, dict) else None
-    if not isinstance(name, str) or name not in variant.known_parameter_names():
+    if not isinstance(name, str) or name not in names.known_parameter_names():
         return item
-    item = {**item, "parameter": variant.canonical(name)}
+    item = {**item, "parameter": names.canonical(name)}
     if values is not None and item.get("start") is None:
         item["start"] = values[item["parameter"]]
     return item

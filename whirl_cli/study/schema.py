@@ -26,8 +26,8 @@ from pydantic import (
 )
 from pydantic_core import PydanticCustomError
 
-from ..models import FAMILIES, Model, get_model
-from .resolve import _LAW_PARAMETERS, _finite, _is_number, _resolved
+from ..models import FAMILIES, Model
+from .resolve import Names, _finite, _is_number, _resolved, names_of
 
 NAME_MAX = 64
 #: Largest integer AUTO-07p reads into its (32-bit) INTEGER constants (NMX, NTST, ITNW).
@@ -134,11 +134,12 @@ class _Strict(BaseModel):
 
 _TYPE_DOC = (
     "Stiffness law: `linear` (linear springs; the polynomial law with K2 = K3 = 0) or "
-    "`polynomial` (restoring moment K1 x + K2 x^3 + K3 x^5 on `dof`, x in rad)."
+    "`polynomial` (restoring force K x + K2 x^3 + K3 x^5 on `dof`, K the dof's linear "
+    "stiffness, e.g. K_theta; x in the dof's unit, rad for angles)."
 )
 _DOF_DOC = (
-    "Degree of freedom the law acts on (classical: `theta` pitch, `psi` yaw); unset: the "
-    "model's default (classical: `theta`)."
+    "Degree of freedom the law acts on (classical: `theta` pitch, `psi` yaw); a dof has at most "
+    "one law. Unset (a single law only): the model's first dof (classical: `theta`)."
 )
 
 
@@ -150,14 +151,29 @@ class Linear(_Strict):
 
 
 class Polynomial(_Strict):
-    """Restoring moment K1 x + K2 x^3 + K3 x^5 on one degree of freedom."""
+    """Restoring force K x + K2 x^3 + K3 x^5 on one degree of freedom."""
 
     type: Literal["polynomial"] = Field(description=_TYPE_DOC)
     dof: Text | None = Field(None, description=_DOF_DOC)
-    K2: Number = Field(0.0, description="Cubic stiffness coefficient, N m/rad^3 (polynomial only).")
-    K3: Number = Field(
-        0.0, description="Quintic stiffness coefficient, N m/rad^5 (polynomial only)."
-    )
+    K2: Number = Field(0.0, description="Cubic coefficient, force per unit^3 (classical: "
+                       "N m/rad^3); leaves the study as `K2_<dof>`.")
+    K3: Number = Field(0.0, description="Quintic coefficient, force per unit^5 (classical: "
+                       "N m/rad^5); leaves the study as `K3_<dof>`.")
+
+
+LawBlock = Annotated[Linear | Polynomial, Field(discriminator="type")]
+
+
+def _as_laws(value: Any) -> Any:
+    """One law mapping counts as a list of one (its errors are reported at the mapping)."""
+    if isinstance(value, dict | BaseModel):
+        return (value,)
+    if not isinstance(value, list | tuple):
+        _fail("expected a mapping (one law) or a list of mappings (one law per dof), got {got}")
+    return value
+
+
+Laws = Annotated[tuple[LawBlock, ...], BeforeValidator(_as_laws)]
 
 
 class OneParameterContinuation(_Strict):
@@ -200,9 +216,9 @@ class OneParameterContinuation(_Strict):
         """``start``, or the study value of the parameter when unset (models built by hand)."""
         if self.start is not None:
             return self.start
-        variant = study.variant()
-        name = variant.canonical(self.parameter)
-        return study.parameter_values().get(name, variant.defaults()[name])
+        names = study.names()
+        name = names.canonical(self.parameter)
+        return study.parameter_values().get(name, names.defaults()[name])
 
 
 LocusKind = Literal["hopf", "branch_point", "fold", "fold_of_cycles"]
@@ -256,9 +272,9 @@ class TwoParameterContinuation(_Strict):
         101, description="Rows across the second parameter's range for the unsafe polygons."
     )
 
-    def bounds(self, model: Model) -> dict[str, tuple[float, float]]:
-        """``range`` keyed by canonical parameter names."""
-        return {model.canonical(key): tuple(value) for key, value in self.range.items()}
+    def bounds(self, names: Names | Model) -> dict[str, tuple[float, float]]:
+        """``range`` keyed by canonical parameter names (``names``: the study's)."""
+        return {names.canonical(key): tuple(value) for key, value in self.range.items()}
 
 
 PlotKind = Literal["bifurcation", "linear", "projections", "period", "phase", "boundary"]
@@ -345,12 +361,15 @@ class Study(_Strict):
     parameters: dict[str, Number] = Field(
         default_factory=dict,
         description="Overrides of the model's datum parameter values, by name or alias, in SI "
-        "units (angles in rad; `whirl models` lists units). K2 and K3 go under `nonlinearity`.",
+        "units (angles in rad; `whirl models` lists units and bounds). Law coefficients go under "
+        "`nonlinearity`. With one law, `K1`, `K2`, `K3` name its dof's stiffness and coefficients "
+        "(the thesis' names: `K1` = `K_theta` for a law on pitch).",
     )
-    nonlinearity: Linear | Polynomial = Field(
-        default=Linear(type="linear"),
-        discriminator="type",
-        description="Structural stiffness law on one degree of freedom.",
+    nonlinearity: Laws = Field(
+        default=(Linear(type="linear"),),
+        json_schema_extra={"type_text": "mapping, or list of mappings"},
+        description="Structural stiffness laws: one mapping (one law), or a list of mappings, "
+        "one law per dof. A law replaces its dof's stiffness term K x.",
     )
     continuations: tuple[Continuation, ...] = Field(
         (), description="AUTO-07p continuation runs, in order."
@@ -394,15 +413,28 @@ class Study(_Strict):
         """The path the study was loaded from, as given (or the name given to validate_text)."""
         return self._path
 
+    @property
+    def laws(self) -> tuple[Linear | Polynomial, ...]:
+        """The law blocks (after validation every one names its dof)."""
+        return self.nonlinearity
+
+    def names(self) -> Names:
+        """The parameter names this study may use (the variant's, and the thesis' K1, K2, K3
+        for a single law's dof)."""
+        names = names_of(self.model, [(law.dof, law) for law in self.laws])
+        assert names is not None, "a validated study has valid laws"
+        return names
+
     def variant(self) -> Model:
-        """The model variant: every study uses the polynomial law (linear is K2 = K3 = 0)."""
-        return get_model(self.model, "polynomial", self.nonlinearity.dof)
+        """The model variant: the polynomial law on every dof (linear is K2 = K3 = 0) unless a
+        study names another law."""
+        return self.names().model
 
     def parameter_values(self) -> dict[str, float]:
-        """Canonical name -> value for every override, plus K2 and K3 of the nonlinearity."""
-        variant = self.variant()
-        values = {variant.canonical(k): v for k, v in self.parameters.items()}
-        for name in _LAW_PARAMETERS:
-            values[name] = getattr(self.nonlinearity, name, 0.0)
+        """Canonical name -> value for every override and every law coefficient."""
+        names = self.names()
+        values = {names.canonical(k): v for k, v in self.parameters.items()}
+        for law in self.laws:
+            for key, name in names.model.coefficient_names(law.dof).items():
+                values[name] = float(getattr(law, key, 0.0))
         return values
-
