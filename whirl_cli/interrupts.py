@@ -6,6 +6,7 @@
 * :func:`quiet_worker` is the initializer of every worker process whirl forks (cross-check
   simulations, sweep studies), which are forked inside :func:`forking`; :func:`end_processes`
   ends such workers after an interrupt.
+* :func:`thread_map` maps over threads that never outlive the call, an interrupt included.
 """
 
 from __future__ import annotations
@@ -14,7 +15,8 @@ import os
 import signal
 import sys
 import threading
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 
 
@@ -159,3 +161,28 @@ def held_signals() -> Iterator[None]:
             signal.signal(number, handler)
         for number in dict.fromkeys(arrived):
             signal.raise_signal(number)
+
+
+def thread_map(function: Callable, items: Iterable, workers: int) -> list:
+    """``[function(item) for item in items]`` over ``workers`` threads, in item order.
+
+    No thread outlives the call, an interrupt included (the caller may then remove the files
+    they work on): the threads start with signals held (an interrupt inside
+    ``Thread.start`` would leave a started thread the pool does not know of), items not
+    started yet are cancelled on an exception, and the running ones are waited for, again
+    if an interrupt lands in that wait (under :func:`catching` later signals do not raise,
+    and the AUTO runs have been killed, so the second wait is short)."""
+    pool = ThreadPoolExecutor(max_workers=max(1, workers))
+    futures = []
+    try:
+        with held_signals():
+            futures = [pool.submit(function, item) for item in items]
+        return [future.result() for future in futures]
+    finally:
+        for future in futures:
+            future.cancel()
+        try:
+            pool.shutdown(wait=True)
+        except KeyboardInterrupt:
+            pool.shutdown(wait=True)
+            raise

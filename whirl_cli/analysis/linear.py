@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..interrupts import thread_map
 from ..models import Model
 from ..results import LinearGrid, LinearSweep
 
@@ -146,14 +147,11 @@ def critical_points(model: Model, overrides: dict[str, float], parameter: str,
 def batched_eigenvalues(matrices: np.ndarray) -> np.ndarray:
     """``numpy.linalg.eigvals`` of a stack (M, n, n), split over the CPU cores (the batched
     LAPACK call releases the GIL, so threads run it in parallel)."""
-    from concurrent.futures import ThreadPoolExecutor
-
     workers = min(os.cpu_count() or 1, max(1, len(matrices) // 4096))
     if workers == 1:
         return np.linalg.eigvals(matrices)
-    with ThreadPoolExecutor(workers) as pool:
-        parts = list(pool.map(np.linalg.eigvals, np.array_split(matrices, workers)))
-    return np.concatenate(parts)
+    return np.concatenate(thread_map(np.linalg.eigvals, np.array_split(matrices, workers),
+                                     workers))
 
 
 def _critical(model: Model, params: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

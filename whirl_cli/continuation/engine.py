@@ -8,7 +8,6 @@ they wrote (an empty branch with the run's status and message where a run failed
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
@@ -17,6 +16,7 @@ import numpy as np
 from ..auto import runner, toolchain
 from ..auto.codegen import fortran_source, source_key
 from ..auto.parse import read_branch
+from ..interrupts import thread_map
 from ..models import Model
 from ..results import Branch, RunRecord, SpecialPoint
 from .branches import special_points
@@ -83,10 +83,9 @@ class Engine:
         self.outcomes: dict[str, runner.RunOutcome] = {}
 
     def run_many(self, specs: Sequence[RunSpec]) -> list[runner.RunOutcome]:
-        """Execute ``specs`` (independent of each other) and return outcomes in spec order."""
-        with ThreadPoolExecutor(max_workers=self.jobs) as pool:
-            outcomes = list(pool.map(self._execute, specs))
-        return outcomes
+        """Execute ``specs`` (independent of each other) and return outcomes in spec order;
+        every run has ended when this returns or raises."""
+        return thread_map(self._execute, specs, self.jobs)
 
     def _execute(self, spec: RunSpec) -> runner.RunOutcome:
         constants = dict(spec.constants)

@@ -16,7 +16,6 @@ from __future__ import annotations
 import pickle
 import shutil
 import tempfile
-import threading
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Executor, Future, as_completed, wait
 from dataclasses import dataclass
@@ -54,8 +53,7 @@ def compute(study: Study) -> StudyResult:
     workroot = Path(tempfile.mkdtemp(prefix=f"whirl-sweep-{study.name}-"))
     try:
         return run_study(study, workroot, jobs=1)
-    except BaseException as error:
-        _join_helper_threads(study.auto.timeout if study.auto else None)
+    except BaseException as error:  # run_study's threads have ended (interrupts.thread_map)
         raise portable(error) from None
     finally:
         shutil.rmtree(workroot, ignore_errors=True)
@@ -72,15 +70,6 @@ def portable(error: BaseException) -> BaseException:
         text = f"{type(error).__name__}: {error}"
         return KeyboardInterrupt(text) if isinstance(error, KeyboardInterrupt) \
             else RuntimeError(text)
-
-
-def _join_helper_threads(timeout: float | None) -> None:
-    """Wait for the threads a study left running (an interrupted AUTO run still writing into
-    the work directory) before the directory is removed; at most ``timeout`` s each (default
-    120, the AUTO run limit)."""
-    for thread in threading.enumerate():
-        if thread is not threading.current_thread() and not thread.daemon:
-            thread.join(timeout or 120.0)
 
 
 @dataclass(frozen=True)
