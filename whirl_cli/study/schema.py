@@ -345,7 +345,8 @@ class AutoSettings(_Strict):
     )
     timeout: Positive | None = Field(None, description="Wall-clock limit per AUTO run, s, > 0.")
     max_amplitude: Positive | None = Field(
-        None, description="Amplitude at which branches are stopped, rad, > 0."
+        None, description="Amplitude at which branches are stopped, in units of each dof's "
+        "typical amplitude (`whirl models` lists them; classical: 1 rad), > 0."
     )
 
 
