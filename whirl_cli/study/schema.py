@@ -381,6 +381,12 @@ class Study(_Strict):
     plots: tuple[PlotKind, ...] = Field(
         ("bifurcation",), description="Figures drawn after the runs."
     )
+    plot_state: Text | None = Field(
+        None,
+        description="State the bifurcation diagrams draw (`bifurcation`, and the slices of "
+        "`boundary`): a dof or a rate of the model (`whirl models` lists them, e.g. `psi`, "
+        "`dq2`). Unset: the model's first dof (classical: `theta`).",
+    )
     cross_check: Boolean = Field(
         False,
         description="Check stable periodic orbits and equilibria by time simulation (scipy) and "
