@@ -754,3 +754,47 @@ def test_every_datum_lies_within_its_bounds_and_models_lists_them():
         for parameter in model.parameters:
             assert parameter.bounds.contains(parameter.default), parameter
         assert "an integer >= 3" in model.describe()
+
+
+# --------------------------------------------------------------------------- issue 14: laws
+def test_several_laws_each_name_their_dof_and_take_a_dof_once():
+    text = HEAD + ("nonlinearity:\n"
+                   "  - {type: polynomial, dof: theta, K2: 10}\n"
+                   "  - {type: polynomial, K2: 10}\n"
+                   "  - {type: linear, dof: theta}\n"
+                   "  - {type: polynomial, dof: phi}\n")
+    assert problems(text) == [
+        "s.yaml:5: nonlinearity[1].dof: required in a list of laws (each law names its dof: "
+        "theta, psi)",
+        "s.yaml:6: nonlinearity[2].dof: a second law on theta (the first is at "
+        "nonlinearity[0]); a dof takes at most one law",
+        "s.yaml:7: nonlinearity[3].dof: expected one of theta, psi, got 'phi'"]
+
+
+def test_a_law_coefficient_belongs_under_its_law():
+    text = HEAD + ("parameters: {K2_psi: 1.0}\nnonlinearity:\n"
+                   "  - {type: polynomial, dof: theta, K2: 10}\n"
+                   "  - {type: polynomial, dof: psi}\n")
+    assert problems(text) == [
+        "s.yaml:3: parameters.K2_psi: set K2_psi under nonlinearity (type: polynomial, dof: "
+        "psi) as K2"]
+
+
+def test_with_several_laws_the_thesis_names_are_not_known():
+    """K1, K2, K3 name a single law's dof; with two laws they would be ambiguous."""
+    text = HEAD + ("nonlinearity:\n  - {type: polynomial, dof: theta, K2: 10}\n"
+                   "  - {type: polynomial, dof: psi, K2: 10}\n"
+                   "continuations: [{name: k, type: one-parameter, parameter: K1, "
+                   "range: [0, 1]}]\n")
+    (problem,) = problems(text)
+    assert problem.startswith("s.yaml:6: continuations[0].parameter: unknown parameter 'K1'")
+    assert "K2_psi, K2_theta" in problem and ", K1," not in problem
+
+
+def test_two_laws_resolve_to_parameters_named_by_dof():
+    study = validate_text(HEAD + ("parameters: {K_psi: 0.3}\nnonlinearity:\n"
+                                  "  - {type: polynomial, dof: theta, K2: -10, K3: 350}\n"
+                                  "  - {type: polynomial, dof: psi, K2: -10, K3: 350}\n"))
+    assert study.parameter_values() == {"K_psi": 0.3, "K2_theta": -10.0, "K3_theta": 350.0,
+                                        "K2_psi": -10.0, "K3_psi": 350.0}
+    assert study.variant().name == "classical_poly"

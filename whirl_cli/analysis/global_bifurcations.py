@@ -97,15 +97,9 @@ def _extrapolated(extremes: np.ndarray) -> float:
 
 
 def _tail(period: np.ndarray, hopf_period: float) -> slice:
-    """The last stretch of at most 15 points with the period above twice the Hopf period."""
-    above = np.isfinite(period) & (period > 2 * hopf_period)
-    if not above.any():
-        return slice(0, 0)
-    end = int(np.flatnonzero(above)[-1]) + 1
-    start = end
-    while start > 0 and above[start - 1]:
-        start -= 1
-    return slice(max(start, end - 15), end)
+    """The last at most 15 points of :func:`_stretch`."""
+    stretch = _stretch(period, hopf_period)
+    return slice(max(stretch.start, stretch.stop - 15), stretch.stop)
 
 
 def _best_distance(p: np.ndarray, t: np.ndarray, basis, side: float, reach: float

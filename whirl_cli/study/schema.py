@@ -190,7 +190,7 @@ class OneParameterContinuation(_Strict):
     )
     parameter: Text = Field(
         description="Continuation parameter, by name or alias, in its SI unit (stored as the "
-        "canonical name: `K_theta` -> `K1`)."
+        "canonical name: `K1` -> `K_theta`)."
     )
     start: Number | None = Field(
         None,
