@@ -193,9 +193,12 @@ def generate(check: bool, directory: Path) -> None:
 @cli.command()
 def models() -> None:
     """List the model variants with their states and parameters (units, defaults)."""
-    from .models import all_variants
+    from .models import FAMILIES, all_variants, get_model
 
-    click.echo("\n\n".join(model.describe() for model in all_variants()))
+    shipped = all_variants()
+    others = [get_model(name) for name in FAMILIES
+              if name not in {model.family.name for model in shipped}]
+    click.echo("\n\n".join(model.describe() for model in shipped + others))
 
 
 # ------------------------------------------------------------------------------------ plot
