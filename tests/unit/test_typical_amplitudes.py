@@ -74,3 +74,20 @@ def test_equilibria_at_counts_distinct_states_in_typical_amplitudes():
 
 STATES = ("q1", "q2", "q3", "dq1", "dq2", "dq3")
 UNITS = ("m",) * 3 + ("m/s",) * 3
+
+
+def test_loci_of_asymmetric_cycles_cut_in_typical_amplitudes():
+    """A Hopf locus of cycles centred half their size off y = 0 is not one of the undeflected
+    equilibrium's, in micrometres as in radians (absolute 1e-6 kept it at that size)."""
+    from whirl_cli.analysis.boundaries import loci_curves
+
+    n, size, centre = 3, 1e-6, 5e-7
+    state_max, state_min = np.full((n, 6), centre + size), np.full((n, 6), centre - size)
+    locus = Branch("hopf_1a", BranchKind.HOPF_LOCUS, "", ("p", "r"), ("1", "1"), STATES, UNITS,
+                   np.column_stack([np.arange(n), np.arange(n)]).astype(float), state_max,
+                   state_min, np.zeros(n), np.full(n, np.nan), np.ones(n, bool),
+                   np.zeros(n, int), np.zeros(n, int), np.zeros((n, 6), complex))
+    assert loci_curves([locus]) != {}  # 1e-6 m of slack: kept
+    assert loci_curves([locus], np.full(6, 1e-6)) == {}
+    big = dataclasses.replace(locus, state_max=state_max * 1e6, state_min=state_min * 1e6)
+    assert loci_curves([big]) == {}
