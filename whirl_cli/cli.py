@@ -100,7 +100,8 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
             with held_signals():
                 if not keep_runs:
                     shutil.rmtree(workroot, ignore_errors=True)
-        published = publish_study(result, output, study.plots if plots else (), overwrite)
+        published = publish_study(result, output, study.plots if plots else (), overwrite,
+                                  state=study.plot_state)
     for path in published.paths:
         console.print(f"wrote {path}", soft_wrap=True)
     found = verdict(result, published.plot_error)
@@ -192,9 +193,12 @@ def generate(check: bool, directory: Path) -> None:
 @cli.command()
 def models() -> None:
     """List the model variants with their states and parameters (units, defaults)."""
-    from .models import all_variants
+    from .models import FAMILIES, all_variants, get_model
 
-    click.echo("\n\n".join(model.describe() for model in all_variants()))
+    shipped = all_variants()
+    others = [get_model(name) for name in FAMILIES
+              if name not in {model.family.name for model in shipped}]
+    click.echo("\n\n".join(model.describe() for model in shipped + others))
 
 
 # ------------------------------------------------------------------------------------ plot
@@ -206,12 +210,21 @@ def models() -> None:
               help="Plot kind (repeatable) [default: all available].")
 @click.option("-o", "--output-dir", type=click.Path(file_okay=False, path_type=Path),
               help="Directory for the PNG files [default: next to RESULT_FILE].")
-def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None) -> None:
+@click.option("--state", help="State the bifurcation diagrams draw [default: the study's "
+              "plot_state, else the model's first dof].")
+def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None,
+         state: str | None) -> None:
     """Draw the plots of a whirl result file."""
     from .output import store
     from .plots.files import save_study_plots
 
     result = store.read(result_file)
+    states = {s for c in result.continuations for b in c.branches for s in b.state_names}
+    if state is None:
+        state = _stored_plot_state(result)
+    elif states and state not in states:
+        raise WhirlError(f"--state {state}: not a state of {result_file.name} (states: "
+                         f"{', '.join(sorted(states))})")
     output_dir = output_dir or result_file.parent
     try:
         output_dir.mkdir(parents=True, exist_ok=True)
@@ -219,8 +232,19 @@ def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None) -> 
         raise OutputError(f"{output_dir}: cannot create the output directory "
                           f"({error.strerror or error})") from None
     kinds = kinds or ("bifurcation", "linear", "period", "boundary")
-    for path in save_study_plots(result, kinds, output_dir, result_file.stem):
+    for path in save_study_plots(result, kinds, output_dir, result_file.stem, state):
         click.echo(f"wrote {path}")
+
+
+def _stored_plot_state(result) -> str | None:
+    """The ``plot_state`` of the study stored with ``result`` (None if unset, or if that study
+    no longer validates)."""
+    from .study import validate_text
+
+    try:
+        return validate_text(str(result.attributes.get("study_yaml", ""))).plot_state
+    except WhirlError:
+        return None
 
 
 # ------------------------------------------------------------------------------------ doctor

@@ -183,6 +183,26 @@ def test_rate_state_in_deg_per_second(continuation):
     assert ax.get_ylabel() == "dtheta (max) [deg/s]"
 
 
+def renamed(continuation: ContinuationResult, names: tuple[str, ...]) -> ContinuationResult:
+    """``continuation`` with the states named ``names`` (a model other than the classical)."""
+    return replace(continuation, branches=tuple(
+        replace(b, state_names=names, state_units=("m", "m", "m/s", "m/s"))
+        for b in continuation.branches))
+
+
+def test_first_state_by_default_any_names(continuation):
+    """No pitch/yaw names assumed: the default is the first state (the model's first dof);
+    the study names another with plot_state (files.save_study_plots' ``state``)."""
+    other = renamed(continuation, ("x", "y", "dx", "dy"))
+    ax = bifurcation_diagram(other).axes[0]
+    assert ax.get_ylabel() == "x (max) [m]"
+    np.testing.assert_allclose(np.max(np.concatenate(
+        [line.get_ydata() for line in branch_lines(ax)])), 0.4)
+    assert bifurcation_diagram(other, state="dy").axes[0].get_ylabel() == "dy (max) [m/s]"
+    with pytest.raises(WhirlError, match="state 'theta' not on branch"):
+        bifurcation_diagram(other, state="theta")
+
+
 def test_min_drawn_for_periodic_only(continuation):
     ax = bifurcation_diagram(continuation, which=("max", "min")).axes[0]
     periodic = [line for line in branch_lines(ax) if line_style(line)[0] in ("red", "blue")]
@@ -516,6 +536,28 @@ def test_phase_plane_rejects_equilibrium_branch():
     equilibrium = make_branch("main", BranchKind.EQUILIBRIUM, [0.1, 0.2], [0.0, 0.0], [1, 1])
     with pytest.raises(WhirlError):
         phase_plane(equilibrium)
+
+
+def test_phase_plane_of_the_first_two_states_any_names(orbit_branch):
+    other = replace(orbit_branch, state_names=("x", "y", "dx", "dy"),
+                    state_units=("m", "m", "m/s", "m/s"))
+    ax = phase_plane(other).axes[0]
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("x [m]", "y [m]")
+    np.testing.assert_allclose(ax.lines[1].get_ydata()[:20], other.orbits[1].states[:20, 1])
+
+
+def test_phase_labels_at_most_twelve_user_points_first(orbit_branch):
+    """A study's phase plane draws every orbit of a short family; of a long one 12: its user
+    points (orbits_at, UZ) and the others spread along the branch, first and last included."""
+    assert files.phase_labels(orbit_branch) == [3, 5]
+    orbits = tuple(replace(orbit_branch.orbits[0], label=k + 1, index=k,
+                           point_type=int(PointType.UZ) if k in (7, 8) else 0)
+                   for k in range(30))
+    long = replace(orbit_branch, orbits=orbits)
+    labels = files.phase_labels(long)
+    assert len(labels) == files.PHASE_ORBITS == 12
+    assert {8, 9} <= set(labels) and labels[0] == 1 and labels[-1] == 30
+    assert labels == sorted(labels)
 
 
 # -- save_study_plots: new kinds -----------------------------------------------------------------

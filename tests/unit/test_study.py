@@ -262,6 +262,11 @@ def test_model_validate_fills_the_same_defaults():
         ),
         ("nonlinearity:\n  dof: psi\n", "s.yaml:3: nonlinearity.type: required key is missing"),
         (
+            "plot_state: phi\n",
+            "s.yaml:3: plot_state: expected one of theta, psi, dtheta, dpsi, got 'phi'",
+        ),
+        ("plot_state: [psi]\n", "s.yaml:3: plot_state: expected a string, got a list"),
+        (
             "nonlinearity: {type: linear, K2: 1}\n",
             "s.yaml:3: nonlinearity.K2: unknown key (allowed: type, dof)",
         ),
@@ -272,7 +277,7 @@ def test_model_validate_fills_the_same_defaults():
         (
             "grid: {x: 1}\n",
             "s.yaml:3: grid: unknown key (allowed: name, description, model, parameters, "
-            "nonlinearity, continuations, linear, plots, cross_check, auto)",
+            "nonlinearity, continuations, linear, plots, plot_state, cross_check, auto)",
         ),
         ("linear: {grid: 1}\n", "s.yaml:3: linear.grid: expected a mapping, got 1"),
         ("linear: {table: 1}\n",
@@ -643,7 +648,7 @@ def test_schema_reference_lists_every_key_with_a_description():
     assert lines[0] == "| Key | Type | Default | Description |"
     rows = {line.split("|")[1].strip().strip("`"): line for line in lines[2:]}
     expected = {"name", "description", "model", "parameters", "nonlinearity", "continuations",
-                "linear", "plots", "cross_check", "auto", "nonlinearity[].type",
+                "linear", "plots", "plot_state", "cross_check", "auto", "nonlinearity[].type",
                 "nonlinearity[].dof", "nonlinearity[].K2", "nonlinearity[].K3", "linear.sweeps",
                 "linear.sweeps[].parameter", "linear.sweeps[].range", "linear.sweeps[].points",
                 "linear.grid", "linear.grid.x", "linear.grid.y"}

@@ -191,10 +191,12 @@ LOCUS_NAMES = {
 }
 
 
-def loci_curves(curves: list[Branch]) -> dict[str, list[np.ndarray]]:
+def loci_curves(curves: list[Branch], amplitudes: np.ndarray | float = 1.0
+                ) -> dict[str, list[np.ndarray]]:
     """Locus curves by name. Hopf and fold-of-cycles loci count only where they concern the
-    undeflected equilibrium and its flutter (orbits centred on y = 0): other stretches (the
-    secondary equilibria, asymmetric cycles) are cut out."""
+    undeflected equilibrium and its flutter (orbits centred on y = 0 within 2 % of their size
+    and 1e-6 ``amplitudes``, each state's typical amplitude): other stretches (the secondary
+    equilibria, asymmetric cycles) are cut out."""
     found: dict[str, list[np.ndarray]] = {}
     for curve in curves:
         name = LOCUS_NAMES[curve.kind]
@@ -202,7 +204,7 @@ def loci_curves(curves: list[Branch]) -> dict[str, list[np.ndarray]]:
         if name in ("hopf", "fold_of_cycles"):  # centred within 2 % of the orbit's size
             centre = np.abs(0.5 * (curve.state_max + curve.state_min))
             size = 0.5 * (curve.state_max - curve.state_min)
-            keep = np.all(centre <= 0.02 * size + 1e-6, axis=1)
+            keep = np.all(centre <= 0.02 * size + 1e-6 * np.asarray(amplitudes), axis=1)
         cuts = np.flatnonzero(np.diff(keep.astype(int))) + 1
         for part in np.split(np.arange(len(curve)), cuts):
             if keep[part[0]] and len(part) >= 2:
@@ -225,7 +227,7 @@ def boundary(name: str, model: Model, overrides: dict[str, float], pair: tuple[s
 
     intervals: list[UnsafeInterval] = []
     if method == "loci":
-        curves_by_name = loci_curves(curves)
+        curves_by_name = loci_curves(curves, np.tile([d.amplitude for d in model.dofs], 2))
         rows = sorted(set(np.linspace(*bounds[second], resolution).tolist()) | set(slices))
         for value in rows:
             intervals += unsafe_from_loci(curves_by_name, stable(value), value, minimum)

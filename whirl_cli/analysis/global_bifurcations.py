@@ -156,8 +156,10 @@ def fit_blowup(parameter: np.ndarray, period: np.ndarray, unstable_rate: float |
                      tuple(sorted((float(p[-1]), log_star))))
 
 
-def equilibria_at(value: float, equilibria: list[Branch]) -> list[np.ndarray]:
-    """States (SI) of every computed equilibrium at parameter ``value``, by interpolation."""
+def equilibria_at(value: float, equilibria: list[Branch], amplitudes: np.ndarray | float = 1.0
+                  ) -> list[np.ndarray]:
+    """States (SI) of every computed equilibrium at parameter ``value``, by interpolation;
+    states within 1e-6 ``amplitudes`` (each state's typical amplitude) count once."""
     found = []
     for branch in equilibria:
         if branch.kind != BranchKind.EQUILIBRIUM or len(branch) < 2:
@@ -168,7 +170,8 @@ def equilibria_at(value: float, equilibria: list[Branch]) -> list[np.ndarray]:
                 continue
             w = (value - p[k]) / (p[k + 1] - p[k])
             state = (1 - w) * branch.state_max[k] + w * branch.state_max[k + 1]
-            if not any(np.allclose(state, s, atol=1e-6) for s in found):
+            if not any(np.allclose(state / amplitudes, s / amplitudes, atol=1e-6)
+                       for s in found):
                 found.append(state)
     return found
 
@@ -205,7 +208,9 @@ def analyse(family: Branch, model: Model, parameters: dict[str, float],
     value = float(family.parameters[last, 0])
     params = model.parameter_vector({**parameters, name: value})
     orbit = max(family.orbits, key=lambda o: o.period) if family.orbits else None
-    near = lingering(model, orbit.states, equilibria_at(value, equilibria)) if orbit else []
+    amplitudes = np.tile([dof.amplitude for dof in model.dofs], 2)
+    near = lingering(model, orbit.states, equilibria_at(value, equilibria, amplitudes)) \
+        if orbit else []
     saddles = [(s, unstable_rate(model, params, s)) for s in near]
     saddles = [(s, rate) for s, rate in saddles if rate > 0]
     if len(saddles) >= 2:

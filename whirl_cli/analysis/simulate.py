@@ -2,10 +2,12 @@
 model: the independent check of what continuation claims.
 
 * A stable periodic orbit: started on AUTO's orbit, the simulation must stay on it (the maximum
-  of the law's degree of freedom over the last periods within ``tolerance`` of AUTO's).
-* A stable equilibrium: a small perturbation must decay.
+  of the dof that moves most, relative to its typical amplitude, over the last periods within
+  ``tolerance`` of AUTO's).
+* A stable equilibrium: a small perturbation of every dof must decay.
 
-Time in seconds, states in SI units (rad, rad/s), as everywhere outside AUTO.
+Time in seconds, states in SI units (the classical model's rad, rad/s), as everywhere outside
+AUTO; perturbations and deviations of equilibria in units of the dofs' typical amplitudes.
 """
 
 from __future__ import annotations
@@ -69,15 +71,15 @@ def check_orbit(model: Model, overrides: dict[str, float], branch: Branch, orbit
 
 def check_equilibrium(model: Model, overrides: dict[str, float], branch: Branch, index: int,
                       perturbation: float = 1e-4) -> CrossCheck:
-    """Perturb the angles of a stable equilibrium by ``perturbation`` rad (at most 0.1 % of its
-    deflection: the basin is tiny next to a pitchfork) and simulate T = ten slowest decay
-    times 1/sigma (sigma = -max Re lambda of the Jacobian), at most 60 s. For the linearised
-    motion the largest angle deviation left is at most kappa sqrt(m) e^(-sigma T) times the
-    perturbation (||e^(J T)|| <= kappa e^(-sigma T), kappa the condition number of the
-    eigenvector matrix: the non-normal transient; m angles perturbed). The check passes if it
-    is below
+    """Perturb every dof of a stable equilibrium by ``perturbation`` typical amplitudes (rad for
+    the classical model; at most 0.1 % of its deflection: the basin is tiny next to a
+    pitchfork) and simulate T = ten slowest decay times 1/sigma (sigma = -max Re lambda of
+    the Jacobian), at most 60 s. For the linearised motion the largest dof deviation left is
+    at most kappa sqrt(m) e^(-sigma T) times the perturbation (||e^(J T)|| <= kappa
+    e^(-sigma T), kappa the condition number of the eigenvector matrix: the non-normal
+    transient; m dofs perturbed). The check passes if it is below
 
-        min(2 kappa sqrt(m) e^(-sigma T), 0.1) * perturbation + 1e-8 rad,
+        min(2 kappa sqrt(m) e^(-sigma T), 0.1) * perturbation + 1e-8 (typical amplitudes),
 
     e^(-sigma T) = e^-10 unless T is capped. The factor 2 leaves room for the nonlinear terms,
     which the default perturbation keeps small also two steps from a fold of equilibria (where

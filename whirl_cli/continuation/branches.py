@@ -54,9 +54,20 @@ def special_points(branch: Branch, skip_first: bool = False) -> list[SpecialPoin
     return found
 
 
-def _same_point(a: SpecialPoint, b: SpecialPoint, width: float) -> bool:
+def typical_amplitudes(model: Model) -> np.ndarray:
+    """(n,) the typical amplitude of each state's dof (a rate shares its dof's, per second):
+    SI states divided by it are in units of typical amplitudes, for tolerances that hold for
+    any unit (rad for the classical model, where it is 1)."""
+    amplitudes = np.array([dof.amplitude for dof in model.dofs], dtype=float)
+    return np.concatenate([amplitudes, amplitudes])
+
+
+def _same_point(a: SpecialPoint, b: SpecialPoint, width: float,
+                amplitudes: np.ndarray) -> bool:
+    """Within 1e-5 of the range in the parameter and 1e-5 typical amplitudes (``amplitudes``:
+    :func:`typical_amplitudes`) or 1e-4 relative in every state."""
     return (abs(a.parameters[0] - b.parameters[0]) <= 1e-5 * width
-            and np.allclose(a.state, b.state, atol=1e-5, rtol=1e-4))
+            and np.allclose(a.state / amplitudes, b.state / amplitudes, atol=1e-5, rtol=1e-4))
 
 
 def _joined(*notes: str) -> str:

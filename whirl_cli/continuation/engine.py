@@ -27,7 +27,8 @@ class Numerics:
     """Resolved AUTO numerics under readable names (study ``auto:`` keys override them).
 
     Step sizes are fractions of the width of the continuation range, so one set of defaults
-    serves every parameter (the model's time is non-dimensional, see ``models/base.py``).
+    serves every parameter (the model's time and states are non-dimensional, see
+    :mod:`whirl_cli.models.variant`).
     """
 
     max_steps: int = 2000  # NMX
@@ -39,7 +40,7 @@ class Numerics:
     newton_max_iterations: int = 7  # ITNW
     tolerance: float = 1e-8  # EPSL = EPSU
     timeout: float = 120.0  # s per AUTO run
-    max_amplitude: float = 1.5  # rad: branches stop when an angle exceeds it
+    max_amplitude: float = 1.5  # branches stop when a dof exceeds it (typical amplitudes)
     orbits_at: tuple[float, ...] = ()  # parameter values with a labelled solution (UZR)
 
     @classmethod

@@ -13,7 +13,7 @@ import numpy as np
 from ..auto.constants import base_constants, par_layout
 from ..models import Model
 from ..results import Branch, BranchKind, PointType, SpecialPoint
-from .branches import _same_point
+from .branches import _same_point, typical_amplitudes
 from .engine import Engine, Numerics, RunSpec, _run_branches
 
 #: How deep branch switching recurses (main -> secondary -> tertiary).
@@ -21,12 +21,12 @@ MAX_SWITCH_DEPTH = 3
 
 
 def _stops(model: Model, parameter: str, bounds: tuple[float, float], amplitude: float) -> dict:
-    """UZSTOP: the range ends, and every dof at +/- ``amplitude`` (in the dof's unit; AUTO's
-    PVLS values are in units of the dof's typical amplitude)."""
+    """UZSTOP: the range ends, and every dof at +/- ``amplitude`` in units of its typical
+    amplitude (AUTO's PVLS values are in those units: for the classical model rad)."""
     stops: dict = {parameter: [float(bounds[0]), float(bounds[1])]}
     for dof in model.dofs:
-        stops[f"max_{dof.name}"] = amplitude / dof.amplitude
-        stops[f"min_{dof.name}"] = -amplitude / dof.amplitude
+        stops[f"max_{dof.name}"] = float(amplitude)
+        stops[f"min_{dof.name}"] = -float(amplitude)
     return stops
 
 
@@ -57,6 +57,7 @@ def equilibria(engine: Engine, name: str, parameter: str, start: float,
     model = engine.model
     lower, upper = bounds
     width = upper - lower
+    amplitudes = typical_amplitudes(model)
     start_parameters = {**parameters, parameter: float(start)}
     specs = []
     for direction, label in ((-1, "down"), (1, "up")):
@@ -79,7 +80,7 @@ def equilibria(engine: Engine, name: str, parameter: str, start: float,
         todo = []
         for point in frontier:
             if point.point_type != PointType.BP or any(
-                    _same_point(point, done, width) for done in switched):
+                    _same_point(point, done, width, amplitudes) for done in switched):
                 continue
             switched.append(point)
             source = _run_of(branches, point.branch)
@@ -94,11 +95,11 @@ def equilibria(engine: Engine, name: str, parameter: str, start: float,
                     f"BP at {parameter} = {point.parameters[0]:.6g} on {point.branch}",
                     (parameter,), restart=(source, point.label)))
         frontier = [p for p in _run_branches(engine, todo, branches, points, skip_first=True)
-                    if not any(_same_point(p, q, width) for q in switched)]
+                    if not any(_same_point(p, q, width, amplitudes) for q in switched)]
 
     unique: list[SpecialPoint] = []
     for point in points:
-        if not any(point.point_type == q.point_type and _same_point(point, q, width)
+        if not any(point.point_type == q.point_type and _same_point(point, q, width, amplitudes)
                    for q in unique):
             unique.append(point)
     return branches, unique

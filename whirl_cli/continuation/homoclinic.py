@@ -13,7 +13,7 @@ from ..auto.constants import base_constants
 from ..auto.parse import parse_b
 from ..models import Model
 from ..results import Branch, SpecialPoint
-from .branches import _joined
+from .branches import _joined, typical_amplitudes
 from .engine import Engine, RunSpec
 
 #: HomCont: a homoclinic orbit counts as located when the principal parameter varies by less
@@ -77,8 +77,10 @@ def _homoclinic_run(engine: Engine, name: str, family: Branch, point: SpecialPoi
     if not labelled:
         return "HomCont not tried: no stored orbit"
     row = max(labelled, key=lambda k: family.period[k])
-    if model.symmetric and np.allclose(family.state_max[row], -family.state_min[row],
-                                       rtol=1e-6, atol=1e-9):
+    amplitudes = typical_amplitudes(model)
+    if model.symmetric and np.allclose(family.state_max[row] / amplitudes,
+                                       -family.state_min[row] / amplitudes, rtol=1e-6,
+                                       atol=1e-9):
         return "HomCont not tried: the orbit is symmetric and passes the saddle twice per period"
     saddle_params = model.parameter_vector({**parameters, parameter: point.parameters[0]})
     n_unstable = int((np.linalg.eigvals(model.jacobian_numpy(point.state, saddle_params)).real

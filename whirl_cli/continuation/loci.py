@@ -12,7 +12,7 @@ from ..auto import runner
 from ..auto.constants import par_layout
 from ..models import Model
 from ..results import Branch, BranchKind, ContinuationResult, PointType, SpecialPoint
-from .branches import _same_point, head, join, special_points
+from .branches import _same_point, head, join, special_points, typical_amplitudes
 from .engine import Engine, Numerics, RunSpec, _read
 from .equilibria import equilibrium_constants
 from .geometry import _at_range_edge, _chunk_used, _closed, _near_polyline, _on_curve
@@ -54,6 +54,7 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
     first, second = pair
     wanted = {kind for kind, (locus, _) in LOCI.items() if locus in loci}
     periodic = PointType.LPC in wanted
+    amplitudes = typical_amplitudes(engine.model)
     branches: list[Branch] = []
     points: list[SpecialPoint] = []
     starts: list[tuple[SpecialPoint, str]] = []
@@ -69,7 +70,8 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
             points.append(named)
             width = bounds[first][1] - bounds[first][0]
             if point.point_type in wanted and point.status == "located" and not any(
-                    point.point_type == other.point_type and _same_point(named, other, width)
+                    point.point_type == other.point_type
+                    and _same_point(named, other, width, amplitudes)
                     for other, _ in starts):
                 starts.append((named, runs[point.branch]))
     curves = _loci(engine, name, pair, bounds, numerics, starts)

@@ -176,8 +176,9 @@ def _assemble(family: _Family, hopfs: list[SpecialPoint], width: float,
 def _first_return(branch: Branch, hopfs: list[SpecialPoint], width: float,
                   scale: np.ndarray) -> int | None:
     """First row where a grown family has shrunk back onto a Hopf point (AUTO may pass
-    through a Hopf point without stopping there and go round the family again)."""
-    size = ((branch.state_max - branch.state_min) / 2).max(axis=1)
+    through a Hopf point without stopping there and go round the family again). Sizes are in
+    AUTO's units (``scale``), so that no dof counts more for its unit."""
+    size = ((branch.state_max - branch.state_min) / (2 * scale)).max(axis=1)
     grown = np.flatnonzero(size > 0.5 * size.max())
     if not len(grown):
         return None
@@ -279,9 +280,9 @@ def _periodic_end(family: Branch, model: Model, hopfs: list[SpecialPoint],
         return "period cap", None
     if min(abs(value - bounds[0]), abs(value - bounds[1])) < 1e-6 * width:
         return "range", None
-    dofs = list(range(len(model.dofs)))
-    reach = np.abs(np.concatenate([family.state_max[-1, dofs],
-                                   family.state_min[-1, dofs]])).max()
+    dofs = len(model.dofs)  # in units of their typical amplitudes, as the UZSTOP bound
+    reach = (np.abs(np.concatenate([family.state_max[-1, :dofs], family.state_min[-1, :dofs]]))
+             / np.tile(scale[:dofs], 2)).max()
     if reach >= 0.999 * numerics.max_amplitude:
         return "amplitude bound", None
     if len(state.pieces) >= MAX_SEGMENTS:

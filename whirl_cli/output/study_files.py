@@ -44,16 +44,17 @@ class Published:
 
 
 def publish_study(result: StudyResult, output: Path, kinds: Sequence[str],
-                  overwrite: bool = False) -> Published:
+                  overwrite: bool = False, state: str | None = None) -> Published:
     """Write ``result`` to ``output`` and its plots of ``kinds`` next to it (``<output
-    stem>_*.png``), as one unit; see the module doc."""
+    stem>_*.png``; bifurcation diagrams of ``state``, None: the first dof), as one unit; see
+    the module doc."""
     output = Path(output)
     plots, plot_error = [], ""
     if kinds:
         from ..plots.files import render_study_plots
 
         try:
-            plots = render_study_plots(result, tuple(kinds), output.stem)
+            plots = render_study_plots(result, tuple(kinds), output.stem, state)
         except Exception as error:  # a bug in drawing: keep the result, say what went wrong
             plot_error = f"plots: {type(error).__name__}: {error}"
     targets = [output.parent / name for name, _ in plots]
@@ -81,12 +82,14 @@ def publish_study(result: StudyResult, output: Path, kinds: Sequence[str],
     return Published(tuple(written), plot_error)
 
 
-def publish_plots(output: Path, kinds: Sequence[str]) -> tuple[Path, ...]:
+def publish_plots(output: Path, kinds: Sequence[str], state: str | None = None
+                  ) -> tuple[Path, ...]:
     """Draw the plots of ``kinds`` of the existing result ``output`` next to it (replacing
-    files of the same names): how a sweep completes an up-to-date study's plots."""
+    files of the same names; ``state`` as for :func:`publish_study`): how a sweep completes an
+    up-to-date study's plots."""
     from ..plots.files import render_study_plots
 
-    rendered = render_study_plots(store.read(output), tuple(kinds), Path(output).stem)
+    rendered = render_study_plots(store.read(output), tuple(kinds), Path(output).stem, state)
     with held_signals():
         return tuple(atomic.publish(data, Path(output).parent / name, True, what="the plot")
                      for name, data in rendered)

@@ -35,10 +35,13 @@ _GLOBAL_POINTS = (PointType.HOMOCLINIC, PointType.HETEROCLINIC)
 _LOG_SPAN = 20.0  # period plots switch to a log y-axis above this max/min ratio
 
 
-def bifurcation_diagram(continuation: ContinuationResult, state: str = "theta",
+def bifurcation_diagram(continuation: ContinuationResult, state: str | None = None,
                         which: Sequence[str] = ("max",), ax: Axes | None = None,
                         degrees: bool = True) -> Figure:
     """One-parameter bifurcation diagram: ``state`` against each branch's principal parameter.
+
+    ``state``: a state name of the branches; None: the first state of the first plotted branch
+    (the model's first degree of freedom).
 
     Equilibrium and periodic branches are drawn (other kinds, e.g. loci, are skipped) with
     y = max of ``state`` over the orbit (the state itself for equilibria), and for periodic
@@ -48,7 +51,7 @@ def bifurcation_diagram(continuation: ContinuationResult, state: str = "theta",
     parameter keeps its SI unit. Draws on ``ax`` if given, else on a new figure; returns the
     figure. The legend lists only styles present; the title is the continuation's name.
     """
-    which, branches = _checked_branches(continuation, state, which)
+    which, branches, state = _checked_branches(continuation, state, which)
     if ax is None:
         ax = _new_figure().add_subplot()
     handles, labels = _draw_bifurcation(ax, continuation, branches, state, which, degrees)
@@ -58,18 +61,21 @@ def bifurcation_diagram(continuation: ContinuationResult, state: str = "theta",
     return ax.figure
 
 
-def _checked_branches(continuation: ContinuationResult, state: str, which: Sequence[str]
-                      ) -> tuple[tuple[str, ...], list[Branch]]:
-    """``which`` as a tuple and the plotted branches; WhirlError if either argument is bad."""
+def _checked_branches(continuation: ContinuationResult, state: str | None,
+                      which: Sequence[str]) -> tuple[tuple[str, ...], list[Branch], str]:
+    """``which`` as a tuple, the plotted branches and the state drawn (``state``, or the first
+    state of the first plotted branch if None); WhirlError if an argument is bad."""
     which = tuple(which)
     if not which or not set(which) <= {"max", "min"}:
         raise WhirlError(f"which must be a non-empty subset of ('max', 'min'), got {which}")
     branches = [b for b in continuation.branches if b.kind in _PLOTTED_KINDS]
+    if state is None:
+        state = branches[0].state_names[0] if branches else ""
     for branch in branches:
         if state not in branch.state_names:
             raise WhirlError(f"state {state!r} not on branch {branch.name!r} "
                              f"(states: {', '.join(branch.state_names)})")
-    return which, branches
+    return which, branches, state
 
 
 def _draw_bifurcation(ax: Axes, continuation: ContinuationResult, branches: list[Branch],
@@ -206,9 +212,11 @@ def _period_points(continuation: ContinuationResult, periodic: list[Branch]
     return points, brackets
 
 
-def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str = "theta",
-                y: str = "psi", degrees: bool = True, ax: Axes | None = None) -> Figure:
-    """Stored orbits of a periodic branch as closed curves of state ``y`` against state ``x``.
+def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str | None = None,
+                y: str | None = None, degrees: bool = True, ax: Axes | None = None) -> Figure:
+    """Stored orbits of a periodic branch as closed curves of state ``y`` against state ``x``
+    (None: the branch's first and second state, i.e. the model's first two degrees of freedom,
+    or a single dof and its rate).
 
     All of ``branch.orbits`` if ``labels`` is None, else those with these AUTO labels (in the
     order given). Each curve is closed (its first point repeated at the end unless already
@@ -221,6 +229,8 @@ def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str = "t
     """
     if not branch.is_periodic:
         raise WhirlError(f"branch {branch.name!r} is {branch.kind}, not periodic: no orbits")
+    x = branch.state_names[0] if x is None else x
+    y = branch.state_names[1] if y is None else y
     for name in (x, y):
         if name not in branch.state_names:
             raise WhirlError(f"state {name!r} not on branch {branch.name!r} "

@@ -9,8 +9,10 @@ import re
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from ..errors import OutputError, WhirlError
-from ..results import Branch, ContinuationResult, StudyResult
+from ..results import Branch, ContinuationResult, PointType, StudyResult
 from .diagrams import bifurcation_diagram, period_plot, phase_plane, projections_figure
 from .key import _PLOTTED_KINDS
 from .linear import linear_sweep_plot
@@ -22,28 +24,34 @@ if TYPE_CHECKING:
 PLOT_KINDS = ("bifurcation", "linear", "projections", "period", "phase", "boundary")
 """Kinds accepted by :func:`save_study_plots`."""
 
+PHASE_ORBITS = 12
+"""Most orbits a study's phase-plane figure draws (a long family stores one every 20 steps)."""
+
 
 def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path, stem: str,
-                     state: str = "theta", dpi: int = 150) -> list[Path]:
+                     state: str | None = None, dpi: int = 150) -> list[Path]:
     """Write a study's figures as PNG files into ``out_dir``; return the paths, sorted.
 
     ``kinds`` (any of :data:`PLOT_KINDS`):
 
     * "bifurcation" -> ``<stem>_<continuation>_bifurcation.png`` per one-parameter continuation
-      (``state`` vs the principal parameter, angles in degrees; the first state if the branches
-      have no ``state``);
+      (``state`` vs the principal parameter, angles in degrees; ``state`` None: the first
+      state, i.e. the model's first degree of freedom);
     * "projections" -> ``<stem>_<continuation>_projections.png`` per one-parameter continuation
       (:func:`projections_figure`);
     * "period" -> ``<stem>_<continuation>_period.png`` per continuation with a periodic branch
       (:func:`period_plot`);
     * "phase" -> ``<stem>_<continuation>_<branch>_phase.png`` per periodic branch with stored
-      orbits (:func:`phase_plane`, psi vs theta, or the branch's first two states);
+      orbits (:func:`phase_plane` of the branch's first two states, i.e. the model's first two
+      dofs: psi vs theta for the classical model; at most :data:`PHASE_ORBITS` orbits, those
+      stored at ``orbits_at`` values first, the others spread along the branch);
     * "linear" -> ``<stem>_linear_<parameter>.png`` per linear sweep;
     * "boundary" -> per boundary of ``result.boundaries``: ``<stem>_<boundary>_boundary.png``
       (:func:`boundary_plot` with ``result.linear_grid`` if it is over the same parameters, the
       slices as cases) and ``<stem>_<boundary>_slice_<k>_overhang.png`` per slice k
       (:func:`overhang_diagram` of the two-parameter continuation named like the boundary, or
-      of no branches if there is none); without boundaries but with a linear grid,
+      of no branches if there is none; ``state`` as for "bifurcation"); without boundaries but
+      with a linear grid,
       ``<stem>_linear_grid.png`` (the grid alone).
 
     Names are made filesystem-safe; repeats get ``_2``, ``_3``, ... (:func:`plot_names`).
@@ -64,20 +72,20 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
 
 
 def plot_names(result: StudyResult, kinds: tuple[str, ...], stem: str,
-               state: str = "theta") -> list[str]:
+               state: str | None = None) -> list[str]:
     """The file names :func:`save_study_plots` writes for ``result`` (in drawing order),
     found without drawing anything."""
     return [name for name, _ in _named_jobs(result, kinds, stem, state)]
 
 
 def render_study_plots(result: StudyResult, kinds: tuple[str, ...], stem: str,
-                       state: str = "theta", dpi: int = 150) -> list[tuple[str, bytes]]:
+                       state: str | None = None, dpi: int = 150) -> list[tuple[str, bytes]]:
     """(file name, PNG bytes) of every figure of :func:`save_study_plots`, rendered in
     memory; nothing is written."""
     return [(name, _png(make(), dpi)) for name, make in _named_jobs(result, kinds, stem, state)]
 
 
-def _named_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: str):
+def _named_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: str | None):
     """(unique filesystem-safe file name, figure factory) pairs of the requested kinds."""
     unknown = set(kinds) - set(PLOT_KINDS)
     if unknown:
@@ -91,7 +99,8 @@ def _named_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: s
     return jobs
 
 
-def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: str):
+def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str,
+                 state: str | None):
     """(file name, figure factory) pairs for the requested kinds, in a stable order."""
     jobs = []
     if "bifurcation" in kinds:
@@ -114,9 +123,8 @@ def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: 
         for continuation in result.continuations:
             for branch in continuation.branches:
                 if branch.is_periodic and branch.orbits and len(branch.state_names) >= 2:
-                    x, y = _phase_states(branch)
                     jobs.append((f"{stem}_{continuation.name}_{branch.name}_phase.png",
-                                 lambda b=branch, x=x, y=y: phase_plane(b, x=x, y=y)))
+                                 lambda b=branch: phase_plane(b, labels=phase_labels(b))))
     if "linear" in kinds:
         for sweep in result.linear_sweeps:
             jobs.append((f"{stem}_linear_{sweep.parameter}.png",
@@ -126,7 +134,7 @@ def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: 
     return jobs
 
 
-def _boundary_jobs(result: StudyResult, stem: str, state: str):
+def _boundary_jobs(result: StudyResult, stem: str, state: str | None):
     """(file name, figure factory) pairs of the "boundary" kind."""
     grid = result.linear_grid
     if not result.boundaries:
@@ -150,19 +158,28 @@ def _boundary_jobs(result: StudyResult, stem: str, state: str):
     return jobs
 
 
-def _phase_states(branch: Branch) -> tuple[str, str]:
-    """("theta", "psi") if the branch has both, else its first two states."""
-    if {"theta", "psi"} <= set(branch.state_names):
-        return "theta", "psi"
-    return branch.state_names[0], branch.state_names[1]
+def phase_labels(branch: Branch, most: int = PHASE_ORBITS) -> list[int]:
+    """Labels of the orbits a study's phase plane of ``branch`` draws, in branch order: all of
+    them if there are at most ``most``; else every orbit stored at an ``orbits_at`` value (UZ)
+    and, up to ``most`` in all, others evenly spread along the branch (first and last
+    included)."""
+    orbits = sorted(branch.orbits, key=lambda o: o.index)
+    if len(orbits) <= most:
+        return [o.label for o in orbits]
+    asked = [o for o in orbits if o.point_type == PointType.UZ]
+    others = [o for o in orbits if o.point_type != PointType.UZ]
+    room = max(most - len(asked), 0)
+    picks = np.unique(np.linspace(0, len(others) - 1, room).round().astype(int)) if room else []
+    chosen = {id(o) for o in asked} | {id(others[k]) for k in picks}
+    return [o.label for o in orbits if id(o) in chosen]
 
 
-def _state_for(continuation: ContinuationResult, state: str) -> str:
-    """``state`` if every plotted branch has it, else the first branch's first state."""
+def _state_for(continuation: ContinuationResult, state: str | None) -> str | None:
+    """``state`` if every plotted branch has it, else None (the first state)."""
     branches = [b for b in continuation.branches if b.kind in _PLOTTED_KINDS]
-    if not branches or all(state in b.state_names for b in branches):
+    if state is None or not branches or all(state in b.state_names for b in branches):
         return state
-    return branches[0].state_names[0]
+    return None
 
 
 def _safe_name(name: str) -> str:

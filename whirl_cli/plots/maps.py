@@ -199,8 +199,9 @@ def slice_index(boundary: Boundary, slice_value: float) -> int:
 
 
 def overhang_diagram(continuation: ContinuationResult, boundary: Boundary | None,
-                     slice_value: float, state: str = "theta", which: Sequence[str] = ("max",),
-                     ax: Axes | None = None, degrees: bool = True) -> Figure:
+                     slice_value: float, state: str | None = None,
+                     which: Sequence[str] = ("max",), ax: Axes | None = None,
+                     degrees: bool = True) -> Figure:
     """Bifurcation diagram of one slice with its unsafe (overhang) intervals shaded.
 
     For a two-parameter ``continuation`` the diagram is :func:`bifurcation_diagram` of
@@ -219,7 +220,7 @@ def overhang_diagram(continuation: ContinuationResult, boundary: Boundary | None
         diagram = slice_continuation(continuation, slice_index(boundary, slice_value))
     else:
         diagram = continuation
-    which, branches = _checked_branches(diagram, state, which)
+    which, branches, state = _checked_branches(diagram, state, which)
     if ax is None:
         ax = _new_figure().add_subplot()
     handles, labels = _draw_bifurcation(ax, diagram, branches, state, which, degrees)

@@ -5,7 +5,8 @@ study may use (:class:`~whirl_cli.study.resolve.Names`), law coefficients only u
 ``nonlinearity``, each law on a dof of the model and each dof with at most one law (every law
 of a list naming its dof), a parameter given once, values and ranges inside the physical
 bounds, unique
-continuation names, ``start``, ``slices`` and ``orbits_at`` inside ``range``.
+continuation names, ``start``, ``slices`` and ``orbits_at`` inside ``range``, ``plot_state`` a
+state of the model.
 """
 
 from __future__ import annotations
@@ -40,6 +41,7 @@ def _meaning_problems(data: dict) -> list[Problem]:
         return []
     values = _study_values(data, names)
     problems = _override_problems(data.get("parameters"), names, family)
+    problems += _plot_state_problems(data.get("plot_state"), family)
     for loc, block in law_blocks(data):
         if not isinstance(block, dict):
             continue
@@ -87,6 +89,15 @@ def _law_problems(data: dict, family: str) -> list[Problem]:
         else:
             seen[dof] = loc
     return problems
+
+
+def _plot_state_problems(state: Any, family: str) -> list[Problem]:
+    """``plot_state`` a state of the model: a dof or a rate."""
+    dofs = FAMILIES[family].dofs
+    states = [d.name for d in dofs] + [d.rate for d in dofs]
+    if not isinstance(state, str) or state in states:
+        return []
+    return [(("plot_state",), _choice_reason(states, repr(state)))]
 
 
 def _sweep_problems(loc: Loc, spec: dict, names: Names, family: str) -> list[Problem]:

@@ -345,7 +345,8 @@ class AutoSettings(_Strict):
     )
     timeout: Positive | None = Field(None, description="Wall-clock limit per AUTO run, s, > 0.")
     max_amplitude: Positive | None = Field(
-        None, description="Amplitude at which branches are stopped, rad, > 0."
+        None, description="Amplitude at which branches are stopped, in units of each dof's "
+        "typical amplitude (`whirl models` lists them; classical: 1 rad), > 0."
     )
 
 
@@ -379,6 +380,12 @@ class Study(_Strict):
     )
     plots: tuple[PlotKind, ...] = Field(
         ("bifurcation",), description="Figures drawn after the runs."
+    )
+    plot_state: Text | None = Field(
+        None,
+        description="State the bifurcation diagrams draw (`bifurcation`, and the slices of "
+        "`boundary`): a dof or a rate of the model (`whirl models` lists them, e.g. `psi`, "
+        "`dq2`). Unset: the model's first dof (classical: `theta`).",
     )
     cross_check: Boolean = Field(
         False,

@@ -167,7 +167,7 @@ def _store(item: SweepItem, future: Future, plots: bool) -> Outcome:
     auto_seconds = sum(r.wall_seconds for r in result.runs)
     try:
         published = publish_study(result, item.output, item.study.plots if plots else (),
-                                  overwrite=True)
+                                  overwrite=True, state=item.study.plot_state)
     except Exception as error:  # e.g. a result the store cannot represent: go on
         return Outcome(item, "error", (f"writing {item.output}: {type(error).__name__}: "
                                        f"{error}", *verdict(result).problems), auto_seconds,
@@ -181,7 +181,7 @@ def _complete_plots(item: SweepItem) -> Outcome:
     """Draw the missing plots of an up-to-date study from its stored result."""
     assert item.output is not None and item.study is not None
     try:
-        written = publish_plots(item.output, item.study.plots)
+        written = publish_plots(item.output, item.study.plots, item.study.plot_state)
     except Exception as error:  # the result file stands; say what went wrong with plots
         return Outcome(item, "error", (f"plots: {type(error).__name__}: {error}",
                                        *item.stored_problems))
