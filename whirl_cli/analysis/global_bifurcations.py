@@ -8,12 +8,15 @@ its last stored orbit profile this module
   (symmetric model) -> heteroclinic;
 * estimates p* with the saddle scaling law T = C - ln|p - p*| / lambda_u (lambda_u: the saddle's
   unstable eigenvalue, 1/s) and with the simpler fit T = A / |p* - p| + B, each by a scan of p*
-  (the other coefficients are linear) over the last points with T > 2 T_Hopf; or, where the
+  (the other coefficients are linear) over the last points with T > 2 T_ref; or, where the
   parameter turns there (snaking near a saddle-focus; the family is continued until it has
   turned :data:`BRACKET_TURNS` times), brackets p* by the last two turns and estimates it by
   Aitken's delta-squared extrapolation of the last three;
 * returns a special point of type HOMOCLINIC or HETEROCLINIC with status "bracketed": the
   estimate, the bracket [last computed value, estimate] and the relative rms fit residual.
+
+T_ref, the reference period, is the period of the family's start: its Hopf point's, or that of
+the orbit it was started from.
 """
 
 from __future__ import annotations
@@ -25,7 +28,7 @@ import numpy as np
 from ..models import Model
 from ..results import Branch, BranchKind, PointType, SpecialPoint
 
-#: A family is in blow-up when its period exceeds this multiple of the Hopf period.
+#: A family is in blow-up when its period exceeds this multiple of the reference period.
 BLOWUP_FACTOR = 3.0
 #: An orbit lingers near an equilibrium it passes within this fraction of its own size.
 LINGER_FRACTION = 0.05
@@ -42,10 +45,10 @@ class BlowupFit:
     bracket: tuple[float, float]  # interval holding p*
 
 
-def in_blowup(family: Branch, hopf_period: float) -> bool:
-    """True if the family's period has grown beyond BLOWUP_FACTOR times the Hopf period."""
+def in_blowup(family: Branch, reference_period: float) -> bool:
+    """True if the family's period has grown beyond BLOWUP_FACTOR times the reference period."""
     periods = family.period[np.isfinite(family.period)]
-    return bool(len(periods)) and periods.max() > BLOWUP_FACTOR * hopf_period
+    return bool(len(periods)) and periods.max() > BLOWUP_FACTOR * reference_period
 
 
 #: A family in blow-up is continued (fold by fold) until its parameter has turned this often
@@ -53,16 +56,16 @@ def in_blowup(family: Branch, hopf_period: float) -> bool:
 BRACKET_TURNS = 5
 
 
-def blowup_turns(parameter: np.ndarray, period: np.ndarray, hopf_period: float) -> int:
+def blowup_turns(parameter: np.ndarray, period: np.ndarray, reference_period: float) -> int:
     """How often the parameter reverses direction where the period exceeds twice the Hopf
     period (the turns of a snaking approach to a global bifurcation)."""
-    return len(_turning_rows(parameter, period, hopf_period))
+    return len(_turning_rows(parameter, period, reference_period))
 
 
-def _turning_rows(parameter: np.ndarray, period: np.ndarray, hopf_period: float) -> np.ndarray:
+def _turning_rows(parameter: np.ndarray, period: np.ndarray, reference_period: float) -> np.ndarray:
     """Rows where the parameter reverses direction, within the blow-up stretch (the last
-    stretch with the period above twice the Hopf period)."""
-    stretch = _stretch(period, hopf_period)
+    stretch with the period above twice the reference period)."""
+    stretch = _stretch(period, reference_period)
     p = parameter[stretch]
     steps = np.diff(p)
     moving = np.flatnonzero(steps != 0)
@@ -73,9 +76,9 @@ def _turning_rows(parameter: np.ndarray, period: np.ndarray, hopf_period: float)
     return stretch.start + moving[flips] + 1
 
 
-def _stretch(period: np.ndarray, hopf_period: float) -> slice:
-    """The last stretch of rows with the period above twice the Hopf period."""
-    above = np.isfinite(period) & (period > 2 * hopf_period)
+def _stretch(period: np.ndarray, reference_period: float) -> slice:
+    """The last stretch of rows with the period above twice the reference period."""
+    above = np.isfinite(period) & (period > 2 * reference_period)
     if not above.any():
         return slice(0, 0)
     end = int(np.flatnonzero(above)[-1]) + 1
@@ -96,9 +99,9 @@ def _extrapolated(extremes: np.ndarray) -> float:
     return float(extremes[-1] - second**2 / (second - first))
 
 
-def _tail(period: np.ndarray, hopf_period: float) -> slice:
+def _tail(period: np.ndarray, reference_period: float) -> slice:
     """The last at most 15 points of :func:`_stretch`."""
-    stretch = _stretch(period, hopf_period)
+    stretch = _stretch(period, reference_period)
     return slice(max(stretch.start, stretch.stop - 15), stretch.stop)
 
 
@@ -119,25 +122,25 @@ def _best_distance(p: np.ndarray, t: np.ndarray, basis, side: float, reach: floa
 
 
 def fit_blowup(parameter: np.ndarray, period: np.ndarray, unstable_rate: float | None,
-               hopf_period: float, width: float) -> BlowupFit | None:
+               reference_period: float, width: float) -> BlowupFit | None:
     """Fit the period growth at the end of a family (periods in s, ``unstable_rate`` in 1/s).
 
     p* is searched within ``0.1 * width`` beyond the fitted points, on either side.
     """
-    tail = _tail(period, hopf_period)
+    tail = _tail(period, reference_period)
     p, t = parameter[tail], period[tail]
     if len(p) < 4:
         return None
-    turns = _turning_rows(parameter, period, hopf_period)
+    turns = _turning_rows(parameter, period, reference_period)
     if len(turns):  # the parameter oscillates: a snaking approach (saddle-focus)
         extremes = parameter[turns]
         if len(extremes) == 1:  # one turn (AUTO stopped early): the last point stands in
-            extremes = np.append(extremes, parameter[_stretch(period, hopf_period).stop - 1])
+            extremes = np.append(extremes, parameter[_stretch(period, reference_period).stop - 1])
         low, high = sorted(float(x) for x in extremes[-2:])
         estimate = _extrapolated(extremes[-3:])
         if not low <= estimate <= high:
             estimate = 0.5 * (low + high)
-        stretch = _stretch(period, hopf_period)
+        stretch = _stretch(period, reference_period)
         return BlowupFit(estimate, estimate, float("nan"), stretch.stop - stretch.start,
                          (low, high))
     reach = max(2 * np.ptp(p), 1e-9 * width)
@@ -198,10 +201,10 @@ def unstable_rate(model: Model, params: np.ndarray, state: np.ndarray) -> float:
 
 
 def analyse(family: Branch, model: Model, parameters: dict[str, float],
-            equilibria: list[Branch], hopf_period: float, width: float
+            equilibria: list[Branch], reference_period: float, width: float
             ) -> SpecialPoint | None:
     """The global bifurcation a blowing-up family approaches, as a bracketed special point."""
-    if not in_blowup(family, hopf_period):
+    if not in_blowup(family, reference_period):
         return None
     name = family.parameter_names[0]
     last = int(np.nanargmax(family.period))
@@ -218,7 +221,7 @@ def analyse(family: Branch, model: Model, parameters: dict[str, float],
     else:
         kind, what = PointType.HOMOCLINIC, "homoclinic"
     rate = max((r for _, r in saddles), default=None)
-    fit = fit_blowup(family.parameters[:, 0], family.period, rate, hopf_period, width)
+    fit = fit_blowup(family.parameters[:, 0], family.period, rate, reference_period, width)
     estimate = fit.log_estimate if fit else value
     bracket = np.array(fit.bracket if fit else (value, value))
     described = ", ".join("(" + ", ".join(f"{x:.4g}" for x in s[:2]) + ")" for s, _ in saddles)

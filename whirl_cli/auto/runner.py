@@ -183,12 +183,15 @@ def _describe_signal(returncode: int) -> str:
 
 
 def run(executable: Path, constants: dict, workdir: Path, name: str,
-        restart: Path | None = None, timeout: float = 120.0) -> RunOutcome:
+        restart: Path | None = None, timeout: float = 120.0,
+        data: str | None = None) -> RunOutcome:
     """Run AUTO once in the fresh directory ``workdir``.
 
     ``constants`` are complete (whirl never relies on AUTO defaults it did not choose); ``sv`` is
     set to ``name`` here. ``restart`` is the ``s.`` file to restart from; it is copied into
-    ``workdir`` and named through the ``s`` constant.
+    ``workdir`` and named through the ``s`` constant. ``data``: the text of an AUTO data file
+    to start from instead (rows ``t u1 .. uNDIM``, used with IRS=0), written into ``workdir``
+    and named through the ``dat`` constant.
     """
     workdir.mkdir(parents=True, exist_ok=False)
     constants = dict(_merged(constants, _extra_constants(name)), sv=name)
@@ -196,6 +199,9 @@ def run(executable: Path, constants: dict, workdir: Path, name: str,
         restart_name = "restart"
         shutil.copyfile(restart, workdir / f"s.{restart_name}")
         constants["s"] = restart_name
+    if data is not None:
+        (workdir / "start.dat").write_text(data)
+        constants["dat"] = "start"
     text = constants_text(constants)
     (workdir / f"c.{name}").write_text(text)
     (workdir / "fort.2").write_text(text)

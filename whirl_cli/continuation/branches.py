@@ -11,13 +11,22 @@ import numpy as np
 from ..models import Model
 from ..results import Branch, PointType, SpecialPoint
 
+#: The per-point columns of a :class:`Branch` (one row per point).
+COLUMNS = ("parameters", "state_max", "state_min", "l2_norm", "period", "stable", "point_type",
+           "label", "eigenvalues", "stability_known")
+
 
 def head(branch: Branch, rows: int) -> Branch:
     """The first ``rows`` points of ``branch`` (with the orbits stored on them)."""
-    return replace(branch, **{key: getattr(branch, key)[:rows] for key in (
-        "parameters", "state_max", "state_min", "l2_norm", "period", "stable", "point_type",
-        "label", "eigenvalues", "stability_known")},
-        orbits=tuple(o for o in branch.orbits if o.index < rows))
+    return replace(branch, **{key: getattr(branch, key)[:rows] for key in COLUMNS},
+                   orbits=tuple(o for o in branch.orbits if o.index < rows))
+
+
+def reverse(branch: Branch) -> Branch:
+    """``branch`` with its points in the opposite order (its orbits re-indexed)."""
+    last = len(branch) - 1
+    return replace(branch, **{key: getattr(branch, key)[::-1] for key in COLUMNS},
+                   orbits=tuple(replace(o, index=last - o.index) for o in branch.orbits[::-1]))
 
 
 def join(first: Branch, second: Branch, name: str) -> Branch:
@@ -25,8 +34,7 @@ def join(first: Branch, second: Branch, name: str) -> Branch:
     which it repeats)."""
     shift = len(first)
     stacked = {key: np.concatenate([getattr(first, key), getattr(second, key)[1:]])
-               for key in ("parameters", "state_max", "state_min", "l2_norm", "period", "stable",
-                           "point_type", "label", "eigenvalues", "stability_known")}
+               for key in COLUMNS}
     moved = tuple(replace(o, index=o.index + shift - 1) for o in second.orbits if o.index > 0)
     return replace(first, name=name, status=second.status, message=second.message,
                    run=f"{first.run}+{second.run}", orbits=first.orbits + moved, **stacked)

@@ -58,7 +58,8 @@ class RunSpec:
     """One AUTO run to make, named ``<continuation>/<branch>``.
 
     ``restart``: (AUTO name of an earlier run, i.e. its name with "/" -> ".", label to restart
-    from).
+    from). ``data``: instead, the text of an AUTO data file to start from (IRS=0; see
+    :func:`whirl_cli.auto.runner.run`).
     """
 
     name: str
@@ -67,6 +68,7 @@ class RunSpec:
     origin: str
     parameter_names: tuple[str, ...]
     restart: tuple[str, int] | None = None
+    data: str | None = None
 
 
 class Engine:
@@ -97,7 +99,7 @@ class Engine:
             constants["IRS"] = label
         outcome = runner.run(self.executable.path, constants, self.workroot / spec.name,
                            spec.name.replace("/", "."), restart=restart_file,
-                           timeout=self.timeout)
+                           timeout=self.timeout, data=spec.data)
         self.outcomes[outcome.name] = outcome
         if self.on_run is not None:
             self.on_run(outcome)

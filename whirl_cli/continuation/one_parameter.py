@@ -1,5 +1,5 @@
 """The one-parameter recipe: equilibria with branch switching, the criticality of their Hopf
-points and, when asked, the periodic family of every Hopf point.
+points and, when asked, the periodic family of every Hopf point and of every given orbit.
 """
 
 from __future__ import annotations
@@ -12,16 +12,17 @@ from ..results import ContinuationResult
 from .criticality import _with_criticality, with_lyapunov
 from .engine import Engine, Numerics
 from .equilibria import equilibria, is_linear
-from .periodic import periodic_families
+from .periodic import OrbitStart, orbit_families, periodic_families
 
 
 def one_parameter(engine: Engine, name: str, parameter: str, start: float,
                   bounds: tuple[float, float], parameters: dict[str, float],
                   numerics: Numerics, branch_points: bool = True,
-                  periodic: bool = False, orbits_at: tuple[float, ...] = ()
-                  ) -> ContinuationResult:
+                  periodic: bool = False, orbits_at: tuple[float, ...] = (),
+                  start_orbits: tuple[OrbitStart, ...] = ()) -> ContinuationResult:
     """Equilibria of ``parameter`` over ``bounds`` from ``start``, with branch switching, and
-    (``periodic``) the periodic families of every Hopf point. ``orbits_at``: parameter values
+    (``periodic``) the periodic families of every Hopf point, and those through each of
+    ``start_orbits`` (e.g. orbits settled by time simulation). ``orbits_at``: parameter values
     where every branch stores a labelled solution (orbit profiles)."""
     numerics = replace(numerics, orbits_at=tuple(orbits_at))
     branches, points = equilibria(engine, name, parameter, start, bounds, parameters, numerics,
@@ -36,5 +37,11 @@ def one_parameter(engine: Engine, name: str, parameter: str, start: float,
         points = _with_criticality(points, families, branches, bounds[1] - bounds[0],
                                    np.asarray(engine.model.state_scale, dtype=float)) \
             + family_points
+    if start_orbits:
+        steady = [b for b in branches if not b.is_periodic]
+        families, family_points = orbit_families(engine, name, parameter, bounds, numerics,
+                                                 list(start_orbits), steady, points, parameters)
+        branches += families
+        points += family_points
     return ContinuationResult(name, "one-parameter", tuple(branches), tuple(points))
 

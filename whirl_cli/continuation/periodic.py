@@ -1,6 +1,10 @@
-"""Periodic families: from every Hopf point, grown and then continued fold by fold to their end
-(a Hopf point reached, the range, the amplitude bound, a period blow-up, ...); see
-:func:`periodic_families`.
+"""Periodic families, continued fold by fold to their ends (a Hopf point reached, the range, the
+amplitude bound, a period blow-up, ...): from every Hopf point (:func:`periodic_families`,
+grown first), or both ways from a given orbit (:func:`orbit_families`: an AUTO start from data,
+e.g. an orbit settled by time simulation or one stored on a family).
+
+The period cap and blow-up detection are judged against a family's reference period: its Hopf
+point's, or its start orbit's.
 """
 
 from __future__ import annotations
@@ -12,8 +16,8 @@ import numpy as np
 from ..analysis import global_bifurcations
 from ..auto.constants import AMPLITUDE, par_layout
 from ..models import Model
-from ..results import Branch, BranchKind, PointType, SpecialPoint
-from .branches import amplitude, head, join, special_points
+from ..results import Branch, BranchKind, Orbit, PointType, SpecialPoint
+from .branches import amplitude, head, join, reverse, special_points
 from .engine import Engine, Numerics, RunSpec, _read
 from .equilibria import equilibrium_constants
 from .homoclinic import locate_homoclinics
@@ -34,29 +38,50 @@ MAX_RETRIES = 2
 #: A family that came back onto its own Hopf point is computed again with this many times
 #: the mesh intervals.
 RETRACE_MESH_FACTOR = 2
+#: The first AUTO label of the second side of a family started at an orbit (the first side's
+#: start at 1): the two sides are one branch, whose labels name its orbits.
+SECOND_SIDE_LABEL = 5001
 
 
 def periodic_constants(model: Model, numerics: Numerics, parameter: str,
-                       bounds: tuple[float, float], hopf_period_tau: float) -> dict:
-    """Constants for periodic orbits (IPS=2) restarted from a Hopf or an earlier orbit."""
+                       bounds: tuple[float, float], period_tau: float) -> dict:
+    """Constants for periodic orbits (IPS=2) restarted from a Hopf or an earlier orbit;
+    ``period_tau``: the reference period in AUTO's time units (the cap is a multiple of it)."""
     constants = equilibrium_constants(model, numerics, parameter, bounds, 1)
     constants.update({
         "IPS": 2, "ISW": 1, "ILP": 1, "ISP": 2,
         "ICP": [parameter, "PERIOD", *par_layout(model).measures()],
         "NPR": ORBIT_EVERY,
     })
-    constants["UZSTOP"] = dict(constants["UZSTOP"], PERIOD=PERIOD_CAP * hopf_period_tau)
+    constants["UZSTOP"] = dict(constants["UZSTOP"], PERIOD=PERIOD_CAP * period_tau)
     return constants
+
+
+@dataclass(frozen=True)
+class OrbitStart:
+    """A start for :func:`orbit_families`: ``orbit`` (time from 0 to its period in s, states
+    in SI units; its rows need not close exactly), ``value`` of the continued parameter there
+    (every other parameter is the study's) and ``origin``, said in the results."""
+
+    orbit: Orbit
+    value: float
+    origin: str
 
 
 @dataclass
 class _Family:
-    """A periodic family being continued: its Hopf point and the branch pieces so far."""
+    """One side of a periodic family being continued, and its branch pieces so far.
 
-    index: int
-    hopf: SpecialPoint
+    ``name``: its branch name; ``period``: its reference period (s), the Hopf period or the
+    start orbit's; ``hopf``: the index of the Hopf point it starts from (None for an orbit
+    start); ``grows``: its first run grows it from the Hopf point to GROWN_AMPLITUDE."""
+
+    name: str
+    period: float
     spec: RunSpec
     pieces: list[Branch]
+    hopf: int | None = None
+    grows: bool = False
     retries: int = 0
 
 
@@ -85,51 +110,149 @@ def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
         spec = RunSpec(f"{name}/periodic_{k}.0", constants, BranchKind.PERIODIC,
                        f"HB at {parameter} = {hopf.parameters[0]:.6g} on {hopf.branch}",
                        (parameter,), restart=(runs[hopf.branch], hopf.label))
-        families.append(_Family(k, hopf, spec, []))
+        families.append(_Family(f"periodic_{k}", hopf.period, spec, [], hopf=k - 1,
+                                grows=True))
 
     _continue(engine, families, hopfs, width)
     # On too coarse a mesh AUTO can turn back along a family of long orbits and retrace it to
     # its own Hopf point (combined case 5 at 40 mesh intervals): such families are computed
     # once more on a finer mesh, kept if they then do not come back
-    again = [_Family(f.index, f.hopf, replace(
-        f.spec, name=f"{name}/periodic_{f.index}m.0",
-        constants=dict(f.spec.constants, NTST=RETRACE_MESH_FACTOR * f.spec.constants["NTST"])),
-        []) for f in families if _back_at_own_hopf(f, hopfs, width, scale)]
+    again = [replace(f, pieces=[], retries=0, spec=replace(
+        f.spec, name=f"{name}/{f.name}m.0",
+        constants=dict(f.spec.constants, NTST=RETRACE_MESH_FACTOR * f.spec.constants["NTST"])))
+        for f in families if _back_at_own_hopf(f, hopfs, width, scale)]
     _continue(engine, again, hopfs, width)
     for family in again:
         if not _back_at_own_hopf(family, hopfs, width, scale):
-            families[family.index - 1] = family
+            families[family.hopf] = family
 
-    kept: list[Branch] = []
-    found: list[SpecialPoint] = []
-    homoclinic: list[tuple[int, Branch]] = []  # (row in found, family) to locate with HomCont
+    ended: list[_Ended] = []
     reached: set[int] = set()
     for family in families:
-        if family.index - 1 in reached:
+        if family.hopf in reached:
             continue  # the same family, already reached from another Hopf point
-        whole = _assemble(family, hopfs, width, scale)
-        end, returned_to = _periodic_end(whole, model, hopfs, bounds, numerics, family)
-        if returned_to is not None:
-            reached.add(returned_to)
-        global_point = global_bifurcations.analyse(whole, model, parameters, equilibria,
-                                                   family.hopf.period, width)
-        if global_point is not None:
-            end = f"period blow-up: {PointType(global_point.point_type).name.lower()} approach"
-            if whole.status == "mx":  # AUTO's expected failure right at the blow-up
-                whole = replace(whole, status="ok", message="ended with MX at the period "
-                                "blow-up (expected near a global bifurcation)")
-            found.append(global_point)
-            if global_point.point_type == PointType.HOMOCLINIC:
-                homoclinic.append((len(found) - 1, whole))
-        kept.append(replace(whole, end=end))
+        side = _end(family, model, hopfs, bounds, numerics, equilibria, parameters)
+        if side.returned_to is not None:
+            reached.add(side.returned_to)
+        ended.append(side)
+    return _collect(engine, name, bounds, parameters, hopfs,
+                    [(side.branch, side.blowups()) for side in ended], skip_first=True)
+
+
+def orbit_families(engine: Engine, name: str, parameter: str, bounds: tuple[float, float],
+                   numerics: Numerics, starts: list[OrbitStart], equilibria: list[Branch],
+                   points: list[SpecialPoint], parameters: dict[str, float]
+                   ) -> tuple[list[Branch], list[SpecialPoint]]:
+    """The periodic family through each start orbit (branch ``periodic_o<k>``), with its
+    special points: AUTO starts from the orbit (IRS=0 and a data file, the period in PAR(11))
+    and continues it both ways, fold by fold, to its ends, as :func:`periodic_families` does;
+    the two sides are one branch, the first side reversed, ending where the start orbit sits.
+    ``points``: the equilibria's special points (a family shrinking onto one of their Hopf
+    points ends there)."""
+    model = engine.model
+    width = bounds[1] - bounds[0]
+    hopfs = [p for p in points if p.point_type == PointType.HB]
+    sides = []
+    for k, start in enumerate(starts, 1):
+        period_tau = start.orbit.period * model.time_scale
+        for direction, tag in ((-1, "a"), (1, "b")):
+            constants = periodic_constants(model, numerics, parameter, bounds, period_tau)
+            constants.update(IRS=0, STOP=["LP1"], DS=direction * abs(constants["DS"]),
+                             LAB=1 if direction < 0 else SECOND_SIDE_LABEL)
+            constants["PAR"] = {**parameters, parameter: float(start.value),
+                                "PERIOD": period_tau}
+            spec = RunSpec(f"{name}/periodic_o{k}{tag}.0", constants, BranchKind.PERIODIC,
+                           start.origin, (parameter,), data=orbit_data(model, start.orbit))
+            sides.append(_Family(f"periodic_o{k}", start.orbit.period, spec, []))
+    _continue(engine, sides, hopfs, width)
+    families = []
+    for first, second in zip(sides[::2], sides[1::2], strict=True):
+        a, b = (_end(side, model, hopfs, bounds, numerics, equilibria, parameters)
+                for side in (first, second))
+        families.append((_two_sided(a.branch, b.branch), a.blowups() + b.blowups()))
+    return _collect(engine, name, bounds, parameters, hopfs, families, skip_first=False)
+
+
+def _two_sided(a: Branch, b: Branch) -> Branch:
+    """One branch from the two sides of a family started at an orbit: ``a`` reversed, then
+    ``b`` (both start with the same converged orbit); its end says both sides' ends."""
+    if not len(a) or not len(b):  # a side failed: the other one, with both ends said
+        whole = b if len(b) else a
+    else:
+        whole = join(reverse(a), b, a.name)
+    end = a.end if a.end == b.end else f"{a.end}; other end: {b.end}"
+    return replace(whole, end=end)
+
+
+@dataclass(frozen=True)
+class _Ended:
+    """One side of a family, assembled: its branch (``end`` set), the global bifurcation its
+    period blows up at (if so) and the index of the Hopf point it returns to (if so)."""
+
+    branch: Branch
+    global_point: SpecialPoint | None
+    returned_to: int | None
+
+    def blowups(self) -> list[tuple[SpecialPoint, Branch]]:
+        """(global point, the side to locate it from) pairs: none or one."""
+        return [] if self.global_point is None else [(self.global_point, self.branch)]
+
+
+def _end(family: _Family, model: Model, hopfs: list[SpecialPoint], bounds: tuple[float, float],
+         numerics: Numerics, equilibria: list[Branch], parameters: dict[str, float]) -> _Ended:
+    """Assemble ``family``'s pieces and say how it ends: a Hopf point, a period blow-up (a
+    bracketed global bifurcation), the range, ..."""
+    width = bounds[1] - bounds[0]
+    scale = np.asarray(model.state_scale, dtype=float)
+    whole, returned_to = _assembled(family, hopfs, width, scale)
+    end, returned_to = _periodic_end(whole, model, hopfs, bounds, numerics, family, returned_to)
+    global_point = global_bifurcations.analyse(whole, model, parameters, equilibria,
+                                               family.period, width)
+    if global_point is not None:
+        end = f"period blow-up: {PointType(global_point.point_type).name.lower()} approach"
+        if whole.status == "mx":  # AUTO's expected failure right at the blow-up
+            whole = replace(whole, status="ok", message="ended with MX at the period "
+                            "blow-up (expected near a global bifurcation)")
+    return _Ended(replace(whole, end=end), global_point, returned_to)
+
+
+def _collect(engine: Engine, name: str, bounds: tuple[float, float],
+             parameters: dict[str, float], hopfs: list[SpecialPoint],
+             families: list[tuple[Branch, list[tuple[SpecialPoint, Branch]]]],
+             skip_first: bool) -> tuple[list[Branch], list[SpecialPoint]]:
+    """The families' branches and special points: each family's global bifurcations (those
+    of homoclinic type located with HomCont from the side they were found on), then its
+    bifurcations, except its first point if ``skip_first`` (a Hopf start) and points where
+    it has shrunk onto a Hopf point."""
+    model = engine.model
+    width = bounds[1] - bounds[0]
+    scale = np.asarray(model.state_scale, dtype=float)
+    kept: list[Branch] = []
+    found: list[SpecialPoint] = []
+    homoclinic: list[tuple[int, Branch]] = []  # (row in found, side) to locate with HomCont
+    for whole, blowups in families:
+        for point, side in blowups:
+            found.append(point)
+            if point.point_type == PointType.HOMOCLINIC:
+                homoclinic.append((len(found) - 1, side))
+        kept.append(whole)
         small = amplitude(whole, model) < HOPF_RETURN_AMPLITUDE
-        found += [p for p in special_points(whole, skip_first=True)
+        found += [p for p in special_points(whole, skip_first=skip_first)
                   if not small[p.index] and _hopf_at(whole, p.index, hopfs, width, scale) is None]
     for row, point in zip([row for row, _ in homoclinic], locate_homoclinics(
-            engine, name, [(family, found[row]) for row, family in homoclinic], bounds,
+            engine, name, [(side, found[row]) for row, side in homoclinic], bounds,
             parameters), strict=True):
         found[row] = point
     return kept, found
+
+
+def orbit_data(model: Model, orbit: Orbit) -> str:
+    """One period of ``orbit`` as an AUTO data file: rows ``tau u1 .. un`` in AUTO's
+    non-dimensional units (see :mod:`whirl_cli.models.variant`)."""
+    scale = np.asarray(model.state_scale, dtype=float)
+    rows = np.column_stack([np.asarray(orbit.time) * model.time_scale,
+                            np.asarray(orbit.states) / scale])
+    return "".join(" ".join(f"{x:.17g}" for x in row) + "\n" for row in rows)
 
 
 def _continue(engine: Engine, families: list[_Family], hopfs: list[SpecialPoint],
@@ -152,34 +275,47 @@ def _back_at_own_hopf(family: _Family, hopfs: list[SpecialPoint], width: float,
     """True if the family, grown, has come back onto the Hopf point it started from."""
     whole = _assemble(family, hopfs, width, scale)
     return len(whole) > 3 and _hopf_at(whole, len(whole) - 1, hopfs, width,
-                                       scale) == family.index - 1
+                                       scale) == family.hopf
 
 
 def _assemble(family: _Family, hopfs: list[SpecialPoint], width: float,
               scale: np.ndarray) -> Branch:
     """One branch from a family's pieces, cut after the first point beyond the period cap
-    (AUTO can step over that stop while it locates a fold there)."""
+    (AUTO can step over that stop while it locates a fold there) or the first return to a
+    Hopf point."""
+    return _assembled(family, hopfs, width, scale)[0]
+
+
+def _assembled(family: _Family, hopfs: list[SpecialPoint], width: float,
+               scale: np.ndarray) -> tuple[Branch, int | None]:
+    """:func:`_assemble`, and the index of the Hopf point the family first returns to (judged
+    on the whole of its pieces, where the family's size is that of all of it), if any."""
     whole = family.pieces[0]
     for piece in family.pieces[1:]:
         if len(piece):
             whole = join(whole, piece, whole.name)
-    whole = replace(whole, name=f"periodic_{family.index}")
-    ends = list(np.flatnonzero(whole.period > PERIOD_CAP * family.hopf.period)[:1])
-    returned = _first_return(whole, hopfs, width, scale)
+    whole = replace(whole, name=family.name)
+    ends = list(np.flatnonzero(whole.period > PERIOD_CAP * family.period)[:1])
+    returned = _first_return(whole, hopfs, width, scale, family.grows)
+    returned_to = None
     if returned is not None:
         ends.append(returned)
+        returned_to = _hopf_at(whole, returned, hopfs, width, scale)
     if ends and min(ends) + 1 < len(whole):
+        if returned is not None and min(ends) < returned:
+            returned_to = None  # the period cap came first
         whole = head(whole, min(ends) + 1)
-    return whole
+    return whole, returned_to
 
 
 def _first_return(branch: Branch, hopfs: list[SpecialPoint], width: float,
-                  scale: np.ndarray) -> int | None:
-    """First row where a grown family has shrunk back onto a Hopf point (AUTO may pass
-    through a Hopf point without stopping there and go round the family again). Sizes are in
-    AUTO's units (``scale``), so that no dof counts more for its unit."""
+                  scale: np.ndarray, grows: bool = True) -> int | None:
+    """First row where a family has shrunk onto a Hopf point (AUTO may pass through a Hopf
+    point without stopping there and go round the family again): after it has grown, for a
+    family that ``grows`` from a Hopf point, else after its first row (an orbit start). Sizes
+    are in AUTO's units (``scale``), so that no dof counts more for its unit."""
     size = ((branch.state_max - branch.state_min) / (2 * scale)).max(axis=1)
-    grown = np.flatnonzero(size > 0.5 * size.max())
+    grown = np.flatnonzero(size > 0.5 * size.max()) if grows else np.arange(1, len(branch))
     if not len(grown):
         return None
     for row in range(int(grown[0]), len(branch)):
@@ -214,23 +350,35 @@ def _next_segment(family: _Family, model: Model, hopfs: list[SpecialPoint],
     if not len(piece) or piece.status != "ok" or len(family.pieces) >= MAX_SEGMENTS:
         return None
     last = PointType(int(piece.point_type[-1]))
-    if len(family.pieces) == 1:
+    if family.grows and len(family.pieces) == 1:
         grown = last == PointType.UZ and abs(amplitude(piece, model)[-1] - GROWN_AMPLITUDE) \
             < 1e-3 * GROWN_AMPLITUDE
         if not grown:
             return None
-    elif last != PointType.LPC or _first_return(piece, hopfs, width, scale) is not None or \
+    elif last != PointType.LPC or \
+            _first_return(piece, hopfs, width, scale, family.grows) is not None or \
             _hopf_at(piece, len(piece) - 1, hopfs, width, scale) is not None:
         return None  # an end (range, amplitude, period, steps) or back at a Hopf point
-    if global_bifurcations.in_blowup(piece, family.hopf.period) and \
-            global_bifurcations.blowup_turns(*_columns(family), family.hopf.period) \
+    if global_bifurcations.in_blowup(piece, family.period) and \
+            global_bifurcations.blowup_turns(*_columns(family), family.period) \
             >= global_bifurcations.BRACKET_TURNS:
         return None
-    constants = dict(family.spec.constants, STOP=["LP1"])
-    constants["UZSTOP"] = {k: v for k, v in constants["UZSTOP"].items() if k != AMPLITUDE}
     return replace(family.spec, name=f"{family.spec.name.rsplit('.', 1)[0]}."
-                   f"{len(family.pieces)}", constants=constants,
-                   restart=(piece.run, int(piece.label[-1])))
+                   f"{len(family.pieces)}", constants=_segment_constants(family),
+                   restart=(piece.run, int(piece.label[-1])), data=None)
+
+
+def _segment_constants(family: _Family, **changes) -> dict:
+    """Constants of a run that continues ``family`` from a labelled point of its last piece:
+    its first run's (the sign of DS with them: AUTO goes on in the direction the restart
+    point was reached), to the next fold of cycles, without a Hopf start's amplitude stop or
+    an orbit start's parameter values and first label (they would replace the restart
+    point's)."""
+    constants = {key: value for key, value in family.spec.constants.items()
+                 if key not in ("PAR", "LAB")}
+    constants.update(STOP=["LP1"], **changes)
+    constants["UZSTOP"] = {k: v for k, v in constants["UZSTOP"].items() if k != AMPLITUDE}
+    return constants
 
 
 def _columns(family: _Family) -> tuple[np.ndarray, np.ndarray]:
@@ -244,39 +392,40 @@ def _retry(family: _Family, piece: Branch) -> RunSpec | None:
     """After MX (no convergence): restart from the last good labelled point of the piece with
     twice the mesh intervals and half the largest step; the piece is cut back to that point."""
     labelled = [k for k in np.flatnonzero(piece.label) if piece.point_type[k] != PointType.MX]
-    if not labelled or global_bifurcations.in_blowup(piece, family.hopf.period):
+    if not labelled or global_bifurcations.in_blowup(piece, family.period):
         return None
     row = int(labelled[-1])
     family.pieces[-1] = head(piece, row + 1)
     family.retries += 1
     refine = 2 ** family.retries
-    constants = dict(family.spec.constants, STOP=["LP1"],
-                     NTST=family.spec.constants["NTST"] * refine,
-                     DSMAX=family.spec.constants["DSMAX"] / refine)
-    constants["UZSTOP"] = {k: v for k, v in constants["UZSTOP"].items() if k != AMPLITUDE}
+    constants = _segment_constants(family, NTST=family.spec.constants["NTST"] * refine,
+                                   DSMAX=family.spec.constants["DSMAX"] / refine)
     return replace(family.spec, name=f"{family.spec.name.rsplit('.', 1)[0]}."
                    f"{len(family.pieces)}r{family.retries}", constants=constants,
-                   restart=(piece.run.rsplit("+", 1)[-1], int(piece.label[row])))
+                   restart=(piece.run.rsplit("+", 1)[-1], int(piece.label[row])), data=None)
 
 
 def _periodic_end(family: Branch, model: Model, hopfs: list[SpecialPoint],
                   bounds: tuple[float, float], numerics: Numerics,
-                  state: _Family) -> tuple[str, int | None]:
-    """Why a periodic family ends, and the index of the Hopf point it returns to (if so)."""
+                  state: _Family, returned_to: int | None = None) -> tuple[str, int | None]:
+    """Why a periodic family ends, and the index of the Hopf point it returns to (if so;
+    ``returned_to``: the one :func:`_assembled` found, if its last point does not say)."""
     if not len(family):
         return f"failed: {family.message}", None
     width = bounds[1] - bounds[0]
     scale = np.asarray(model.state_scale, dtype=float)
     value = family.parameters[-1, 0]
     returned = _hopf_at(family, len(family) - 1, hopfs, width, scale) if len(family) > 3 else None
+    if returned is None:
+        returned = returned_to
     if returned is not None:
         hopf = hopfs[returned]
-        which = "its own HB" if returned == state.index - 1 else "HB"
+        which = "its own HB" if returned == state.hopf else "HB"
         return (f"returns to {which} at {family.parameter_names[0]} = "
                 f"{hopf.parameters[0]:.6g} on {hopf.branch}"), returned
     if family.point_type[-1] == PointType.MX:
         return "no convergence (MX)", None
-    if family.period[-1] >= 0.999 * PERIOD_CAP * state.hopf.period:
+    if family.period[-1] >= 0.999 * PERIOD_CAP * state.period:
         return "period cap", None
     if min(abs(value - bounds[0]), abs(value - bounds[1])) < 1e-6 * width:
         return "range", None
