@@ -4,6 +4,7 @@ It depends on :mod:`whirl_cli.results` (and :mod:`~whirl_cli.output.study_files`
 :mod:`whirl_cli.plots`, imported inside its functions). Modules, lowest first:
 
 * :mod:`~whirl_cli.output.atomic` -- a file appears complete or not at all (``publish``);
+* :mod:`~whirl_cli.output.mapping` -- dataclass fields to HDF5 attributes, datasets and tables;
 * :mod:`~whirl_cli.output.store` -- the one writer and reader of result files (HDF5, schema 1);
 * :mod:`~whirl_cli.output.study_files` -- a study's HDF5 file and plots as one unit;
 * :mod:`~whirl_cli.output.compare` -- two result files compared on what is physical;

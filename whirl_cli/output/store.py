@@ -38,6 +38,10 @@ The groups holding collections (continuations, branches, orbits, sweeps, boundar
 polygons, contour lines, runs) track the creation order of their members, so a round trip
 keeps the order of the study and its results; older files list (and read) by name.
 
+Every dataclass field's place in that layout is declared once, below (:data:`BRANCH`,
+:data:`SPECIAL_POINT`, ...), and both :func:`write` and :func:`read` go by those declarations
+(:mod:`whirl_cli.output.mapping`).
+
 The file is built in memory and published by :mod:`whirl_cli.output.atomic`: written to an
 unnamed file in the output directory (O_TMPFILE) and linked into place, so an output path never
 holds a partial file and an interrupted write (even SIGKILL) leaves no temporary file; an
@@ -72,15 +76,89 @@ from ..results import (
     UnsafeInterval,
 )
 from .atomic import publish
+from .mapping import Field, read_record, read_table, text, write_record, write_table
 
 SCHEMA = 1
-_STR = h5py.string_dtype()
+
+# ------------------------------------------------------------------------- the declarations
+_PERIODIC = BranchKind.PERIODIC
+
+#: A :class:`Branch` in ``branches/<name>`` (its name is the group's).
+BRANCH = (
+    Field("kind", "attribute", "text"), Field("origin", "attribute", "text"),
+    Field("status", "attribute", "text"), Field("message", "attribute", "text"),
+    Field("run", "attribute", "text"), Field("end", "attribute", "text"),
+    Field("parameters", columns=("parameter_names", "parameter_units")),
+    Field("state_max", columns=("state_names", "state_units")),
+    Field("state_min", columns=("state_names", "state_units")),
+    Field("l2_norm", units="1"),
+    Field("period", units="s"),
+    Field("stable", kind="bool"),
+    Field("stability_known", kind="bool", default=None),  # older files: known everywhere
+    Field("point_type", kind="int"),
+    Field("label", kind="int"),
+    Field("eigenvalues",
+          key=lambda kind: "floquet_multipliers" if kind == _PERIODIC else "eigenvalues",
+          units=lambda kind: "1" if kind == _PERIODIC else "1/s"),
+)
+#: An :class:`Orbit` in ``orbits/<label>`` of its branch.
+ORBIT = (
+    Field("point_type", "attribute", "int"), Field("index", "attribute", "int"),
+    Field("period", "attribute", "float"), Field("parameters", "attribute"),
+    Field("time", units="s"), Field("states"),
+)
+#: The :class:`SpecialPoint` table of a continuation (``special_points/``), one column each.
+SPECIAL_POINT = (
+    Field("branch", kind="text"), Field("index", kind="int"),
+    Field("point_type", kind="int"), Field("type_name", kind="text", derived=True),
+    Field("label", kind="int"),
+    Field("parameters", width="parameters", columns=("parameter_names", None)),
+    Field("state", width="states"),
+    Field("period", kind="float"), Field("stable", kind="bool"),
+    Field("status", kind="text"), Field("criticality", kind="text"), Field("note", kind="text"),
+    Field("bracket", width=2), Field("residual", kind="float"),
+    Field("lyapunov", kind="float", units="1/(s*state_unit^2)", default=float("nan")),
+)
+#: The :class:`CrossCheck` table of a continuation (``cross_checks/``).
+CROSS_CHECK = (
+    Field("branch", kind="text"), Field("index", kind="int"), Field("kind", kind="text"),
+    Field("parameter", kind="float"), Field("expected", kind="float"),
+    Field("simulated", kind="float"), Field("passed", kind="bool"),
+    Field("state", kind="text", default=""),  # older files: not recorded
+)
+#: A :class:`LinearSweep` in ``linear/sweeps/<parameter>``.
+LINEAR_SWEEP = (
+    Field("parameter", "attribute", "text"),
+    Field("values", unit_field="unit"), Field("eigenvalues", units="1/s"),
+    Field("damping_ratio", units="1"), Field("frequency", units="rad/s"),
+    Field("whirl", kind="text"),
+)
+#: A :class:`LinearGrid` in ``linear/grid`` (its contour lines: collections of their own).
+LINEAR_GRID = (
+    Field("x_parameter", "attribute", "text"), Field("y_parameter", "attribute", "text"),
+    Field("x", unit_field="x_unit"), Field("y", unit_field="y_unit"),
+    Field("max_real", units="1/s"), Field("oscillatory"),
+)
+#: A :class:`Boundary` in ``boundaries/<name>`` (its loci and polygons: collections).
+BOUNDARY = (
+    Field("parameter_names", "attribute", "text", key="parameters"),
+    Field("parameter_units", "attribute", "text", key="units"),
+    Field("method", "attribute", "text"), Field("slices", "attribute", "float"),
+)
+#: The :class:`UnsafeInterval` table of a boundary (``unsafe_intervals/``).
+UNSAFE_INTERVAL = (
+    Field("slice_value", kind="float"), Field("lower", kind="float"),
+    Field("upper", kind="float"), Field("cause", kind="text"),
+)
+#: A :class:`RunRecord` in ``runs/<name>``.
+RUN = (
+    Field("status", "attribute", "text"), Field("message", "attribute", "text"),
+    Field("constants", "attribute", "text"), Field("returncode", "attribute", "int"),
+    Field("wall_seconds", "attribute", "float"), Field("n_points", "attribute", "int"),
+)
 
 
-def _strings(values) -> np.ndarray:
-    return np.array([str(v) for v in values], dtype=object)
-
-
+# ------------------------------------------------------------------------------ writing
 def _collection(parent: h5py.Group, name: str) -> h5py.Group:
     """The group ``name`` of ``parent`` that holds a collection (continuations, branches,
     orbits, sweeps, boundaries, loci, runs, ...), created tracking the order in which its
@@ -92,139 +170,42 @@ def _collection(parent: h5py.Group, name: str) -> h5py.Group:
 
 
 def _write_branch(group: h5py.Group, branch: Branch) -> None:
-    group.attrs.update(kind=branch.kind, origin=branch.origin, status=branch.status,
-                       message=branch.message, run=branch.run, end=branch.end)
-    params = group.create_dataset("parameters", data=np.reshape(
-        branch.parameters, (len(branch), len(branch.parameter_names))))
-    params.attrs.update(names=list(branch.parameter_names), units=list(branch.parameter_units))
-    for key in ("state_max", "state_min"):
-        data = group.create_dataset(key, data=getattr(branch, key))
-        data.attrs.update(names=list(branch.state_names), units=list(branch.state_units))
-    group.create_dataset("l2_norm", data=branch.l2_norm).attrs["units"] = "1"
-    group.create_dataset("period", data=branch.period).attrs["units"] = "s"
-    group.create_dataset("stable", data=branch.stable.astype(bool))
-    group.create_dataset("stability_known", data=branch.stability_known.astype(bool))
-    group.create_dataset("point_type", data=branch.point_type.astype(np.int64))
-    group.create_dataset("label", data=branch.label.astype(np.int64))
-    if branch.is_periodic:
-        group.create_dataset("floquet_multipliers", data=branch.eigenvalues).attrs["units"] = "1"
-    else:
-        group.create_dataset("eigenvalues", data=branch.eigenvalues).attrs["units"] = "1/s"
+    write_record(group, branch, BRANCH)
     for orbit in branch.orbits:
         sub = _collection(group, "orbits").create_group(str(orbit.label))
-        sub.attrs.update(point_type=orbit.point_type, index=orbit.index, period=orbit.period,
-                         parameters=orbit.parameters)
-        sub.create_dataset("time", data=orbit.time).attrs["units"] = "s"
-        states = sub.create_dataset("states", data=orbit.states)
-        states.attrs.update(names=list(branch.state_names), units=list(branch.state_units))
+        write_record(sub, orbit, ORBIT)
+        sub["states"].attrs.update(names=list(branch.state_names),
+                                   units=list(branch.state_units))
 
 
-def _write_special_points(group: h5py.Group, points: tuple[SpecialPoint, ...],
-                          n_states: int) -> None:
-    n_params = len(points[0].parameter_names) if points else 1
-    group.create_dataset("branch", data=_strings(p.branch for p in points), dtype=_STR)
-    group.create_dataset("index", data=np.array([p.index for p in points], dtype=np.int64))
-    group.create_dataset("point_type",
-                         data=np.array([p.point_type for p in points], dtype=np.int64))
-    group.create_dataset("type_name", data=_strings(p.type_name for p in points), dtype=_STR)
-    group.create_dataset("label", data=np.array([p.label for p in points], dtype=np.int64))
-    params = group.create_dataset(
-        "parameters", data=np.array([p.parameters for p in points]).reshape(-1, n_params))
-    params.attrs["names"] = list(points[0].parameter_names) if points else []
-    group.create_dataset("state",
-                         data=np.array([p.state for p in points]).reshape(-1, n_states))
-    group.create_dataset("period", data=np.array([p.period for p in points], dtype=float))
-    group.create_dataset("stable", data=np.array([p.stable for p in points], dtype=bool))
-    for key in ("status", "criticality", "note"):
-        group.create_dataset(key, data=_strings(getattr(p, key) for p in points), dtype=_STR)
-    group.create_dataset("bracket", data=np.array([p.bracket for p in points]).reshape(-1, 2))
-    group.create_dataset("residual", data=np.array([p.residual for p in points], dtype=float))
-    lyapunov = group.create_dataset("lyapunov",
-                                    data=np.array([p.lyapunov for p in points], dtype=float))
-    lyapunov.attrs["units"] = "1/(s*state_unit^2)"
-
-
-def _write_cross_checks(group: h5py.Group, checks: tuple[CrossCheck, ...]) -> None:
-    group.create_dataset("branch", data=_strings(c.branch for c in checks), dtype=_STR)
-    group.create_dataset("index", data=np.array([c.index for c in checks], dtype=np.int64))
-    group.create_dataset("kind", data=_strings(c.kind for c in checks), dtype=_STR)
-    for key in ("parameter", "expected", "simulated"):
-        group.create_dataset(key, data=np.array([getattr(c, key) for c in checks], dtype=float))
-    group.create_dataset("passed", data=np.array([c.passed for c in checks], dtype=bool))
-    group.create_dataset("state", data=_strings(c.state for c in checks), dtype=_STR)
-
-
-def _read_cross_checks(group: h5py.Group) -> tuple[CrossCheck, ...]:
-    columns = {key: group[key][()] for key in group}
-    return tuple(
-        CrossCheck(_text(columns["branch"][k]), int(columns["index"][k]),
-                   _text(columns["kind"][k]), float(columns["parameter"][k]),
-                   float(columns["expected"][k]), float(columns["simulated"][k]),
-                   bool(columns["passed"][k]),
-                   _text(columns["state"][k]) if "state" in columns else "")
-        for k in range(len(columns["index"])))
+def _write_continuation(group: h5py.Group, continuation: ContinuationResult) -> None:
+    group.attrs["kind"] = continuation.kind
+    for branch in continuation.branches:
+        _write_branch(_collection(group, "branches").create_group(branch.name), branch)
+    points = continuation.special_points
+    write_table(group.create_group("special_points"), points, SPECIAL_POINT, {
+        "parameters": len(points[0].parameter_names) if points else 1,
+        "states": len(continuation.branches[0].state_names) if continuation.branches else 0})
+    if continuation.cross_checks:
+        write_table(group.create_group("cross_checks"), continuation.cross_checks,
+                    CROSS_CHECK)
 
 
 def _write_boundary(group: h5py.Group, boundary: Boundary) -> None:
-    group.attrs.update(parameters=list(boundary.parameter_names),
-                       units=list(boundary.parameter_units), method=boundary.method,
-                       slices=np.array(boundary.slices, dtype=float))
+    write_record(group, boundary, BOUNDARY)
     for name, (kind, curve) in boundary.loci.items():
         data = _collection(group, "loci").create_dataset(name, data=curve.reshape(-1, 2))
         data.attrs["kind"] = kind
     for k, polygon in enumerate(boundary.polygons):
         _collection(group, "unsafe").create_dataset(f"polygon_{k}", data=polygon)
-    table = group.create_group("unsafe_intervals")
-    rows = boundary.intervals
-    for key in ("slice_value", "lower", "upper"):
-        table.create_dataset(key, data=np.array([getattr(r, key) for r in rows], dtype=float))
-    table.create_dataset("cause", data=_strings(r.cause for r in rows), dtype=_STR)
-
-
-def _read_boundary(name: str, group: h5py.Group) -> Boundary:
-    loci = {key: (_text(data.attrs["kind"]), data[()])
-            for key, data in group.get("loci", {}).items()}
-    polygons = tuple(group["unsafe"][key][()] for key in _members(group.get("unsafe", {}),
-                                                                   _number))
-    table = group["unsafe_intervals"]
-    intervals = tuple(
-        UnsafeInterval(float(v), float(lo), float(hi), _text(c)) for v, lo, hi, c in zip(
-            table["slice_value"][()], table["lower"][()], table["upper"][()],
-            table["cause"][()], strict=True))
-    return Boundary(name, _texts(group.attrs["parameters"]), _texts(group.attrs["units"]),
-                    _text(group.attrs["method"]), loci, intervals, polygons,
-                    tuple(float(v) for v in group.attrs["slices"]))
+    write_table(group.create_group("unsafe_intervals"), boundary.intervals, UNSAFE_INTERVAL)
 
 
 def _write_grid(group: h5py.Group, grid: LinearGrid) -> None:
-    group.attrs.update(x_parameter=grid.x_parameter, y_parameter=grid.y_parameter)
-    group.create_dataset("x", data=grid.x).attrs["units"] = grid.x_unit
-    group.create_dataset("y", data=grid.y).attrs["units"] = grid.y_unit
-    group.create_dataset("max_real", data=grid.max_real).attrs["units"] = "1/s"
-    group.create_dataset("oscillatory", data=grid.oscillatory)
+    write_record(group, grid, LINEAR_GRID)
     for kind in ("flutter", "divergence"):
         for k, line in enumerate(getattr(grid, kind)):
             _collection(group, kind).create_dataset(f"line_{k}", data=line)
-
-
-def _read_grid(group: h5py.Group) -> LinearGrid:
-    def lines(kind: str) -> tuple[np.ndarray, ...]:
-        found = group.get(kind, {})
-        return tuple(found[k][()] for k in _members(found, _number))
-
-    return LinearGrid(_text(group.attrs["x_parameter"]), _text(group.attrs["y_parameter"]),
-                      _text(group["x"].attrs["units"]), _text(group["y"].attrs["units"]),
-                      group["x"][()], group["y"][()], group["max_real"][()],
-                      group["oscillatory"][()], lines("flutter"), lines("divergence"))
-
-
-def _write_sweep(group: h5py.Group, sweep: LinearSweep) -> None:
-    group.attrs["parameter"] = sweep.parameter
-    group.create_dataset("values", data=sweep.values).attrs["units"] = sweep.unit
-    group.create_dataset("eigenvalues", data=sweep.eigenvalues).attrs["units"] = "1/s"
-    group.create_dataset("damping_ratio", data=sweep.damping_ratio).attrs["units"] = "1"
-    group.create_dataset("frequency", data=sweep.frequency).attrs["units"] = "rad/s"
-    group.create_dataset("whirl", data=sweep.whirl.astype(object), dtype=_STR)
 
 
 def write(result: StudyResult, path: Path, overwrite: bool = False) -> Path:
@@ -257,20 +238,11 @@ def _image(result: StudyResult) -> bytes:
         handle.attrs["study_name"] = result.study_name
         handle.attrs["model"] = result.model
         for continuation in result.continuations:
-            group = _collection(handle, "continuations").create_group(continuation.name)
-            group.attrs["kind"] = continuation.kind
-            n_states = len(continuation.branches[0].state_names) if continuation.branches \
-                else 0
-            for branch in continuation.branches:
-                _write_branch(_collection(group, "branches").create_group(branch.name), branch)
-            _write_special_points(group.create_group("special_points"),
-                                  continuation.special_points, n_states)
-            if continuation.cross_checks:
-                _write_cross_checks(group.create_group("cross_checks"),
-                                    continuation.cross_checks)
+            _write_continuation(_collection(handle, "continuations").create_group(
+                continuation.name), continuation)
         for sweep in result.linear_sweeps:
-            _write_sweep(_collection(handle.require_group("linear"), "sweeps").create_group(
-                sweep.parameter), sweep)
+            write_record(_collection(handle.require_group("linear"), "sweeps").create_group(
+                sweep.parameter), sweep, LINEAR_SWEEP)
         if result.linear_grid is not None:
             _write_grid(handle.create_group("linear/grid"), result.linear_grid)
         for boundary in result.boundaries:
@@ -278,22 +250,12 @@ def _image(result: StudyResult) -> bytes:
                             boundary)
         runs = _collection(handle, "runs")
         for record in result.runs:
-            runs.create_group(record.name).attrs.update(
-                status=record.status, message=record.message, constants=record.constants,
-                returncode=record.returncode, wall_seconds=record.wall_seconds,
-                n_points=record.n_points)
+            write_record(runs.create_group(record.name), record, RUN)
         handle.flush()
         return handle.id.get_file_image()
 
 
-def _text(value) -> str:
-    return value.decode() if isinstance(value, bytes) else str(value)
-
-
-def _texts(values) -> tuple[str, ...]:
-    return tuple(_text(v) for v in values)
-
-
+# ------------------------------------------------------------------------------ reading
 def _members(group, old_order=None) -> list[str]:
     """Names of the members of ``group`` in the order they were written (files since whirl
     tracks it, see :func:`_collection`); in older files by name, or sorted by ``old_order``."""
@@ -309,48 +271,38 @@ def _number(name: str) -> int:
 
 
 def _read_branch(name: str, group: h5py.Group) -> Branch:
-    params = group["parameters"]
-    kind = _text(group.attrs["kind"])
-    key = "floquet_multipliers" if kind == BranchKind.PERIODIC else "eigenvalues"
-    orbits = []
-    if "orbits" in group:
-        for label in _members(group["orbits"], int):
-            sub = group["orbits"][label]
-            orbits.append(Orbit(int(label), int(sub.attrs["point_type"]),
-                                int(sub.attrs["index"]), np.asarray(sub.attrs["parameters"]),
-                                float(sub.attrs["period"]), sub["time"][()],
-                                sub["states"][()]))
-    return Branch(
-        name=name, kind=kind, origin=_text(group.attrs["origin"]),
-        parameter_names=_texts(params.attrs["names"]),
-        parameter_units=_texts(params.attrs["units"]),
-        state_names=_texts(group["state_max"].attrs["names"]),
-        state_units=_texts(group["state_max"].attrs["units"]),
-        parameters=params[()], state_max=group["state_max"][()],
-        state_min=group["state_min"][()], l2_norm=group["l2_norm"][()],
-        period=group["period"][()], stable=group["stable"][()].astype(bool),
-        stability_known=group["stability_known"][()].astype(bool)
-        if "stability_known" in group else None,  # files from before: known everywhere
-        point_type=group["point_type"][()], label=group["label"][()],
-        eigenvalues=group[key][()], status=_text(group.attrs["status"]),
-        message=_text(group.attrs["message"]), run=_text(group.attrs["run"]),
-        orbits=tuple(orbits), end=_text(group.attrs["end"]))
+    orbits = group.get("orbits", {})
+    return Branch(name=name, **read_record(group, BRANCH), orbits=tuple(
+        Orbit(label=int(label), **read_record(orbits[label], ORBIT))
+        for label in _members(orbits, int)))
 
 
-def _read_special_points(group: h5py.Group) -> tuple[SpecialPoint, ...]:
-    names = _texts(group["parameters"].attrs["names"])
-    columns = {key: group[key][()] for key in group}
-    return tuple(
-        SpecialPoint(
-            branch=_text(columns["branch"][k]), index=int(columns["index"][k]),
-            point_type=int(columns["point_type"][k]), parameter_names=names,
-            parameters=columns["parameters"][k], state=columns["state"][k],
-            period=float(columns["period"][k]), stable=bool(columns["stable"][k]),
-            label=int(columns["label"][k]), status=_text(columns["status"][k]),
-            criticality=_text(columns["criticality"][k]), note=_text(columns["note"][k]),
-            bracket=columns["bracket"][k], residual=float(columns["residual"][k]),
-            lyapunov=float(columns["lyapunov"][k]) if "lyapunov" in columns else float("nan"))
-        for k in range(len(columns["index"])))
+def _read_continuation(name: str, group: h5py.Group) -> ContinuationResult:
+    return ContinuationResult(
+        name, text(group.attrs["kind"]),
+        tuple(_read_branch(b, g) for b, g in group.get("branches", {}).items()),
+        read_table(group["special_points"], SpecialPoint, SPECIAL_POINT),
+        read_table(group["cross_checks"], CrossCheck, CROSS_CHECK)
+        if "cross_checks" in group else ())
+
+
+def _read_boundary(name: str, group: h5py.Group) -> Boundary:
+    loci = {key: (text(data.attrs["kind"]), data[()])
+            for key, data in group.get("loci", {}).items()}
+    polygons = tuple(group["unsafe"][key][()] for key in _members(group.get("unsafe", {}),
+                                                                   _number))
+    return Boundary(name=name, **read_record(group, BOUNDARY), loci=loci, polygons=polygons,
+                    intervals=read_table(group["unsafe_intervals"], UnsafeInterval,
+                                         UNSAFE_INTERVAL))
+
+
+def _read_grid(group: h5py.Group) -> LinearGrid:
+    def lines(kind: str) -> tuple[np.ndarray, ...]:
+        found = group.get(kind, {})
+        return tuple(found[k][()] for k in _members(found, _number))
+
+    return LinearGrid(**read_record(group, LINEAR_GRID), flutter=lines("flutter"),
+                      divergence=lines("divergence"))
 
 
 #: What reading a file that does not hold what a whirl result file holds can raise (h5py
@@ -409,33 +361,17 @@ def read(path: Path) -> StudyResult:
         if schema != SCHEMA:
             raise OutputError(f"{path}: not a whirl result file of schema {SCHEMA} "
                               f"(found {schema})")
-        continuations = []
-        for name, group in handle.get("continuations", {}).items():
-            branches = tuple(_read_branch(b, g) for b, g in group.get("branches", {}).items())
-            checks = _read_cross_checks(group["cross_checks"]) if "cross_checks" in group \
-                else ()
-            continuations.append(ContinuationResult(
-                name, _text(group.attrs["kind"]), branches,
-                _read_special_points(group["special_points"]), checks))
-        sweeps = []
-        for parameter, group in handle.get("linear/sweeps", {}).items():
-            sweeps.append(LinearSweep(
-                parameter, _text(group["values"].attrs["units"]), group["values"][()],
-                group["eigenvalues"][()], group["damping_ratio"][()],
-                group["frequency"][()],
-                np.array(_texts(group["whirl"][()].ravel())).reshape(group["whirl"].shape)))
-        runs = tuple(
-            RunRecord(name, _text(g.attrs["status"]), _text(g.attrs["message"]),
-                      _text(g.attrs["constants"]), int(g.attrs["returncode"]),
-                      float(g.attrs["wall_seconds"]), int(g.attrs["n_points"]))
-            for name, g in handle.get("runs", {}).items())
+        continuations = tuple(_read_continuation(name, group)
+                              for name, group in handle.get("continuations", {}).items())
+        sweeps = tuple(LinearSweep(**read_record(group, LINEAR_SWEEP))
+                       for group in handle.get("linear/sweeps", {}).values())
+        runs = tuple(RunRecord(name=name, **read_record(group, RUN))
+                     for name, group in handle.get("runs", {}).items())
         grid = _read_grid(handle["linear/grid"]) if "linear/grid" in handle else None
         boundaries = tuple(_read_boundary(name, group)
                            for name, group in handle.get("boundaries", {}).items())
         skip = {"whirl_schema", "study_name", "model"}
-        attributes = {k: (_text(v) if isinstance(v, bytes | str) else v)
+        attributes = {k: (text(v) if isinstance(v, bytes | str) else v)
                       for k, v in handle.attrs.items() if k not in skip}
-        return StudyResult(_text(handle.attrs["study_name"]), _text(handle.attrs["model"]),
-                           tuple(continuations), tuple(sweeps), runs, attributes, boundaries,
-                           grid)
-
+        return StudyResult(text(handle.attrs["study_name"]), text(handle.attrs["model"]),
+                           continuations, sweeps, runs, attributes, boundaries, grid)

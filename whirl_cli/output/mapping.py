@@ -1,0 +1,217 @@
+"""How a result dataclass maps onto HDF5: one declaration per class, read and written by the
+same few functions.
+
+A :class:`Field` says where one dataclass field lives in the group of its object: an attribute,
+or a dataset (with its units; a dataset may carry the names and units of its columns, which
+are dataclass fields of their own). :func:`write_record` and :func:`read_record` store and
+recover an object (a branch, an orbit, a linear sweep, ...) from those declarations;
+:func:`write_table` and :func:`read_table` do the same for a list of objects stored column by
+column (special points, cross-checks, unsafe intervals). ``store.py`` holds the declarations
+and the file's layout of groups; nothing else names a field.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import h5py
+import numpy as np
+
+_STR = h5py.string_dtype()
+#: A :attr:`Field.default` meaning: the field must be in the file.
+REQUIRED = object()
+
+
+@dataclass(frozen=True)
+class Field:
+    """Where a dataclass field ``name`` is stored in its object's group.
+
+    ``stored``: "attribute" or "dataset". ``kind``: "text", "int", "float", "bool" (each
+    element converted on reading) or "array" (read as stored). ``key``: its HDF5 name, if not
+    ``name``; ``units``: the ``units`` attribute of its dataset. Either may be a function of
+    the object's ``kind`` attribute (periodic branches store Floquet multipliers where
+    equilibria store eigenvalues). ``columns``: (names field, units field or None) of the
+    object, written as the dataset's ``names`` and ``units`` attributes and read back from
+    them; ``unit_field``: the object's field holding the dataset's ``units`` attribute.
+    ``width``: columns of a table's 2-D column (an int, or the name of a context value), so
+    that an empty table keeps its shape. ``default``: the value where an older file lacks the
+    field (a function of nothing, or a value). ``derived``: written from the object's
+    attribute of that name, never read (e.g. a point type's name beside its code).
+    """
+
+    name: str
+    stored: str = "dataset"
+    kind: str = "array"
+    key: str | Callable[[str], str] | None = None
+    units: str | Callable[[str], str] | None = None
+    columns: tuple[str, str | None] | None = None
+    unit_field: str | None = None
+    width: int | str | None = None
+    default: Any = REQUIRED
+    derived: bool = False
+
+    def hdf5_key(self, kind: str = "") -> str:
+        return _choose(self.key, kind) or self.name
+
+    def hdf5_units(self, kind: str = "") -> str | None:
+        return _choose(self.units, kind)
+
+
+def _choose(value, kind: str):
+    return value(kind) if callable(value) else value
+
+
+def text(value) -> str:
+    """An HDF5 string (bytes or str) as str."""
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def texts(values) -> tuple[str, ...]:
+    return tuple(text(v) for v in values)
+
+
+def _strings(values) -> np.ndarray:
+    return np.array([str(v) for v in values], dtype=object)
+
+
+_CONVERT: dict[str, Callable[[Any], Any]] = {
+    "text": text, "int": int, "float": float, "bool": bool, "array": lambda v: v}
+_NUMPY = {"int": np.int64, "float": float, "bool": bool}
+
+
+def _encoded(values, kind: str) -> dict:
+    """``create_dataset`` arguments for ``values`` (an array, or a sequence for a column)."""
+    if kind == "text":
+        array = np.asarray(values, dtype=object)
+        return {"data": _strings(array.ravel()).reshape(array.shape), "dtype": _STR}
+    if kind in _NUMPY:
+        return {"data": np.asarray(values).astype(_NUMPY[kind])}
+    return {"data": values}
+
+
+def _decoded(data, kind: str):
+    """A dataset's value as the dataclass holds it (text arrays as str, elementwise)."""
+    if kind == "text":
+        array = np.asarray(data, dtype=object)
+        return np.array(texts(array.ravel())).reshape(array.shape)
+    if kind == "bool":
+        return np.asarray(data).astype(bool)
+    return data
+
+
+def _attach(dataset: h5py.Dataset, field: Field, obj, kind: str) -> None:
+    if field.columns is not None:
+        names, units = field.columns
+        dataset.attrs["names"] = list(getattr(obj, names))
+        if units is not None:
+            dataset.attrs["units"] = list(getattr(obj, units))
+    elif field.unit_field is not None:
+        dataset.attrs["units"] = getattr(obj, field.unit_field)
+    elif field.hdf5_units(kind) is not None:
+        dataset.attrs["units"] = field.hdf5_units(kind)
+
+
+def _attribute(field: Field, value):
+    """An attribute value as h5py takes it: tuples as lists of names or arrays of numbers."""
+    if isinstance(value, tuple):
+        return np.array(value, dtype=float) if field.kind == "float" else list(value)
+    return value
+
+
+def write_record(group: h5py.Group, obj, fields: Sequence[Field]) -> None:
+    """Store ``obj``'s ``fields`` in ``group``: attributes first (in one update), then the
+    datasets in declaration order."""
+    kind = str(getattr(obj, "kind", ""))
+    group.attrs.update({f.hdf5_key(kind): _attribute(f, getattr(obj, f.name)) for f in fields
+                        if f.stored == "attribute"})
+    for field in fields:
+        if field.stored == "dataset":
+            value = getattr(obj, field.name)
+            dataset = group.create_dataset(field.hdf5_key(kind), **_encoded(value, field.kind))
+            _attach(dataset, field, obj, kind)
+
+
+def read_record(group: h5py.Group, fields: Sequence[Field]) -> dict[str, Any]:
+    """The dataclass fields stored in ``group`` (the keyword arguments of its class), those
+    a dataset's ``names``/``units`` attributes carry included."""
+    values: dict[str, Any] = {}
+    for field in (f for f in fields if f.stored == "attribute"):
+        values[field.name] = _read_attribute(group.attrs, field)
+    kind = str(values.get("kind", ""))
+    for field in (f for f in fields if f.stored == "dataset" and not f.derived):
+        key = field.hdf5_key(kind)
+        if key not in group:
+            values[field.name] = _missing(field, key)
+            continue
+        dataset = group[key]
+        values[field.name] = _decoded(dataset[()], field.kind)
+        if field.columns is not None:
+            names, units = field.columns
+            values[names] = texts(dataset.attrs["names"])
+            if units is not None:
+                values[units] = texts(dataset.attrs["units"])
+        if field.unit_field is not None:
+            values[field.unit_field] = text(dataset.attrs["units"])
+    return values
+
+
+def _read_attribute(attributes, field: Field):
+    key = field.hdf5_key()
+    if key not in attributes:
+        return _missing(field, key)
+    value = attributes[key]
+    if field.kind == "array":
+        return value
+    if isinstance(value, np.ndarray):  # a list of names, or of numbers
+        return tuple(_CONVERT[field.kind](v) for v in value)
+    return _CONVERT[field.kind](value)
+
+
+def _missing(field: Field, key: str):
+    if field.default is REQUIRED:
+        raise KeyError(f"no {key!r}")
+    return field.default() if callable(field.default) else field.default
+
+
+def write_table(group: h5py.Group, rows: Sequence, fields: Sequence[Field],
+                context: dict[str, int] | None = None) -> None:
+    """Store ``rows`` (dataclass objects) in ``group``, one dataset per field: a column of
+    one value per row (2-D for array fields, ``width`` wide). ``context``: values of the
+    width names."""
+    context = context or {}
+    for field in fields:
+        values = [getattr(row, field.name) for row in rows]
+        if field.width is not None:
+            width = field.width if isinstance(field.width, int) else context[field.width]
+            values = np.array(values, dtype=float).reshape(len(rows), width)
+        dataset = group.create_dataset(field.hdf5_key(), **_encoded(values, field.kind))
+        if field.columns is not None:
+            names, _ = field.columns
+            dataset.attrs["names"] = list(getattr(rows[0], names)) if rows else []
+        elif field.hdf5_units() is not None:
+            dataset.attrs["units"] = field.hdf5_units()
+
+
+def read_table(group: h5py.Group, cls: type, fields: Sequence[Field]) -> tuple:
+    """The ``cls`` objects stored column by column in ``group`` by :func:`write_table`."""
+    columns: dict[str, Any] = {}
+    shared: dict[str, Any] = {}
+    for field in (f for f in fields if not f.derived):
+        key = field.hdf5_key()
+        if key in group:
+            columns[field.name] = group[key][()]
+            if field.columns is not None:
+                shared[field.columns[0]] = texts(group[key].attrs["names"])
+    length = max((len(c) for c in columns.values()), default=0)
+    rows = []
+    for k in range(length):
+        values = dict(shared)
+        for field in (f for f in fields if not f.derived):
+            if field.name in columns:
+                values[field.name] = _CONVERT[field.kind](columns[field.name][k])
+            else:
+                values[field.name] = _missing(field, field.hdf5_key())
+        rows.append(cls(**values))
+    return tuple(rows)
