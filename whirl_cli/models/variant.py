@@ -23,11 +23,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from .declaration import Dof, Family, Parameter, State
 from .laws import LAWS, Law
+
+if TYPE_CHECKING:  # numpy is imported where numbers are computed: validating a study needs none
+    import numpy as np
 
 
 @dataclass(frozen=True)
@@ -104,6 +106,8 @@ class Model:
     @cached_property
     def hub_matrix(self) -> np.ndarray:
         """(2, n): the hub displacement (y, z) normal to the spin axis is hub_matrix @ state."""
+        import numpy as np
+
         matrix = np.zeros((2, self.n_states))
         for row, terms in enumerate(self.family.hub):
             for index, factor in terms:
@@ -161,6 +165,8 @@ class Model:
 
     def parameter_vector(self, overrides: dict[str, float] | None = None) -> np.ndarray:
         """Parameter values in declaration order: defaults with ``overrides`` applied."""
+        import numpy as np
+
         values = self.defaults()
         for key, value in (overrides or {}).items():
             values[self.canonical(key)] = float(value)
