@@ -18,7 +18,7 @@ from .continuation.engine import Engine, Numerics
 from .continuation.loci import two_parameter
 from .continuation.one_parameter import one_parameter
 from .output.provenance import provenance
-from .results import Boundary, ContinuationResult, StudyResult
+from .results import Boundary, ContinuationResult, ParameterValue, StudyResult
 from .study import Study
 
 
@@ -72,7 +72,16 @@ def _run_study(study: Study, workroot: Path, jobs: int,
     return StudyResult(
         study_name=study.name, model=model.name, continuations=tuple(continuations),
         linear_sweeps=tuple(sweeps), runs=engine.records() if engine else (),
-        attributes=provenance(study), boundaries=tuple(found_boundaries), linear_grid=grid)
+        attributes=provenance(study), boundaries=tuple(found_boundaries), linear_grid=grid,
+        parameters=resolved_parameters(model, parameters))
+
+
+def resolved_parameters(model, overrides: dict[str, float]) -> tuple[ParameterValue, ...]:
+    """Every parameter of ``model`` as the study runs it: its value (``overrides``, by any
+    spelling, else the datum), datum and unit."""
+    values = model.parameter_vector(overrides)
+    return tuple(ParameterValue(p.name, float(v), float(p.default), p.unit)
+                 for p, v in zip(model.parameters, values, strict=True))
 
 
 def _two_parameter(engine: Engine, study: Study, spec, parameters: dict[str, float],

@@ -193,6 +193,7 @@ class SpecialPoint:
     bracket: np.ndarray = field(default_factory=lambda: np.full(2, np.nan))  # bracketed only
     residual: float = float("nan")  # relative rms fit residual (bracketed global points)
     lyapunov: float = float("nan")  # first Lyapunov coefficient (Hopf points of equilibria)
+    parameter_units: tuple[str, ...] = ()  # of parameter_names; () in schema-1 files
 
     @property
     def type_name(self) -> str:
@@ -316,6 +317,17 @@ class ContinuationResult:
 
 
 @dataclass(frozen=True)
+class ParameterValue:
+    """One model parameter as a study ran it: its ``value`` (the study's override, else the
+    datum), the model's ``datum``, its ``unit``."""
+
+    name: str
+    value: float
+    datum: float
+    unit: str
+
+
+@dataclass(frozen=True)
 class StudyResult:
     """A whole study's results, as written to one HDF5 file."""
 
@@ -327,3 +339,4 @@ class StudyResult:
     attributes: dict = field(default_factory=dict)  # provenance (versions, study text, hash)
     boundaries: tuple[Boundary, ...] = ()
     linear_grid: LinearGrid | None = None
+    parameters: tuple[ParameterValue, ...] = ()  # the resolved set; () in schema-1 files

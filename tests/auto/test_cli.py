@@ -22,7 +22,7 @@ def test_run_writes_hdf5_and_plot_then_refuses_to_overwrite(tmp_path):
     assert sorted(p.name for p in output.parent.iterdir()) == [
         "linear_case2.h5", "linear_case2_k1_bifurcation.png"]
     with h5py.File(output) as handle:
-        assert handle.attrs["whirl_schema"] == 1
+        assert handle.attrs["whirl_schema"] == store.SCHEMA
         assert handle.attrs["study_yaml"] == (STUDIES / "linear_case2.yaml").read_text()
         branch = handle["continuations/k1/branches/main_down"]
         assert branch["parameters"].attrs["names"].tolist() == ["K_theta"]

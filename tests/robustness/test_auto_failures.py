@@ -20,6 +20,7 @@ import pytest
 from click.testing import CliRunner
 
 from whirl_cli.cli import cli
+from whirl_cli.output import store
 
 from .helpers import WHIRL, environment
 
@@ -48,7 +49,7 @@ def check_stored(output: Path, failed: dict[str, tuple[str, str]], good: str = "
     """``failed``: run name -> (status, message part). The run records and branches of those
     runs carry them; every other run and branch is ok, and the good continuation has points."""
     with h5py.File(output) as handle:
-        assert handle.attrs["whirl_schema"] == 1
+        assert handle.attrs["whirl_schema"] == store.SCHEMA
         runs = {name: dict(group.attrs) for name, group in handle["runs"].items()}
         assert set(failed) <= set(runs), runs.keys()
         for name, attrs in runs.items():

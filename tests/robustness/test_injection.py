@@ -27,6 +27,7 @@ from whirl_cli.auto.constants import constants_text
 from whirl_cli.cli import cli
 from whirl_cli.errors import CodegenError
 from whirl_cli.models import all_variants
+from whirl_cli.output import store
 
 from .helpers import ROOT, STUDIES
 
@@ -239,7 +240,7 @@ def test_output_path_with_dot_dot_writes_exactly_where_asked(tmp_path, monkeypat
         "a", "s.yaml", "x.h5", "x_airspeed_bifurcation.png", "x_linear_V.png"]
     assert list(cwd.iterdir()) == [] and [p.name for p in (tmp_path / "a").iterdir()] == ["b"]
     with h5py.File(tmp_path / "x.h5") as handle:
-        assert handle.attrs["whirl_schema"] == 1
+        assert handle.attrs["whirl_schema"] == store.SCHEMA
     # a directory that does not exist yet is created; a file in the way is a clear error
     (tmp_path / "file").write_text("")
     blocked = CliRunner().invoke(cli, ["run", str(study), "-o", "../../file/x.h5"])

@@ -58,7 +58,7 @@ def check_output_dir(directory: Path, name: str = "r.h5") -> bool:
     if name not in names:
         return False
     with h5py.File(directory / name, "r") as handle:
-        assert handle.attrs["whirl_schema"] == 1
+        assert handle.attrs["whirl_schema"] == store.SCHEMA
     result = store.read(directory / name)  # every dataset readable
     assert result.continuations and result.runs
     return True

@@ -68,10 +68,11 @@ def branch(name: str, kind: str, n: int) -> results.Branch:
         stability_known=rng.random(n) > 0.5)
 
 
-def test_a_result_with_every_kind_of_record_round_trips(tmp_path):
+def synthetic_result() -> results.StudyResult:
     point = results.SpecialPoint("b_periodic", 1, 5, ("V",), np.array([0.5]), np.zeros(2), 0.2,
                                  True, label=3, status="bracketed", criticality="sub",
-                                 note="n", bracket=np.array([0.4, 0.6]), residual=0.1)
+                                 note="n", bracket=np.array([0.4, 0.6]), residual=0.1,
+                                 parameter_units=("m/s",))
     result = results.StudyResult(
         "s", "m", (results.ContinuationResult(
             "c", "one-parameter", (branch("b_equilibrium", results.BranchKind.EQUILIBRIUM, 4),
@@ -89,7 +90,14 @@ def test_a_result_with_every_kind_of_record_round_trips(tmp_path):
                           (np.zeros((5, 2)),), (0.1, 0.2)),),
         results.LinearGrid("V", "K", "m/s", "N m/rad", np.arange(3.0), np.arange(2.0),
                            np.zeros((2, 3)), np.zeros((2, 3), dtype=bool),
-                           (np.ones((3, 2)),), ()))
+                           (np.ones((3, 2)),), ()),
+        (results.ParameterValue("V", 7.0, 6.7, "m/s"),
+         results.ParameterValue("K", 0.3, 0.4, "N m/rad")))
+    return result
+
+
+def test_a_result_with_every_kind_of_record_round_trips(tmp_path):
+    result = synthetic_result()
     back = store.read(store.write(result, tmp_path / "r.h5"))
     assert repr(back) == repr(result)  # every value, type and order
     with store.opened(tmp_path / "r.h5") as handle:  # Floquet multipliers stored as such
@@ -97,3 +105,72 @@ def test_a_result_with_every_kind_of_record_round_trips(tmp_path):
         assert "floquet_multipliers" in periodic and "eigenvalues" not in periodic
         assert periodic["floquet_multipliers"].attrs["units"] == "1"
         assert handle["linear/sweeps/V/values"].attrs["units"] == "m/s"
+
+
+def test_every_physical_dataset_says_its_units(tmp_path):
+    """Issue 17, item 5: every dataset of numbers that are not counts, codes or flags carries
+    ``units`` (one per column where the columns differ, one per row for cross-checks)."""
+    import h5py
+
+    path = store.write(synthetic_result(), tmp_path / "r.h5")
+    missing = []
+    with h5py.File(path) as handle:
+        def visit(name, item):
+            if isinstance(item, h5py.Dataset) and item.dtype.kind in "fc" and \
+                    "units" not in item.attrs:
+                missing.append(name)
+        handle.visititems(visit)
+        points = handle["continuations/c/special_points"]
+        assert list(points["parameters"].attrs["units"]) == ["m/s"]
+        assert list(points["state"].attrs["units"]) == ["m", "m/s"]
+        assert points["lyapunov"].attrs["units"] == "1/(s m^2)"
+        checks = handle["continuations/c/cross_checks"]
+        assert list(checks["parameter"].attrs["units"]) == ["m/s"]
+        assert list(checks["expected"].attrs["units"]) == ["m"]  # q1's unit
+        assert handle.attrs["whirl_schema"] == store.SCHEMA == 2
+    assert missing == []
+
+
+def test_every_branch_says_how_it_ends():
+    """The ends AUTO's stops give, for a run of any kind (issue 17, item 5)."""
+    from dataclasses import replace
+
+    from whirl_cli.continuation.engine import run_end
+    from whirl_cli.models import get_model
+
+    model = get_model("oscillators")
+    b = branch("b", results.BranchKind.EQUILIBRIUM, 4)
+    b = replace(b, parameter_names=("V",), parameters=np.array([[0.0], [1.0], [2.0], [3.0]]),
+                state_max=np.zeros((4, model.n_states)), state_min=np.zeros((4, model.n_states)),
+                point_type=np.zeros(4, dtype=np.int64))
+    assert run_end(b, {"UZSTOP": {"V": [-1.0, 3.0]}}, model) == "range"
+    assert run_end(b, {"UZSTOP": {"V": [-1.0, 5.0]}, "NMX": 4}, model) == "step limit"
+    big = b.state_max.copy()
+    big[-1, 0] = 1.5 * model.dofs[0].amplitude
+    dof = model.dofs[0].name
+    assert run_end(replace(b, state_max=big), {"UZSTOP": {f"max_{dof}": 1.5}}, model) == \
+        "amplitude bound"
+    assert run_end(replace(b, status="mx"), {}, model) == "no convergence (MX)"
+    ended = replace(b, point_type=np.array([0, 0, 0, 9]))
+    assert run_end(ended, {"NMX": 100}, model) == "AUTO end point"
+
+
+@pytest.mark.parametrize("name", ["hardening_case2", "linear_datum_airspeed"])
+def test_a_schema_1_file_still_reads_and_plots(tmp_path, name):
+    """The committed references were written in schema 1 (no units on special points, no
+    parameter set): they read, with what they lack left empty, and every plot kind draws."""
+    from click.testing import CliRunner
+
+    from whirl_cli.cli import cli
+
+    from ..conftest import ROOT
+
+    path = ROOT / "tests" / "regression" / "references" / f"{name}.h5"
+    with store.opened(path) as handle:
+        assert handle.attrs["whirl_schema"] == 1
+    result = store.read(path)
+    assert result.parameters == ()
+    assert all(p.parameter_units == () for c in result.continuations for p in c.special_points)
+    run = CliRunner().invoke(cli, ["plot", str(path), "-o", str(tmp_path)])
+    assert run.exit_code == 0, run.output
+    assert list(tmp_path.glob("*.png"))

@@ -238,6 +238,7 @@ def analyse(family: Branch, model: Model, parameters: dict[str, float],
     return SpecialPoint(
         branch=family.name, index=last, point_type=int(kind),
         parameter_names=family.parameter_names, parameters=np.array([estimate]),
+        parameter_units=family.parameter_units,
         state=np.asarray(state, dtype=float), period=float(family.period[last]),
         stable=False, status="bracketed", note=note, bracket=bracket,
         residual=fit.residual if fit else float("nan"))

@@ -31,13 +31,14 @@ def reverse(branch: Branch) -> Branch:
 
 def join(first: Branch, second: Branch, name: str) -> Branch:
     """One branch from two consecutive runs (the second restarted at the first's last point,
-    which it repeats)."""
+    which it repeats); it ends as the second does."""
     shift = len(first)
     stacked = {key: np.concatenate([getattr(first, key), getattr(second, key)[1:]])
                for key in COLUMNS}
     moved = tuple(replace(o, index=o.index + shift - 1) for o in second.orbits if o.index > 0)
     return replace(first, name=name, status=second.status, message=second.message,
-                   run=f"{first.run}+{second.run}", orbits=first.orbits + moved, **stacked)
+                   end=second.end, run=f"{first.run}+{second.run}",
+                   orbits=first.orbits + moved, **stacked)
 
 
 def amplitude(branch: Branch, model: Model) -> np.ndarray:
@@ -57,6 +58,7 @@ def special_points(branch: Branch, skip_first: bool = False) -> list[SpecialPoin
         found.append(SpecialPoint(
             branch=branch.name, index=index, point_type=int(kind),
             parameter_names=branch.parameter_names, parameters=branch.parameters[index].copy(),
+            parameter_units=branch.parameter_units,
             state=branch.state_max[index].copy(), period=float(branch.period[index]),
             stable=bool(branch.stable[index]), label=int(branch.label[index])))
     return found

@@ -18,7 +18,7 @@ from ..auto.codegen import fortran_source, source_key
 from ..auto.parse import read_branch
 from ..interrupts import thread_map
 from ..models import Model
-from ..results import Branch, RunRecord, SpecialPoint
+from ..results import Branch, PointType, RunRecord, SpecialPoint
 from .branches import special_points
 
 
@@ -125,12 +125,7 @@ def _run_branches(engine: Engine, specs: list[RunSpec], branches: list[Branch],
     """Run ``specs``, append their branches and special points; return the new points."""
     new_points: list[SpecialPoint] = []
     for spec, outcome in zip(specs, engine.run_many(specs), strict=True):
-        if not outcome.has_output:
-            branches.append(_failed_branch(engine.model, spec, outcome))
-            continue
-        branch = read_branch(outcome, engine.model, name=spec.name.split("/", 1)[-1],
-                             kind=spec.kind, origin=spec.origin,
-                             parameter_names=spec.parameter_names)
+        branch = _read(engine, spec, outcome)
         branches.append(branch)
         found = special_points(branch, skip_first=skip_first)
         points.extend(found)
@@ -154,8 +149,46 @@ def _failed_branch(model: Model, spec: RunSpec, outcome: runner.RunOutcome) -> B
 
 
 def _read(engine: Engine, spec: RunSpec, outcome: runner.RunOutcome) -> Branch:
+    """The branch of one run, with why it ends (:func:`run_end`; recipes that know more, such
+    as the periodic one, say more)."""
     if not outcome.has_output:
-        return _failed_branch(engine.model, spec, outcome)
-    return read_branch(outcome, engine.model, name=spec.name.split("/", 1)[-1], kind=spec.kind,
-                       origin=spec.origin, parameter_names=spec.parameter_names)
+        branch = _failed_branch(engine.model, spec, outcome)
+    else:
+        branch = read_branch(outcome, engine.model, name=spec.name.split("/", 1)[-1],
+                             kind=spec.kind, origin=spec.origin,
+                             parameter_names=spec.parameter_names)
+    return replace(branch, end=branch.end or run_end(branch, spec.constants, engine.model))
+
+
+def run_end(branch: Branch, constants: dict, model: Model) -> str:
+    """Why an AUTO run's branch ends, from the stops it ran with: "failed: ..." (no output),
+    "no convergence (MX)", "range" (a parameter at a UZSTOP bound), "amplitude bound" (a dof
+    at its UZSTOP amplitude, in typical amplitudes), "period cap", "step limit" (NMX points)
+    or "AUTO end point" (another EP, e.g. a locus meeting a degenerate point)."""
+    if not len(branch):
+        return f"failed: {branch.message}"
+    if branch.status == "mx" or branch.point_type[-1] == PointType.MX:
+        return "no convergence (MX)"
+    if branch.status != "ok":
+        return f"{branch.status}: {branch.message}"
+    dofs = {dof.name: k for k, dof in enumerate(model.dofs)}
+    amplitudes = [dof.amplitude for dof in model.dofs]
+    for name, limit in constants.get("UZSTOP", {}).items():
+        limits = limit if isinstance(limit, list | tuple) else [limit]
+        if name in branch.parameter_names:
+            value = branch.parameters[-1, branch.parameter_names.index(name)]
+            width = max(abs(limits[-1] - limits[0]), abs(limits[0]), 1e-12)
+            if any(abs(value - v) <= 1e-6 * width for v in limits):
+                return "range"
+        elif name == "PERIOD" and branch.period[-1] >= 0.999 * limits[0] / model.time_scale:
+            return "period cap"
+        elif name[:4] in ("max_", "min_") and name[4:] in dofs:
+            k = dofs[name[4:]]
+            reach = max(abs(branch.state_max[-1, k]), abs(branch.state_min[-1, k])) \
+                / amplitudes[k]
+            if reach >= 0.999 * abs(limits[0]):
+                return "amplitude bound"
+    if len(branch) >= constants.get("NMX", np.inf):
+        return "step limit"
+    return "AUTO end point" if branch.point_type[-1] == PointType.EP else "step limit"
 

@@ -368,7 +368,8 @@ def compare_branch(path: str, a: Branch, b: Branch, span: float, tolerances: Tol
                    ) -> list[Difference]:
     """One branch of both files: attributes exact, states and stability along the parameter."""
     found = [Difference(f"{path}/@{key}", getattr(a, key), getattr(b, key))
-             for key in ("kind", "status", "end") if getattr(a, key) != getattr(b, key)]
+             for key in ("kind", "status", "end") if getattr(a, key) != getattr(b, key)
+             and not (key == "end" and "" in (a.end, b.end))]  # schema 1: not recorded
     if a.state_names != b.state_names:
         return found + [Difference(f"{path}/state_max", f"states {a.state_names}",
                                    f"{b.state_names}")]
@@ -611,6 +612,9 @@ def _compare_arrays(path: str, x: np.ndarray, y: np.ndarray, rtol: float) -> lis
 
 
 # ------------------------------------------------------------------------------ boundaries
+#: Attributes schema 2 added to the datasets of those groups: absent from a schema-1 file,
+#: which is no drift.
+SCHEMA_2_ATTRIBUTES = ("/@names", "/@units")
 #: Groups compared dataset by dataset with h5py (their layout is not needed here).
 GENERIC_GROUPS = ("boundaries", "linear/grid")
 
@@ -623,7 +627,8 @@ def compare_boundaries(a: Path, b: Path, tolerances: Tolerances,
     data_a, data_b = _datasets(a, roots), _datasets(b, roots)
     found = [Difference(name, "present" if name in data_a else "missing",
                         "present" if name in data_b else "missing")
-             for name in sorted(set(data_a) ^ set(data_b))]
+             for name in sorted(set(data_a) ^ set(data_b))
+             if not name.endswith(SCHEMA_2_ATTRIBUTES)]  # what a schema-1 file lacks
     for name in sorted(set(data_a) & set(data_b)):
         x, y = data_a[name], data_b[name]
         if _is_curve(name, x) and _is_curve(name, y):

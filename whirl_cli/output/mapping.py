@@ -176,11 +176,14 @@ def _missing(field: Field, key: str):
 
 
 def write_table(group: h5py.Group, rows: Sequence, fields: Sequence[Field],
-                context: dict[str, int] | None = None) -> None:
+                context: dict[str, int] | None = None,
+                attributes: dict[str, dict] | None = None) -> None:
     """Store ``rows`` (dataclass objects) in ``group``, one dataset per field: a column of
     one value per row (2-D for array fields, ``width`` wide). ``context``: values of the
-    width names."""
+    width names; ``attributes``: more attributes of a field's dataset (e.g. the names and
+    units of a state column the rows do not hold), by field name."""
     context = context or {}
+    attributes = attributes or {}
     for field in fields:
         values = [getattr(row, field.name) for row in rows]
         if field.width is not None:
@@ -188,10 +191,13 @@ def write_table(group: h5py.Group, rows: Sequence, fields: Sequence[Field],
             values = np.array(values, dtype=float).reshape(len(rows), width)
         dataset = group.create_dataset(field.hdf5_key(), **_encoded(values, field.kind))
         if field.columns is not None:
-            names, _ = field.columns
+            names, units = field.columns
             dataset.attrs["names"] = list(getattr(rows[0], names)) if rows else []
+            if units is not None:
+                dataset.attrs["units"] = list(getattr(rows[0], units)) if rows else []
         elif field.hdf5_units() is not None:
             dataset.attrs["units"] = field.hdf5_units()
+        dataset.attrs.update(attributes.get(field.name, {}))
 
 
 def read_table(group: h5py.Group, cls: type, fields: Sequence[Field]) -> tuple:
@@ -203,7 +209,10 @@ def read_table(group: h5py.Group, cls: type, fields: Sequence[Field]) -> tuple:
         if key in group:
             columns[field.name] = group[key][()]
             if field.columns is not None:
-                shared[field.columns[0]] = texts(group[key].attrs["names"])
+                names, units = field.columns
+                shared[names] = texts(group[key].attrs["names"])
+                if units is not None and "units" in group[key].attrs:  # older files: none
+                    shared[units] = texts(group[key].attrs["units"])
     length = max((len(c) for c in columns.values()), default=0)
     rows = []
     for k in range(length):

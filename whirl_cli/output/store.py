@@ -1,4 +1,4 @@
-"""HDF5 output: the one writer and the one reader of whirl's result files (schema 1).
+"""HDF5 output: the one writer and the one reader of whirl's result files (schema 2; reads 1).
 
 Layout (units in a ``units`` attribute on every physical dataset)::
 
@@ -31,6 +31,7 @@ Layout (units in a ``units`` attribute on every physical dataset)::
         loci/<branch>               (K, 2) locus curve in the two parameters; attrs kind
         unsafe/polygon_<k>          (K, 2) closed outline of the unsafe region
         unsafe_intervals/           slice_value, lower, upper, cause (flutter | divergence)
+    /parameters/                    columns: name, value, datum, unit (the resolved set)
     /runs/<run>                     attrs: status, message, constants, returncode,
                                            wall_seconds, n_points
 
@@ -70,6 +71,7 @@ from ..results import (
     LinearGrid,
     LinearSweep,
     Orbit,
+    ParameterValue,
     RunRecord,
     SpecialPoint,
     StudyResult,
@@ -78,7 +80,9 @@ from ..results import (
 from .atomic import publish
 from .mapping import Field, read_record, read_table, text, write_record, write_table
 
-SCHEMA = 1
+SCHEMA = 2
+#: Schemas :func:`read` reads (1: before units on every dataset and the parameter set).
+READABLE = (1, 2)
 
 # ------------------------------------------------------------------------- the declarations
 _PERIODIC = BranchKind.PERIODIC
@@ -112,12 +116,18 @@ SPECIAL_POINT = (
     Field("branch", kind="text"), Field("index", kind="int"),
     Field("point_type", kind="int"), Field("type_name", kind="text", derived=True),
     Field("label", kind="int"),
-    Field("parameters", width="parameters", columns=("parameter_names", None)),
-    Field("state", width="states"),
-    Field("period", kind="float"), Field("stable", kind="bool"),
+    Field("parameters", width="parameters", columns=("parameter_names", "parameter_units")),
+    Field("state", width="states"),  # names and units: the continuation's states
+    Field("period", kind="float", units="s"), Field("stable", kind="bool"),
     Field("status", kind="text"), Field("criticality", kind="text"), Field("note", kind="text"),
-    Field("bracket", width=2), Field("residual", kind="float"),
-    Field("lyapunov", kind="float", units="1/(s*state_unit^2)", default=float("nan")),
+    Field("bracket", width=2),  # units: the principal parameter's
+    Field("residual", kind="float", units="1"),
+    Field("lyapunov", kind="float", default=float("nan")),  # units: see _lyapunov_unit
+)
+#: The resolved :class:`ParameterValue` table of a study (``parameters/``; schema 2).
+PARAMETER = (
+    Field("name", kind="text"), Field("value", kind="float"), Field("datum", kind="float"),
+    Field("unit", kind="text"),
 )
 #: The :class:`CrossCheck` table of a continuation (``cross_checks/``).
 CROSS_CHECK = (
@@ -183,29 +193,61 @@ def _write_continuation(group: h5py.Group, continuation: ContinuationResult) -> 
     for branch in continuation.branches:
         _write_branch(_collection(group, "branches").create_group(branch.name), branch)
     points = continuation.special_points
+    first = continuation.branches[0] if continuation.branches else None
+    states = {"names": list(first.state_names) if first else [],
+              "units": list(first.state_units) if first else []}
     write_table(group.create_group("special_points"), points, SPECIAL_POINT, {
         "parameters": len(points[0].parameter_names) if points else 1,
-        "states": len(continuation.branches[0].state_names) if continuation.branches else 0})
-    if continuation.cross_checks:
+        "states": len(first.state_names) if first else 0}, {
+        "state": states,
+        "bracket": {"units": first.parameter_units[0] if first else ""},
+        "lyapunov": {"units": _lyapunov_unit(first.state_units) if first else ""}})
+    if continuation.cross_checks and first is not None:
         write_table(group.create_group("cross_checks"), continuation.cross_checks,
-                    CROSS_CHECK)
+                    CROSS_CHECK, attributes=_cross_check_units(continuation.cross_checks, first))
+
+
+def _cross_check_units(checks, branch: Branch) -> dict[str, dict]:
+    """Units of the cross-check columns: the principal parameter's (the value a check is at),
+    and per row those of expected and simulated: the compared state's unit for an orbit, the
+    dofs' typical amplitudes for an equilibrium."""
+    units = dict(zip(branch.state_names, branch.state_units, strict=True))
+    rows = [units.get(c.state, "") if c.kind == "orbit" else "typical amplitudes"
+            for c in checks]
+    return {"parameter": {"names": [branch.parameter_names[0]],
+                          "units": [branch.parameter_units[0]]},
+            "expected": {"units": rows}, "simulated": {"units": rows}}
+
+
+def _lyapunov_unit(state_units: tuple[str, ...]) -> str:
+    """The unit of the first Lyapunov coefficient with SI states, 1/(s u^2) where every dof
+    is in u (the first half of the states are the dofs)."""
+    dofs = set(state_units[: len(state_units) // 2])
+    unit = dofs.pop() if len(dofs) == 1 else "state_unit"
+    return f"1/(s {unit}^2)" if unit != "1" else "1/s"
 
 
 def _write_boundary(group: h5py.Group, boundary: Boundary) -> None:
     write_record(group, boundary, BOUNDARY)
+    pair = {"names": list(boundary.parameter_names), "units": list(boundary.parameter_units)}
     for name, (kind, curve) in boundary.loci.items():
         data = _collection(group, "loci").create_dataset(name, data=curve.reshape(-1, 2))
-        data.attrs["kind"] = kind
+        data.attrs.update(kind=kind, **pair)
     for k, polygon in enumerate(boundary.polygons):
-        _collection(group, "unsafe").create_dataset(f"polygon_{k}", data=polygon)
-    write_table(group.create_group("unsafe_intervals"), boundary.intervals, UNSAFE_INTERVAL)
+        _collection(group, "unsafe").create_dataset(f"polygon_{k}", data=polygon).attrs.update(
+            pair)
+    first, second = boundary.parameter_units
+    write_table(group.create_group("unsafe_intervals"), boundary.intervals, UNSAFE_INTERVAL,
+                attributes={"slice_value": {"units": second}, "lower": {"units": first},
+                            "upper": {"units": first}})
 
 
 def _write_grid(group: h5py.Group, grid: LinearGrid) -> None:
     write_record(group, grid, LINEAR_GRID)
     for kind in ("flutter", "divergence"):
         for k, line in enumerate(getattr(grid, kind)):
-            _collection(group, kind).create_dataset(f"line_{k}", data=line)
+            _collection(group, kind).create_dataset(f"line_{k}", data=line).attrs.update(
+                names=[grid.x_parameter, grid.y_parameter], units=[grid.x_unit, grid.y_unit])
 
 
 def write(result: StudyResult, path: Path, overwrite: bool = False) -> Path:
@@ -248,6 +290,9 @@ def _image(result: StudyResult) -> bytes:
         for boundary in result.boundaries:
             _write_boundary(_collection(handle, "boundaries").create_group(boundary.name),
                             boundary)
+        units = [p.unit for p in result.parameters]
+        write_table(handle.create_group("parameters"), result.parameters, PARAMETER,
+                    attributes={"value": {"units": units}, "datum": {"units": units}})
         runs = _collection(handle, "runs")
         for record in result.runs:
             write_record(runs.create_group(record.name), record, RUN)
@@ -358,9 +403,9 @@ def read(path: Path) -> StudyResult:
             raise OutputError(f"{path}: an HDF5 file but not a whirl result file (no "
                               "whirl_schema attribute)")
         schema = int(handle.attrs["whirl_schema"])
-        if schema != SCHEMA:
-            raise OutputError(f"{path}: not a whirl result file of schema {SCHEMA} "
-                              f"(found {schema})")
+        if schema not in READABLE:
+            raise OutputError(f"{path}: a whirl result file of schema {schema}; this whirl "
+                              f"reads schemas {', '.join(map(str, READABLE))}")
         continuations = tuple(_read_continuation(name, group)
                               for name, group in handle.get("continuations", {}).items())
         sweeps = tuple(LinearSweep(**read_record(group, LINEAR_SWEEP))
@@ -373,5 +418,8 @@ def read(path: Path) -> StudyResult:
         skip = {"whirl_schema", "study_name", "model"}
         attributes = {k: (text(v) if isinstance(v, bytes | str) else v)
                       for k, v in handle.attrs.items() if k not in skip}
+        parameters = read_table(handle["parameters"], ParameterValue, PARAMETER) \
+            if "parameters" in handle else ()
         return StudyResult(text(handle.attrs["study_name"]), text(handle.attrs["model"]),
-                           continuations, sweeps, runs, attributes, boundaries, grid)
+                           continuations, sweeps, runs, attributes, boundaries, grid,
+                           parameters)
