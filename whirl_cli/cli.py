@@ -107,6 +107,11 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     found = verdict(result, published.plot_error)
     for note in found.notes:
         console.print(f"note: {note}", soft_wrap=True)
+    from .output.summary import render
+
+    console.print(render(result, "table", study.variant().family.dof_names,
+                         console.width if console.is_terminal else None),
+                  end="", soft_wrap=True, markup=False)
     checks = [x for c in result.continuations for x in c.cross_checks]
     if checks:
         console.print(f"cross-checks by time simulation: {sum(x.passed for x in checks)} of "
@@ -114,6 +119,30 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     if found.problems:
         raise WhirlError(f"{len(found.problems)} problem(s); the results are stored with "
                          "their status: " + "; ".join(found.problems))
+
+
+# ------------------------------------------------------------------------------------ summary
+@cli.command()
+@click.argument("result_file", type=click.Path(path_type=Path))
+@click.option("--format", "output_format", type=click.Choice(["table", "csv", "json"]),
+              default="table", show_default=True,
+              help="A table per continuation to read, or CSV / JSON (one row per special "
+                   "point, numbers at full precision) for scripts.")
+def summary(result_file: Path, output_format: str) -> None:
+    """Print the special points of a result file: type, parameters, amplitude of every dof
+    (angles in degrees), period, stability, criticality, status."""
+    from .output import store
+    from .output.summary import render
+
+    if not result_file.exists():
+        raise OutputError(f"{result_file}: no such file")
+    if result_file.is_dir():
+        raise OutputError(f"{result_file}: is a directory, not a result file")
+    result = store.read(result_file)
+    study = _stored_study(result)
+    dofs = study.variant().family.dof_names if study is not None else None
+    width = shutil.get_terminal_size().columns if sys.stdout.isatty() else None
+    click.echo(render(result, output_format, dofs, width), nl=False)
 
 
 # ------------------------------------------------------------------------------------ check
@@ -239,10 +268,16 @@ def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None,
 def _stored_plot_state(result) -> str | None:
     """The ``plot_state`` of the study stored with ``result`` (None if unset, or if that study
     no longer validates)."""
+    study = _stored_study(result)
+    return None if study is None else study.plot_state
+
+
+def _stored_study(result):
+    """The study stored with ``result`` (None if that study no longer validates)."""
     from .study import validate_text
 
     try:
-        return validate_text(str(result.attributes.get("study_yaml", ""))).plot_state
+        return validate_text(str(result.attributes.get("study_yaml", "")))
     except WhirlError:
         return None
 
