@@ -7,6 +7,7 @@ import csv
 import io
 import json
 import math
+from dataclasses import replace
 
 import h5py
 import numpy as np
@@ -204,3 +205,26 @@ def test_other_hdf5_file_is_one_line(tmp_path):
     result = CliRunner().invoke(cli, ["summary", str(path)])
     assert result.exit_code == 1
     assert len(result.stderr.splitlines()) == 1 and "not a whirl result file" in result.stderr
+
+
+def test_a_long_run_of_one_type_is_shortened_in_the_table_only(tmp_path):
+    """Eight GH points in a row on one branch (as on a linear model's Hopf locus) are shown
+    as the first, "... 6 more GH" and the last; CSV and JSON keep every one."""
+    base = oscillator_result()
+    (continuation,) = base.continuations
+    hopf = continuation.special_points[0]
+    ghs = tuple(replace(hopf, point_type=-32, parameters=np.array([-0.01 * k, 2.0]))
+                for k in range(1, 9))
+    two_hopf = (hopf, replace(hopf, parameters=np.array([0.05, 2.0])))
+    points = two_hopf + ghs + (continuation.special_points[2],)
+    result = replace(base, continuations=(replace(continuation, special_points=points),))
+    path = tmp_path / "many.h5"
+    store.write(result, path)
+    assert len(json.loads(summary(path, "--format", "json"))) == 11
+    lines = summary(path).splitlines()
+    assert lines[0] == "alpha (one-parameter): 11 special points"
+    body = [line.split()[:3] for line in lines[2:]]
+    assert body == [["main", "HB", "-0.0125"], ["main", "HB", "0.05"],
+                    ["main", "GH", "-0.01"], ["...", "6", "more"], ["main", "GH", "-0.08"],
+                    ["periodic_1", "LPC", "-0.05"]]
+    assert lines[5].split() == ["...", "6", "more", "GH"]

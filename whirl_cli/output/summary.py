@@ -214,9 +214,43 @@ def _cell(value: object) -> str:
     return number(value) if value is None or isinstance(value, float) else str(value)
 
 
+RUN_SHOWN = 3
+"""A table shows runs of at most this many consecutive points of one type on one branch in
+full; a longer run as its first and last row with one "... N more" row between them."""
+
+
+@dataclass(frozen=True)
+class Skipped:
+    """Where :func:`compact` left out ``count`` records of points of ``type``."""
+
+    count: int
+    type: str
+
+
+def compact(records_: Sequence[dict[str, object]], longest: int = RUN_SHOWN
+            ) -> list[dict[str, object] | Skipped]:
+    """``records_`` with every run of more than ``longest`` consecutive records of the same
+    branch and type replaced by its first record, a :class:`Skipped` and its last record
+    (e.g. the many GH points AUTO flags along a Hopf locus of a linear model)."""
+    shown: list[dict[str, object] | Skipped] = []
+    start = 0
+    while start < len(records_):
+        key = (records_[start]["branch"], records_[start]["type"])
+        end = start
+        while end + 1 < len(records_) and \
+                (records_[end + 1]["branch"], records_[end + 1]["type"]) == key:
+            end += 1
+        run = list(records_[start:end + 1])
+        shown += run if len(run) <= longest else [run[0], Skipped(len(run) - 2, str(key[1])),
+                                                  run[-1]]
+        start = end + 1
+    return shown
+
+
 def tables(result: StudyResult, dofs: Sequence[str] | None = None) -> list:
     """One rich Table per continuation of ``result`` (its special points, as in
-    :func:`summary_rows`; a continuation without any gets a table with a "none" caption)."""
+    :func:`summary_rows`, long runs of one type on one branch shortened by :func:`compact`;
+    a continuation without any gets a table with a "none" caption)."""
     from rich.markup import escape
     from rich.table import Table
 
@@ -231,8 +265,12 @@ def tables(result: StudyResult, dofs: Sequence[str] | None = None) -> list:
         for name in names:
             numeric = name not in ("branch", "type", *LAST_COLUMNS[1:])
             table.add_column(escape(name), justify="right" if numeric else "left", no_wrap=True)
-        for record in records(rows):
-            table.add_row(*(escape(_cell(record[name])) for name in names))
+        for record in compact(records(rows)):
+            if isinstance(record, Skipped):
+                table.add_row("...", escape(f"{record.count} more {record.type}"),
+                              *[""] * (len(names) - 2))
+            else:
+                table.add_row(*(escape(_cell(record[name])) for name in names))
         drawn.append(table)
     return drawn
 
