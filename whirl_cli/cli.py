@@ -6,6 +6,7 @@ results are still written, with each run's status); 2 usage errors (click).
 
 from __future__ import annotations
 
+import math
 import os
 import shutil
 import sys
@@ -107,6 +108,11 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     found = verdict(result, published.plot_error)
     for note in found.notes:
         console.print(f"note: {note}", soft_wrap=True)
+    from .output.summary import render
+
+    console.print(render(result, "table", study.variant().family.dof_names,
+                         console.width if console.is_terminal else None),
+                  end="", soft_wrap=True, markup=False)
     checks = [x for c in result.continuations for x in c.cross_checks]
     if checks:
         console.print(f"cross-checks by time simulation: {sum(x.passed for x in checks)} of "
@@ -114,6 +120,30 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     if found.problems:
         raise WhirlError(f"{len(found.problems)} problem(s); the results are stored with "
                          "their status: " + "; ".join(found.problems))
+
+
+# ------------------------------------------------------------------------------------ summary
+@cli.command()
+@click.argument("result_file", type=click.Path(path_type=Path))
+@click.option("--format", "output_format", type=click.Choice(["table", "csv", "json"]),
+              default="table", show_default=True,
+              help="A table per continuation to read, or CSV / JSON (one row per special "
+                   "point, numbers at full precision) for scripts.")
+def summary(result_file: Path, output_format: str) -> None:
+    """Print the special points of a result file: type, parameters, amplitude of every dof
+    (angles in degrees), period, stability, criticality, status."""
+    from .output import store
+    from .output.summary import render
+
+    if not result_file.exists():
+        raise OutputError(f"{result_file}: no such file")
+    if result_file.is_dir():
+        raise OutputError(f"{result_file}: is a directory, not a result file")
+    result = store.read(result_file)
+    study = _stored_study(result)
+    dofs = study.variant().family.dof_names if study is not None else None
+    width = shutil.get_terminal_size().columns if sys.stdout.isatty() else None
+    click.echo(render(result, output_format, dofs, width), nl=False)
 
 
 # ------------------------------------------------------------------------------------ check
@@ -202,21 +232,37 @@ def models() -> None:
 
 
 # ------------------------------------------------------------------------------------ plot
+def _limits(ctx: click.Context, param: click.Parameter, value):
+    """``--xlim``/``--ylim``: two different finite numbers (None if not given)."""
+    if value is None:
+        return None
+    low, high = value
+    if not (math.isfinite(low) and math.isfinite(high)) or low == high:
+        raise click.BadParameter(f"expected two different finite numbers, got {low:g} {high:g}")
+    return float(low), float(high)
+
+
 @cli.command()
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--kind", "kinds", multiple=True,
               type=click.Choice(["bifurcation", "linear", "projections", "period", "phase",
                                  "boundary"]),
-              help="Plot kind (repeatable) [default: all available].")
+              help="Plot kind (repeatable) [default: every kind the file has the data for]; "
+                   "a kind it lacks the data for is an error.")
 @click.option("-o", "--output-dir", type=click.Path(file_okay=False, path_type=Path),
               help="Directory for the PNG files [default: next to RESULT_FILE].")
 @click.option("--state", help="State the bifurcation diagrams draw [default: the study's "
               "plot_state, else the model's first dof].")
+@click.option("--xlim", nargs=2, type=float, callback=_limits, metavar="LOW HIGH",
+              help="x-axis limits of every figure, in the units shown.")
+@click.option("--ylim", nargs=2, type=float, callback=_limits, metavar="LOW HIGH",
+              help="y-axis limits of every figure, in the units shown (degrees for angles).")
+@click.option("--hz", is_flag=True, help="Frequencies in Hz instead of rad/s (linear sweeps).")
 def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None,
-         state: str | None) -> None:
+         state: str | None, xlim, ylim, hz: bool) -> None:
     """Draw the plots of a whirl result file."""
     from .output import store
-    from .plots.files import save_study_plots
+    from .plots.files import View, available_kinds, missing_data, save_study_plots
 
     result = store.read(result_file)
     states = {s for c in result.continuations for b in c.branches for s in b.state_names}
@@ -225,24 +271,39 @@ def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None,
     elif states and state not in states:
         raise WhirlError(f"--state {state}: not a state of {result_file.name} (states: "
                          f"{', '.join(sorted(states))})")
+    lacking = [f"--kind {kind}: {result_file.name} has {missing_data(result, kind)}"
+               for kind in dict.fromkeys(kinds) if missing_data(result, kind)]
+    if lacking:
+        raise WhirlError("\n".join(lacking))
+    kinds = kinds or available_kinds(result)
+    if not kinds:
+        raise WhirlError(f"{result_file.name}: nothing to plot (no continuation, linear "
+                         "sweep, boundary or linear grid)")
     output_dir = output_dir or result_file.parent
     try:
         output_dir.mkdir(parents=True, exist_ok=True)
     except OSError as error:
         raise OutputError(f"{output_dir}: cannot create the output directory "
                           f"({error.strerror or error})") from None
-    kinds = kinds or ("bifurcation", "linear", "period", "boundary")
-    for path in save_study_plots(result, kinds, output_dir, result_file.stem, state):
+    view = View(xlim=xlim, ylim=ylim, hz=hz)
+    for path in save_study_plots(result, kinds, output_dir, result_file.stem, state,
+                                 view=view):
         click.echo(f"wrote {path}")
 
 
 def _stored_plot_state(result) -> str | None:
     """The ``plot_state`` of the study stored with ``result`` (None if unset, or if that study
     no longer validates)."""
+    study = _stored_study(result)
+    return None if study is None else study.plot_state
+
+
+def _stored_study(result):
+    """The study stored with ``result`` (None if that study no longer validates)."""
     from .study import validate_text
 
     try:
-        return validate_text(str(result.attributes.get("study_yaml", ""))).plot_state
+        return validate_text(str(result.attributes.get("study_yaml", "")))
     except WhirlError:
         return None
 

@@ -91,10 +91,10 @@ def _two_parameter(engine: Engine, study: Study, spec, parameters: dict[str, flo
     pair = tuple(spec.parameters)
     bounds = spec.bounds(study.names())
     continuation, curves = two_parameter(engine, spec.name, pair, bounds, spec.start,
-                                         tuple(spec.slices), tuple(spec.loci), parameters,
+                                         spec.slice_values, tuple(spec.loci), parameters,
                                          numerics)
     per_slice = [tuple(b for b in continuation.branches if b.name.startswith(f"slice_{k}."))
                  for k in range(len(spec.slices))]
     found = boundaries.boundary(spec.name, model, parameters, pair, bounds, spec.method,
-                                tuple(spec.slices), spec.resolution, curves, per_slice)
+                                spec.slice_values, spec.resolution, curves, per_slice)
     return continuation, found

@@ -40,8 +40,13 @@ def test_run_writes_hdf5_and_plot_then_refuses_to_overwrite(tmp_path):
 def test_store_round_trip(tmp_path):
     output = tmp_path / "r.h5"
     runner = CliRunner()
-    assert runner.invoke(cli, ["run", str(STUDIES / "linear_datum_airspeed.yaml"), "-o",
-                               str(output), "--no-plots"]).exit_code == 0
+    ran = runner.invoke(cli, ["run", str(STUDIES / "linear_datum_airspeed.yaml"), "-o",
+                              str(output), "--no-plots"])
+    assert ran.exit_code == 0, ran.output
+    # whirl run ends with the table whirl summary prints from the file (issue 17, item 4)
+    table = runner.invoke(cli, ["summary", str(output)]).stdout
+    assert table.startswith("airspeed (one-parameter): 1 special point\n")
+    assert ran.stderr.endswith(table)
     first = store.read(output)
     copy = store.write(first, tmp_path / "copy.h5")
     second = store.read(copy)
@@ -55,8 +60,8 @@ def test_store_round_trip(tmp_path):
     assert set(sweep.whirl.ravel()) == {"FW", "BW"}
     plotted = runner.invoke(cli, ["plot", str(copy), "-o", str(tmp_path / "plots")])
     assert plotted.exit_code == 0, plotted.output
-    assert sorted(p.name for p in (tmp_path / "plots").iterdir()) == [
-        "copy_airspeed_bifurcation.png", "copy_linear_V.png"]
+    assert sorted(p.name for p in (tmp_path / "plots").iterdir()) == [  # every kind it has
+        "copy_airspeed_bifurcation.png", "copy_airspeed_projections.png", "copy_linear_V.png"]
 
 
 def test_validate_models_and_doctor():

@@ -497,15 +497,16 @@ def orbit_branch() -> Branch:
 def test_phase_plane_closed_curves_in_degrees(orbit_branch):
     ax = phase_plane(orbit_branch).axes[0]
     assert len(ax.lines) == 2
-    for line, orbit in zip(ax.lines, orbit_branch.orbits, strict=True):
+    by_parameter = orbit_branch.orbits[::-1]  # K1 = 0.1234, then 0.35
+    for line, orbit in zip(ax.lines, by_parameter, strict=True):
         xs, ys = line.get_xdata(), line.get_ydata()
         assert (xs[0], ys[0]) == (xs[-1], ys[-1])
         np.testing.assert_allclose(xs[:20], np.degrees(orbit.states[:20, 0]))
         np.testing.assert_allclose(ys[:20], np.degrees(orbit.states[:20, 1]))
     assert [len(line.get_xdata()) for line in ax.lines] == [21, 21]  # one closed, one as is
-    assert [line.get_linestyle() for line in ax.lines] == [":", "-"]
+    assert [line.get_linestyle() for line in ax.lines] == ["-", ":"]
     assert [t.get_text() for t in ax.get_legend().get_texts()] == [
-        "K1 = 0.35 (unstable)", "K1 = 0.1234 (stable)"]
+        "K1 = 0.1234 (stable)", "K1 = 0.35 (unstable)"]
     assert ax.get_xlabel() == "theta [deg]" and ax.get_ylabel() == "psi [deg]"
     assert ax.get_aspect() == 1.0
     assert ax.get_title() == "periodic_1"
@@ -518,6 +519,17 @@ def test_phase_plane_selected_labels_states_and_radians(orbit_branch):
     assert np.max(line.get_ydata()) == pytest.approx(0.4 * 31.4)
     assert ax.get_ylabel() == "dtheta [rad/s]"
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["K1 = 0.1234 (stable)"]
+
+
+def test_phase_plane_legend_sorted_by_parameter_whatever_the_order_asked(orbit_branch):
+    orbits = tuple(make_orbit(label, label, k1, 0.1, closed=True)
+                   for label, k1 in ((1, 0.3), (2, -0.2), (3, 0.05), (4, 0.1)))
+    branch = replace(orbit_branch, orbits=orbits)
+    for labels in (None, [4, 1, 3, 2], [1, 4]):
+        ax = phase_plane(branch, labels=labels).axes[0]
+        shown = [float(t.get_text().split(" = ")[1].split()[0])
+                 for t in ax.get_legend().get_texts()]
+        assert shown == sorted(shown) and len(shown) == (4 if labels is None else len(labels))
 
 
 def test_phase_plane_draws_on_given_axes(orbit_branch):
@@ -543,7 +555,7 @@ def test_phase_plane_of_the_first_two_states_any_names(orbit_branch):
                     state_units=("m", "m", "m/s", "m/s"))
     ax = phase_plane(other).axes[0]
     assert (ax.get_xlabel(), ax.get_ylabel()) == ("x [m]", "y [m]")
-    np.testing.assert_allclose(ax.lines[1].get_ydata()[:20], other.orbits[1].states[:20, 1])
+    np.testing.assert_allclose(ax.lines[0].get_ydata()[:20], other.orbits[1].states[:20, 1])
 
 
 def test_phase_labels_at_most_twelve_user_points_first(orbit_branch):
@@ -862,7 +874,7 @@ def test_save_study_plots_boundary_grid_only_or_nothing(tmp_path, continuation):
 def test_save_study_plots_boundary_ignores_grid_of_other_parameters(tmp_path, monkeypatch):
     seen = []
 
-    def fake(boundary, grid, cases=(), ax=None):
+    def fake(boundary, grid, cases=(), ax=None, **view):
         seen.append((boundary, grid, tuple(cases)))
         return _new_figure()
 

@@ -657,6 +657,7 @@ def test_schema_reference_lists_every_key_with_a_description():
     expected |= {f"continuations[].{k}" for k in OneParameterContinuation.model_fields}
     expected |= {f"continuations[].{k}" for k in TwoParameterContinuation.model_fields}
     expected |= {f"auto.{k}" for k in AutoSettings.model_fields}
+    expected |= {"continuations[].slices[].value", "continuations[].slices[].label"}
     assert set(rows) == expected
     for line in lines[2:]:
         cells = [c.strip() for c in line.strip("|").split(" | ")]
@@ -798,3 +799,28 @@ def test_two_laws_resolve_to_parameters_named_by_dof():
     assert study.parameter_values() == {"K_psi": 0.3, "K2_theta": -10.0, "K3_theta": 350.0,
                                         "K2_psi": -10.0, "K3_psi": 350.0}
     assert study.variant().name == "classical_poly"
+
+
+# --------------------------------------------------------------------------- issue 17: 3
+PAIR = ("continuations:\n  - name: b\n    type: two-parameter\n    parameters: [K1, K_psi]\n"
+        "    range: {K1: [-0.3, 0.5], K_psi: [0, 0.5]}\n")
+
+
+def test_slices_are_numbers_or_labelled_mappings():
+    study = validate_text(HEAD + PAIR + "    slices: [0.4, {value: 0.3, label: case 2}]\n",
+                          "s.yaml")
+    (spec,) = study.continuations
+    assert spec.slice_values == (0.4, 0.3)
+    assert spec.slice_labels == ("", "case 2")
+
+
+def test_a_labelled_slice_is_checked_like_a_number():
+    assert problems(HEAD + PAIR + "    slices: [{value: 0.7, label: far}]\n") == [
+        "s.yaml:8: continuations[0].slices[0]: slice 0.7 is outside the range [0.0, 0.5] of "
+        "K_psi"]
+    found = problems(HEAD + PAIR + "    slices: [{label: x}, {value: 0.1, name: y}, ten]\n")
+    assert len(found) == 3
+    assert found[2] == ("s.yaml:8: continuations[0].slices[2]: expected a number or a mapping "
+                        "{value, label}, got 'ten'")
+    assert found[0].startswith("s.yaml:8: continuations[0].slices[0].value: ")
+    assert found[1].startswith("s.yaml:8: continuations[0].slices[1].name: ")

@@ -37,7 +37,7 @@ _LOG_SPAN = 20.0  # period plots switch to a log y-axis above this max/min ratio
 
 def bifurcation_diagram(continuation: ContinuationResult, state: str | None = None,
                         which: Sequence[str] = ("max",), ax: Axes | None = None,
-                        degrees: bool = True) -> Figure:
+                        degrees: bool = True, title: str | None = None) -> Figure:
     """One-parameter bifurcation diagram: ``state`` against each branch's principal parameter.
 
     ``state``: a state name of the branches; None: the first state of the first plotted branch
@@ -49,7 +49,8 @@ def bifurcation_diagram(continuation: ContinuationResult, state: str | None = No
     and stability. Special points get markers at (principal parameter, ``state`` value). Angle
     states are shown in degrees (rad -> deg, rad/s -> deg/s) unless ``degrees`` is False; the
     parameter keeps its SI unit. Draws on ``ax`` if given, else on a new figure; returns the
-    figure. The legend lists only styles present; the title is the continuation's name.
+    figure. The legend lists only styles present; the title is ``title`` (None: the
+    continuation's name).
     """
     which, branches, state = _checked_branches(continuation, state, which)
     if ax is None:
@@ -57,7 +58,7 @@ def bifurcation_diagram(continuation: ContinuationResult, state: str | None = No
     handles, labels = _draw_bifurcation(ax, continuation, branches, state, which, degrees)
     if handles:
         ax.legend(handles, labels, fontsize="small")
-    ax.set_title(continuation.name)
+    ax.set_title(continuation.name if title is None else title)
     return ax.figure
 
 
@@ -92,20 +93,22 @@ def _draw_bifurcation(ax: Axes, continuation: ContinuationResult, branches: list
 
 
 def projections_figure(continuation: ContinuationResult, which: Sequence[str] = ("max",),
-                       degrees: bool = True) -> Figure:
+                       degrees: bool = True, title: str | None = None) -> Figure:
     """One bifurcation diagram per state on a grid of ceil(n/2) x 2 axes sharing the x-axis.
 
     The states are those common to every plotted (equilibrium or periodic) branch, in the order
     of the first; each panel is :func:`bifurcation_diagram` of one state (angles in deg, rates in
     deg/s unless ``degrees`` is False; ``which`` as there). Only the first panel has a legend and
-    only the bottom panels an x label; the figure title is the continuation's name. Without
+    only the bottom panels an x label; the figure title is ``title`` (None: the continuation's
+    name). Without
     plotted branches the figure has one empty axes.
     """
     states = _common_states(continuation)
     rows = max(1, -(-len(states) // 2))
     figure = _new_figure(figsize=(10.0, 3.2 * rows + 0.6), layout="constrained")
+    title = continuation.name if title is None else title
     if not states:
-        figure.add_subplot().set_title(continuation.name)
+        figure.add_subplot().set_title(title)
         return figure
     axes = figure.subplots(rows, 2, sharex=True, squeeze=False).ravel()
     for k, (ax, state) in enumerate(zip(axes, states, strict=False)):
@@ -120,7 +123,7 @@ def projections_figure(continuation: ContinuationResult, which: Sequence[str] = 
     if len(states) % 2 and len(states) > 1:  # lone last panel: label its neighbour's x
         axes[len(states) - 2].xaxis.set_tick_params(labelbottom=True)
         axes[len(states) - 2].set_xlabel(axes[len(states) - 1].get_xlabel())
-    figure.suptitle(continuation.name)
+    figure.suptitle(title)
     return figure
 
 
@@ -132,7 +135,7 @@ def _common_states(continuation: ContinuationResult) -> tuple[str, ...]:
     return tuple(s for s in branches[0].state_names if all(s in b.state_names for b in branches))
 
 
-def period_plot(continuation: ContinuationResult) -> Figure:
+def period_plot(continuation: ContinuationResult, title: str | None = None) -> Figure:
     """Period [s] of every periodic branch against its principal parameter (SI unit).
 
     Lines follow :data:`PLOT_KEY` (stable solid blue, unstable dotted red) split as in
@@ -142,7 +145,7 @@ def period_plot(continuation: ContinuationResult) -> Figure:
     estimate, the period at the last point of their branch). A "bracketed" global point also
     gets its bracket drawn as a horizontal error bar at the top of the data. The y-axis is
     logarithmic if the largest period exceeds 20 times the smallest. Without periodic branches
-    the axes stay empty.
+    the axes stay empty. Title: ``title`` (None: ``"<continuation>: period"``).
     """
     ax = _new_figure().add_subplot()
     periodic = [b for b in continuation.branches if b.is_periodic]
@@ -176,7 +179,7 @@ def period_plot(continuation: ContinuationResult) -> Figure:
     ax.set_ylabel(axis_label("period", "s"))
     if handles:
         ax.legend(handles, labels, fontsize="small")
-    ax.set_title(f"{continuation.name}: period")
+    ax.set_title(f"{continuation.name}: period" if title is None else title)
     return ax.figure
 
 
@@ -213,19 +216,22 @@ def _period_points(continuation: ContinuationResult, periodic: list[Branch]
 
 
 def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str | None = None,
-                y: str | None = None, degrees: bool = True, ax: Axes | None = None) -> Figure:
+                y: str | None = None, degrees: bool = True, ax: Axes | None = None,
+                title: str | None = None) -> Figure:
     """Stored orbits of a periodic branch as closed curves of state ``y`` against state ``x``
     (None: the branch's first and second state, i.e. the model's first two degrees of freedom,
     or a single dof and its rate).
 
-    All of ``branch.orbits`` if ``labels`` is None, else those with these AUTO labels (in the
-    order given). Each curve is closed (its first point repeated at the end unless already
-    equal), drawn solid if the branch is stable at the orbit's row, dotted if not and dashed
-    where its stability is unknown, in the default colour cycle, and labelled
-    ``"<parameter> = <value> (stable|unstable|stability unknown)"`` with the
-    principal parameter (4 significant digits). Angles in degrees, rates in deg/s unless
+    All of ``branch.orbits`` if ``labels`` is None, else those with these AUTO labels; drawn
+    (and listed in the legend) in order of the principal parameter. Each curve is closed (its
+    first point repeated at the end unless already equal), drawn solid if the branch is
+    stable at the orbit's row, dotted if not and dashed where its stability is unknown, in
+    the default colour cycle, and labelled
+    ``"<parameter> = <value> (stable|unstable|stability unknown)"`` with the principal
+    parameter (4 significant digits). Angles in degrees, rates in deg/s unless
     ``degrees`` is False; equal aspect when both axes have the same unit. Draws on ``ax`` if
-    given, else on a new figure; returns the figure. The title is the branch's name.
+    given, else on a new figure; returns the figure. The title is ``title`` (None: the
+    branch's name).
     """
     if not branch.is_periodic:
         raise WhirlError(f"branch {branch.name!r} is {branch.kind}, not periodic: no orbits")
@@ -243,6 +249,7 @@ def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str | No
             raise WhirlError(f"no stored orbit with label(s) {missing} on branch "
                              f"{branch.name!r} (labels: {sorted(by_label)})")
         orbits = [by_label[label] for label in labels]
+    orbits.sort(key=lambda orbit: float(orbit.parameters[0]))
     ix, iy = branch.state_names.index(x), branch.state_names.index(y)
     fx, unit_x = display_unit(branch.state_units[ix], degrees)
     fy, unit_y = display_unit(branch.state_units[iy], degrees)
@@ -264,7 +271,7 @@ def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str | No
         ax.set_aspect("equal", adjustable="datalim")
     if orbits:
         ax.legend(fontsize="small")
-    ax.set_title(branch.name)
+    ax.set_title(branch.name if title is None else title)
     return ax.figure
 
 

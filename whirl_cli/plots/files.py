@@ -6,6 +6,9 @@ from __future__ import annotations
 
 import io
 import re
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -13,6 +16,7 @@ import numpy as np
 
 from ..errors import OutputError, WhirlError
 from ..results import Branch, ContinuationResult, PointType, StudyResult
+from .captions import Captions, captions
 from .diagrams import bifurcation_diagram, period_plot, phase_plane, projections_figure
 from .key import _PLOTTED_KINDS
 from .linear import linear_sweep_plot
@@ -28,8 +32,44 @@ PHASE_ORBITS = 12
 """Most orbits a study's phase-plane figure draws (a long family stores one every 20 steps)."""
 
 
+@dataclass(frozen=True)
+class View:
+    """How the figures of :func:`save_study_plots` are drawn beyond their data: axis limits
+    (in the units shown, applied to every axes of every figure; None: from the data) and
+    frequencies in Hz instead of rad/s (linear sweeps)."""
+
+    xlim: tuple[float, float] | None = None
+    ylim: tuple[float, float] | None = None
+    hz: bool = False
+
+
+def missing_data(result: StudyResult, kind: str) -> str:
+    """What ``result`` lacks to draw plot ``kind`` (a sentence), or "" if it can draw it."""
+    one_parameter = [c for c in result.continuations if c.kind == "one-parameter"]
+    if kind in ("bifurcation", "projections") and not one_parameter:
+        return "no one-parameter continuation"
+    if kind == "period" and not any(b.is_periodic for c in result.continuations
+                                    for b in c.branches):
+        return "no periodic branch (a continuation with periodic: true)"
+    if kind == "phase" and not any(b.is_periodic and b.orbits and len(b.state_names) >= 2
+                                   for c in result.continuations for b in c.branches):
+        return "no stored orbits on a periodic branch (periodic: true; orbits_at stores more)"
+    if kind == "linear" and not result.linear_sweeps:
+        return "no linear sweep (linear.sweeps)"
+    if kind == "boundary" and not result.boundaries and result.linear_grid is None:
+        return "no stability boundary (a two-parameter continuation) and no linear grid " \
+               "(linear.grid)"
+    return ""
+
+
+def available_kinds(result: StudyResult) -> tuple[str, ...]:
+    """The kinds of :data:`PLOT_KINDS` that ``result`` has the data for, in that order."""
+    return tuple(kind for kind in PLOT_KINDS if not missing_data(result, kind))
+
+
 def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path, stem: str,
-                     state: str | None = None, dpi: int = 150) -> list[Path]:
+                     state: str | None = None, dpi: int = 150, view: View = View()
+                     ) -> list[Path]:
     """Write a study's figures as PNG files into ``out_dir``; return the paths, sorted.
 
     ``kinds`` (any of :data:`PLOT_KINDS`):
@@ -54,13 +94,16 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
       with a linear grid,
       ``<stem>_linear_grid.png`` (the grid alone).
 
+    Titles name the study and the parameters it fixes (:mod:`~whirl_cli.plots.captions`,
+    from the study stored with ``result``), slices by the study's labels; ``view`` sets axis
+    limits and Hz. A kind without data draws nothing (:func:`missing_data` says why).
     Names are made filesystem-safe; repeats get ``_2``, ``_3``, ... (:func:`plot_names`).
     Each file is rendered in memory and published complete or not at all (an existing file
     of the same name is replaced). ``whirl run`` and ``whirl sweep`` publish a study's plots
     together with its HDF5 file instead (:mod:`whirl_cli.output.study_files`).
     """
     out_dir = Path(out_dir)
-    rendered = render_study_plots(result, kinds, stem, state, dpi)
+    rendered = render_study_plots(result, kinds, stem, state, dpi, view)
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -79,20 +122,44 @@ def plot_names(result: StudyResult, kinds: tuple[str, ...], stem: str,
 
 
 def render_study_plots(result: StudyResult, kinds: tuple[str, ...], stem: str,
-                       state: str | None = None, dpi: int = 150) -> list[tuple[str, bytes]]:
+                       state: str | None = None, dpi: int = 150, view: View = View()
+                       ) -> list[tuple[str, bytes]]:
     """(file name, PNG bytes) of every figure of :func:`save_study_plots`, rendered in
     memory; nothing is written."""
-    return [(name, _png(make(), dpi)) for name, make in _named_jobs(result, kinds, stem, state)]
+    return [(name, _png(figure, dpi))
+            for name, figure in study_figures(result, kinds, stem, state, view)]
 
 
-def _named_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: str | None):
+def study_figures(result: StudyResult, kinds: tuple[str, ...], stem: str = "",
+                  state: str | None = None, view: View = View()):
+    """(file name, matplotlib Figure) of every figure of :func:`save_study_plots`, drawn one
+    at a time as the iterator advances (nothing is written)."""
+    for name, make in _named_jobs(result, kinds, stem, state, view):
+        yield name, _viewed(make(), view)
+
+
+def _viewed(figure: Figure, view: View) -> Figure:
+    """``figure`` with ``view``'s axis limits on every axes (an equal-aspect axes then keeps
+    its aspect by its box, not by moving the limits)."""
+    for ax in figure.axes:
+        if (view.xlim or view.ylim) and ax.get_aspect() != "auto":
+            ax.set_adjustable("box")
+        if view.xlim is not None:
+            ax.set_xlim(*view.xlim)
+        if view.ylim is not None:
+            ax.set_ylim(*view.ylim)
+    return figure
+
+
+def _named_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: str | None,
+                view: View = View()):
     """(unique filesystem-safe file name, figure factory) pairs of the requested kinds."""
     unknown = set(kinds) - set(PLOT_KINDS)
     if unknown:
         raise WhirlError(f"unknown plot kind(s) {sorted(unknown)}; choose from {PLOT_KINDS}")
     taken: list[Path] = []
     jobs = []
-    for name, make in _figure_jobs(result, kinds, stem, state):
+    for name, make in _figure_jobs(result, kinds, stem, state, view):
         path = _unique(Path(_safe_name(name)), taken)
         taken.append(path)
         jobs.append((path.name, make))
@@ -100,52 +167,72 @@ def _named_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: s
 
 
 def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str,
-                 state: str | None):
+                 state: str | None, view: View = View()):
     """(file name, figure factory) pairs for the requested kinds, in a stable order."""
+    caption = cache(lambda: captions(result))  # read the stored study once, when drawing
     jobs = []
     if "bifurcation" in kinds:
         for continuation in result.continuations:
             if continuation.kind == "one-parameter":
                 chosen = _state_for(continuation, state)
                 jobs.append((f"{stem}_{continuation.name}_bifurcation.png",
-                             lambda c=continuation, s=chosen: bifurcation_diagram(c, s)))
+                             lambda c=continuation, s=chosen: bifurcation_diagram(
+                                 c, s, title=_title(caption, c))))
     if "projections" in kinds:
         for continuation in result.continuations:
             if continuation.kind == "one-parameter":
                 jobs.append((f"{stem}_{continuation.name}_projections.png",
-                             lambda c=continuation: projections_figure(c)))
+                             lambda c=continuation: projections_figure(
+                                 c, title=_title(caption, c))))
     if "period" in kinds:
         for continuation in result.continuations:
             if any(b.is_periodic for b in continuation.branches):
                 jobs.append((f"{stem}_{continuation.name}_period.png",
-                             lambda c=continuation: period_plot(c)))
+                             lambda c=continuation: period_plot(c, title=_title(caption, c))))
     if "phase" in kinds:
         for continuation in result.continuations:
             for branch in continuation.branches:
                 if branch.is_periodic and branch.orbits and len(branch.state_names) >= 2:
                     jobs.append((f"{stem}_{continuation.name}_{branch.name}_phase.png",
-                                 lambda b=branch: phase_plane(b, labels=phase_labels(b))))
+                                 lambda b=branch, c=continuation: phase_plane(
+                                     b, labels=phase_labels(b),
+                                     title=f"{_title(caption, c)}\n{b.name}")))
     if "linear" in kinds:
         for sweep in result.linear_sweeps:
             jobs.append((f"{stem}_linear_{sweep.parameter}.png",
-                         lambda s=sweep: linear_sweep_plot(s)))
+                         lambda s=sweep: linear_sweep_plot(
+                             s, hz=view.hz, title=caption().title({s.parameter}))))
     if "boundary" in kinds:
-        jobs += _boundary_jobs(result, stem, state)
+        jobs += _boundary_jobs(result, stem, state, caption, view)
     return jobs
 
 
-def _boundary_jobs(result: StudyResult, stem: str, state: str | None):
+def _title(caption: Callable[[], Captions], continuation: ContinuationResult) -> str:
+    """The study's title over the parameters ``continuation`` does not vary."""
+    varied = {name for b in continuation.branches for name in b.parameter_names}
+    return caption().title(varied)
+
+
+def _boundary_jobs(result: StudyResult, stem: str, state: str | None,
+                   caption: Callable[[], Captions], view: View = View()):
     """(file name, figure factory) pairs of the "boundary" kind."""
     grid = result.linear_grid
     if not result.boundaries:
         if grid is None:
             return []
-        return [(f"{stem}_linear_grid.png", lambda: boundary_plot(None, grid))]
+        return [(f"{stem}_linear_grid.png", lambda: boundary_plot(
+            None, grid, title=caption().title({grid.x_parameter, grid.y_parameter}),
+            xlim=view.xlim, ylim=view.ylim))]
     jobs = []
     for boundary in result.boundaries:
         matched = None if grid is None else _oriented_grid(grid, boundary.parameter_names)
+        labels = lambda b=boundary: tuple(caption().slice_label(b.name, k)  # noqa: E731
+                                          for k in range(len(b.slices)))
         jobs.append((f"{stem}_{boundary.name}_boundary.png",
-                     lambda b=boundary, g=matched: boundary_plot(b, g, cases=b.slices)))
+                     lambda b=boundary, g=matched, labels=labels: boundary_plot(
+                         b, g, cases=b.slices, case_labels=labels(),
+                         title=caption().title(b.parameter_names),
+                         xlim=view.xlim, ylim=view.ylim)))
         continuation = next((c for c in result.continuations if c.name == boundary.name
                              and c.kind == "two-parameter"),
                             ContinuationResult(boundary.name, "one-parameter", (), ()))
@@ -153,9 +240,18 @@ def _boundary_jobs(result: StudyResult, stem: str, state: str | None):
             chosen = (_state_for(slice_continuation(continuation, k), state)
                       if continuation.kind == "two-parameter" else state)
             jobs.append((f"{stem}_{boundary.name}_slice_{k}_overhang.png",
-                         lambda c=continuation, b=boundary, v=value, s=chosen:
-                         overhang_diagram(c, b, v, state=s)))
+                         lambda c=continuation, b=boundary, v=value, s=chosen, k=k:
+                         overhang_diagram(c, b, v, state=s,
+                                          title=_slice_title(caption(), b, k, v))))
     return jobs
+
+
+def _slice_title(caption: Captions, boundary, k: int, value: float) -> str:
+    """``"<study title>\n<slice label>: <second parameter> = <value> <unit>"``."""
+    unit = boundary.parameter_units[1]
+    return (f"{caption.title(boundary.parameter_names)}\n"
+            f"{caption.slice_label(boundary.name, k)}: {boundary.parameter_names[1]} = "
+            f"{float(value):g}{' ' + unit if unit else ''}")
 
 
 def phase_labels(branch: Branch, most: int = PHASE_ORBITS) -> list[int]:

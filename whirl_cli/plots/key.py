@@ -9,13 +9,13 @@ arguments that draw it and its legend label. Stability maps (thesis figures 3.13
 from __future__ import annotations
 
 import itertools
-import re
 from collections.abc import Iterator
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..results import BranchKind, PointType
+from ..units import axis_label, display_unit  # noqa: F401  (re-exported: plots use them)
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -127,18 +127,6 @@ def stability_segments(x: np.ndarray, y: np.ndarray, stable: np.ndarray,
     starts = np.concatenate(([0], np.flatnonzero(stable[1:] != stable[:-1]) + 1))
     ends = np.append(starts[1:] + 1, len(x))  # inclusive of the next run's first point
     return [(x[a:b], y[a:b], bool(stable[a])) for a, b in zip(starts, ends, strict=True)]
-
-
-def display_unit(unit: str, degrees: bool = True) -> tuple[float, str]:
-    """(factor, unit) to show an SI quantity: rad -> deg (and rad/s -> deg/s) if ``degrees``."""
-    if degrees and re.fullmatch(r"rad(/.*)?", unit):
-        return float(np.degrees(1.0)), "deg" + unit[3:]
-    return 1.0, unit
-
-
-def axis_label(name: str, unit: str) -> str:
-    """``"name [unit]"``, with ``[-]`` for dimensionless quantities (unit "" or "1")."""
-    return f"{name} [{unit if unit not in ('', '1') else '-'}]"
 
 
 def _new_figure(**kwargs) -> Figure:

@@ -8,34 +8,39 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..results import LinearSweep
+from ..units import HZ_PER_RAD_S
 from .key import _colours, _new_figure, axis_label
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 
-def linear_sweep_plot(sweep: LinearSweep) -> Figure:
-    """Frequency [rad/s] (top) and damping ratio [-] (bottom) of each mode vs the parameter.
+def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = None
+                      ) -> Figure:
+    """Frequency [rad/s, or Hz if ``hz``] (top) and damping ratio [-] (bottom) of each mode vs
+    the parameter.
 
     One line per column of ``sweep.eigenvalues``, drawn only where Im(lambda) > 0 so each
     conjugate pair appears once (real eigenvalues are not drawn). Lines are labelled with their
     whirl direction ("BW"/"FW", numbered if repeated); the damping panel has a zero line.
+    Title: ``title`` (None: ``"linear analysis vs <parameter>"``).
     """
     figure = _new_figure(figsize=(6.4, 6.4))
     ax_freq, ax_damp = figure.subplots(2, 1, sharex=True)
     for (column, label), colour in zip(_mode_labels(sweep), _colours(), strict=False):
         upper = sweep.eigenvalues[:, column].imag > 0
-        freq = np.where(upper, sweep.frequency[:, column], np.nan)
+        freq = np.where(upper, sweep.frequency[:, column], np.nan) * (HZ_PER_RAD_S if hz
+                                                                      else 1.0)
         damp = np.where(upper, sweep.damping_ratio[:, column], np.nan)
         ax_freq.plot(sweep.values, freq, color=colour, label=label)
         ax_damp.plot(sweep.values, damp, color=colour, label=label)
     ax_damp.axhline(0.0, color="black", linewidth=0.8, label="_zero")
-    ax_freq.set_ylabel(axis_label("frequency", "rad/s"))
+    ax_freq.set_ylabel(axis_label("frequency", "Hz" if hz else "rad/s"))
     ax_damp.set_ylabel(axis_label("damping ratio", ""))
     ax_damp.set_xlabel(axis_label(sweep.parameter, sweep.unit))
     if ax_freq.get_lines():
         ax_freq.legend(fontsize="small")
-    ax_freq.set_title(f"linear analysis vs {sweep.parameter}")
+    ax_freq.set_title(f"linear analysis vs {sweep.parameter}" if title is None else title)
     return figure
 
 

@@ -27,7 +27,10 @@ _LIMIT_MARGIN = 0.02  # fraction of the data span added around loci-derived axis
 
 
 def boundary_plot(boundary: Boundary | None, grid: LinearGrid | None,
-                  cases: Sequence[float] = (), ax: Axes | None = None) -> Figure:
+                  cases: Sequence[float] = (), ax: Axes | None = None,
+                  case_labels: Sequence[str] = (), title: str | None = None,
+                  xlim: tuple[float, float] | None = None,
+                  ylim: tuple[float, float] | None = None) -> Figure:
     """Stability map in two parameters (thesis figures 3.13, 3.15, 3.28, 3.29).
 
     x is the first parameter of ``boundary`` (or ``grid.x_parameter``), y the second, both in
@@ -40,14 +43,17 @@ def boundary_plot(boundary: Boundary | None, grid: LinearGrid | None,
       dash-dot grey, fold of cycles solid orange; other kinds are not drawn) and the unsafe
       (overhang) region, its polygons filled red;
     * a thin dotted horizontal line at each value of ``cases`` (e.g. ``boundary.slices``),
-      labelled "case 1", "case 2", ... just right of the axes (labels only for lines within
-      the y limits, nudged up where they would overlap).
+      labelled by ``case_labels`` (by default, and where a label is missing or empty, "case
+      1", "case 2", ...) just right of the axes (labels only for lines within the y limits,
+      nudged up where they would overlap).
 
     The legend lists only what is drawn. Axis limits are the grid's extent, else the extent of
-    the loci (or, without loci, of the polygons) plus a 2 % margin, else matplotlib's. A grid
+    the loci (or, without loci, of the polygons) plus a 2 % margin, else matplotlib's;
+    ``xlim`` and ``ylim`` replace them. A grid
     over the same two parameters in the other order is transposed; over other parameters it is
     a :class:`WhirlError`, as is passing neither. Title: ``boundary.name`` (else "linear
-    stability"). Draws on ``ax`` if given, else on a new figure; returns the figure.
+    stability"), unless ``title`` is given. Draws on ``ax`` if given, else on a new figure;
+    returns the figure.
     """
     if boundary is None and grid is None:
         raise WhirlError("boundary_plot needs a boundary, a linear grid or both")
@@ -72,7 +78,11 @@ def boundary_plot(boundary: Boundary | None, grid: LinearGrid | None,
                 (patch,) = ax.fill(polygon[:, 0], polygon[:, 1], **style, zorder=2)
                 first.setdefault("unsafe", patch)
     _set_map_limits(ax, boundary, grid)
-    _draw_cases(ax, cases)
+    if xlim is not None:
+        ax.set_xlim(*xlim)
+    if ylim is not None:
+        ax.set_ylim(*ylim)
+    _draw_cases(ax, cases, case_labels)
     if boundary is not None:
         names, units = boundary.parameter_names, boundary.parameter_units
     else:
@@ -83,7 +93,9 @@ def boundary_plot(boundary: Boundary | None, grid: LinearGrid | None,
         ax.legend([first[key] for key in BOUNDARY_KEY if key in first],
                   [str(BOUNDARY_KEY[key]["label"]) for key in BOUNDARY_KEY if key in first],
                   fontsize="small")
-    ax.set_title(boundary.name if boundary is not None else "linear stability")
+    if title is None:
+        title = boundary.name if boundary is not None else "linear stability"
+    ax.set_title(title)
     return ax.figure
 
 
@@ -157,8 +169,9 @@ def _set_map_limits(ax: Axes, boundary: Boundary | None, grid: LinearGrid | None
             setter(float(low - pad), float(high + pad))
 
 
-def _draw_cases(ax: Axes, cases: Sequence[float]) -> None:
-    """Dotted horizontal lines at the case values, labelled "case k" right of the axes."""
+def _draw_cases(ax: Axes, cases: Sequence[float], labels: Sequence[str] = ()) -> None:
+    """Dotted horizontal lines at the case values, labelled right of the axes by ``labels``
+    ("case k" where there is none)."""
     for k, value in enumerate(cases, 1):
         ax.axhline(float(value), color=_BLACK, linestyle=":", linewidth=0.8, zorder=1,
                    label=f"_case {k}")
@@ -169,7 +182,8 @@ def _draw_cases(ax: Axes, cases: Sequence[float]) -> None:
     position = -np.inf
     for fraction, k in shown:  # in axes fractions, pushed up to keep close labels apart
         position = max(fraction, position + _CASE_LABEL_GAP)
-        ax.text(1.01, position, f"case {k}", transform=ax.transAxes, ha="left", va="center",
+        label = labels[k - 1] if k <= len(labels) and labels[k - 1] else f"case {k}"
+        ax.text(1.01, position, label, transform=ax.transAxes, ha="left", va="center",
                 fontsize="small")
 
 
@@ -201,7 +215,7 @@ def slice_index(boundary: Boundary, slice_value: float) -> int:
 def overhang_diagram(continuation: ContinuationResult, boundary: Boundary | None,
                      slice_value: float, state: str | None = None,
                      which: Sequence[str] = ("max",), ax: Axes | None = None,
-                     degrees: bool = True) -> Figure:
+                     degrees: bool = True, title: str | None = None) -> Figure:
     """Bifurcation diagram of one slice with its unsafe (overhang) intervals shaded.
 
     For a two-parameter ``continuation`` the diagram is :func:`bifurcation_diagram` of
@@ -211,7 +225,8 @@ def overhang_diagram(continuation: ContinuationResult, boundary: Boundary | None
     red vertical band (alpha 0.25) from ``lower`` to ``upper``, with one legend entry
     "unsafe (overhang)". ``state``, ``which``, ``degrees`` and ``ax`` as in
     :func:`bifurcation_diagram`. Title: ``"<continuation>: <second parameter> = <value>"``
-    (just the continuation's name without a boundary). Returns the figure.
+    (just the continuation's name without a boundary), unless ``title`` is given. Returns the
+    figure.
     """
     if continuation.kind == "two-parameter":
         if boundary is None:
@@ -236,9 +251,10 @@ def overhang_diagram(continuation: ContinuationResult, boundary: Boundary | None
         labels.append(_UNSAFE_LABEL)
     if handles:
         ax.legend(handles, labels, fontsize="small")
-    title = continuation.name
-    if boundary is not None:
-        title += f": {boundary.parameter_names[1]} = {float(slice_value):g}"
+    if title is None:
+        title = continuation.name
+        if boundary is not None:
+            title += f": {boundary.parameter_names[1]} = {float(slice_value):g}"
     ax.set_title(title)
     return ax.figure
 

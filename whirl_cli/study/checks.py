@@ -264,7 +264,7 @@ def _pair_problems(loc: Loc, item: dict, names: Names, family: str,
     if isinstance(limits, list) and len(limits) == 2 and isinstance(slices, list):
         lower, upper = (_finite(b) for b in limits)
         for k, value in enumerate(slices):
-            number = _finite(value)
+            number = _finite(value.get("value") if isinstance(value, dict) else value)
             if None not in (lower, upper, number) and lower < upper and not (
                     lower <= number <= upper):
                 problems.append((loc + ("slices", k), f"slice {number!r} is outside the range "

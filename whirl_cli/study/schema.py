@@ -224,6 +224,27 @@ class OneParameterContinuation(_Strict):
 LocusKind = Literal["hopf", "branch_point", "fold", "fold_of_cycles"]
 
 
+class Slice(_Strict):
+    """A slice of a two-parameter continuation: a value of its second parameter, and how
+    figures name it."""
+
+    value: Number = Field(description="Value of the second parameter, in its unit.")
+    label: Text = Field("", description="Name of the slice in figures (e.g. `case 2`); "
+                        "unset: `case <k>`, its position from 1.")
+
+
+def _as_slice(value: Any) -> Any:
+    """A slice given as a bare number is ``{value: number}``."""
+    if isinstance(value, dict):
+        return value
+    if not _is_number(value):
+        _fail("expected a number or a mapping {{value, label}}, got {got}")
+    return {"value": value}
+
+
+SliceEntry = Annotated[Slice, BeforeValidator(_as_slice)]
+
+
 class TwoParameterContinuation(_Strict):
     """Loci of Hopf points, branch points, folds and folds of cycles in two parameters, the
     stability boundary they draw and the unsafe (overhang) region.
@@ -251,11 +272,13 @@ class TwoParameterContinuation(_Strict):
         description="Starting value of the first parameter for the one-parameter runs; unset: "
         "its study value.",
     )
-    slices: tuple[Number, ...] = Field(
+    slices: tuple[SliceEntry, ...] = Field(
         (),
+        json_schema_extra={"type_text": "list of number or {value, label}"},
         description="Values of the second parameter at which one-parameter runs find the "
-        "special points the loci start from, and at which unsafe intervals are reported; "
-        "unset: its study value.",
+        "special points the loci start from, and at which unsafe intervals are reported, each "
+        "a number or `{value: number, label: text}` (`label` names it in figures); unset: its "
+        "study value.",
     )
     loci: tuple[LocusKind, ...] = Field(
         ("hopf", "branch_point", "fold", "fold_of_cycles"),
@@ -275,6 +298,16 @@ class TwoParameterContinuation(_Strict):
     def bounds(self, names: Names | Model) -> dict[str, tuple[float, float]]:
         """``range`` keyed by canonical parameter names (``names``: the study's)."""
         return {names.canonical(key): tuple(value) for key, value in self.range.items()}
+
+    @property
+    def slice_values(self) -> tuple[float, ...]:
+        """The values of the slices, in order."""
+        return tuple(s.value for s in self.slices)
+
+    @property
+    def slice_labels(self) -> tuple[str, ...]:
+        """The labels of the slices, in order ("" where the study gives none)."""
+        return tuple(s.label for s in self.slices)
 
 
 PlotKind = Literal["bifurcation", "linear", "projections", "period", "phase", "boundary"]

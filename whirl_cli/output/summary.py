@@ -1,0 +1,296 @@
+"""The special points of a study as a summary a person reads (a rich table per continuation)
+or a script reads (CSV, JSON): type, parameter values, amplitude of every dof, period,
+stability, criticality and status.
+
+:func:`summary_rows` is a pure function of a :class:`~whirl_cli.results.StudyResult` (read
+from a file with :func:`whirl_cli.output.store.read`, or fresh from ``whirl run``);
+:func:`records` flattens its rows into named columns, which :func:`to_csv`, :func:`to_json`
+and :func:`tables` render. Nothing here knows a model's states: the dofs are named by the
+caller (the study's model variant), else they are the first half of the stored states (a
+variant's state is its dofs, then their rates).
+
+Units: parameters in their stored (SI) units, amplitudes in each dof's declared unit with
+angles in degrees (rad -> deg), periods in s. A dof's amplitude is its value at an
+equilibrium point and its maximum over the orbit at a point of a periodic family.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..results import Branch, ContinuationResult, PointType, SpecialPoint, StudyResult
+from ..units import axis_label, display_unit
+
+FORMATS = ("table", "csv", "json")
+"""Formats of ``whirl summary --format``."""
+
+FIXED_COLUMNS = ("continuation", "branch", "type")
+"""The first columns of :func:`records`; parameters and amplitudes follow, then
+:data:`LAST_COLUMNS`."""
+
+LAST_COLUMNS = ("period [s]", "stability", "criticality", "status")
+
+
+@dataclass(frozen=True)
+class Quantity:
+    """A named value in a stated unit (as shown: angles already in degrees)."""
+
+    name: str
+    unit: str
+    value: float
+
+    @property
+    def column(self) -> str:
+        """Its column name, ``"name [unit]"``."""
+        return axis_label(self.name, self.unit)
+
+
+@dataclass(frozen=True)
+class SummaryRow:
+    """One special point as the summary shows it.
+
+    ``stability``: "stable", "unstable" or "unknown" (where the branch has no stability
+    verdict at the point, e.g. on loci); ``period``: s, NaN where there is none.
+    """
+
+    continuation: str
+    branch: str
+    type: str
+    parameters: tuple[Quantity, ...]
+    amplitudes: tuple[Quantity, ...]
+    period: float
+    stability: str
+    criticality: str
+    status: str
+
+
+def summary_rows(result: StudyResult, dofs: Sequence[str] | None = None) -> list[SummaryRow]:
+    """One row per special point of every continuation of ``result``, in stored order.
+
+    Plain points (regular, labelled, user, end and no-convergence points) are left out.
+    ``dofs``: the states whose amplitude is shown (the model's dofs); None: the first half of
+    each branch's states.
+    """
+    return [row for continuation in result.continuations
+            for row in continuation_rows(continuation, dofs)]
+
+
+def continuation_rows(continuation: ContinuationResult, dofs: Sequence[str] | None = None
+                      ) -> list[SummaryRow]:
+    """The rows of :func:`summary_rows` of one continuation."""
+    by_name = {b.name: b for b in continuation.branches}
+    return [_row(continuation, point, by_name.get(point.branch), continuation.branches, dofs)
+            for point in continuation.special_points if _listed(point.point_type)]
+
+
+def _listed(code: int) -> bool:
+    """Whether a point of type ``code`` is listed (unknown codes are)."""
+    try:
+        return PointType(int(code)).is_special
+    except ValueError:
+        return True
+
+
+def type_name(code: int) -> str:
+    """The point type's name (HB, LPC, HOMOCLINIC, ...), or the code for an unknown one."""
+    try:
+        return PointType(int(code)).name
+    except ValueError:
+        return str(int(code))
+
+
+def _row(continuation: ContinuationResult, point: SpecialPoint, branch: Branch | None,
+         branches: Sequence[Branch], dofs: Sequence[str] | None) -> SummaryRow:
+    reference = branch if branch is not None else (branches[0] if branches else None)
+    parameters = tuple(Quantity(name, _parameter_unit(name, branch, branches), float(value))
+                       for name, value in zip(point.parameter_names,
+                                              np.asarray(point.parameters, dtype=float),
+                                              strict=False))
+    return SummaryRow(continuation.name, point.branch, type_name(point.point_type), parameters,
+                      _amplitudes(point, reference, dofs), float(point.period),
+                      _stability(point, branch), point.criticality, point.status)
+
+
+def _parameter_unit(name: str, branch: Branch | None, branches: Sequence[Branch]) -> str:
+    """The unit of parameter ``name`` on the point's branch, else on any branch, else ""."""
+    for candidate in ([branch] if branch is not None else []) + list(branches):
+        if name in candidate.parameter_names:
+            return candidate.parameter_units[candidate.parameter_names.index(name)]
+    return ""
+
+
+def _amplitudes(point: SpecialPoint, branch: Branch | None, dofs: Sequence[str] | None
+                ) -> tuple[Quantity, ...]:
+    """The point's state for each dof, in the dof's unit (rad shown in deg)."""
+    if branch is None:
+        return ()
+    names = branch.state_names
+    shown = [name for name in (names[:len(names) // 2] if dofs is None else dofs)
+             if name in names]
+    state = np.asarray(point.state, dtype=float)
+    amplitudes = []
+    for name in shown:
+        k = names.index(name)
+        factor, unit = display_unit(branch.state_units[k])
+        amplitudes.append(Quantity(name, unit, float(state[k]) * factor))
+    return tuple(amplitudes)
+
+
+def _stability(point: SpecialPoint, branch: Branch | None) -> str:
+    if branch is not None and 0 <= point.index < len(branch) \
+            and not branch.stability_known[point.index]:
+        return "unknown"
+    return "stable" if point.stable else "unstable"
+
+
+# ---------------------------------------------------------------------------- flat records
+def columns(rows: Sequence[SummaryRow]) -> list[str]:
+    """Column names of :func:`records`: the fixed ones, every parameter and amplitude column
+    in order of first appearance, then :data:`LAST_COLUMNS`."""
+    seen: dict[str, None] = {}
+    for row in rows:
+        for quantity in row.parameters:
+            seen.setdefault(quantity.column)
+    for row in rows:
+        for quantity in row.amplitudes:
+            seen.setdefault(quantity.column)
+    return [*FIXED_COLUMNS, *seen, *LAST_COLUMNS]
+
+
+def records(rows: Sequence[SummaryRow]) -> list[dict[str, object]]:
+    """``rows`` as dicts over :func:`columns` (None where a row has no such value: another
+    continuation's parameter, or no period)."""
+    names = columns(rows)
+    return [{name: record.get(name) for name in names}
+            for record in (_record(row) for row in rows)]
+
+
+def _record(row: SummaryRow) -> dict[str, object]:
+    record: dict[str, object] = {"continuation": row.continuation, "branch": row.branch,
+                                 "type": row.type}
+    for quantity in row.parameters + row.amplitudes:
+        record[quantity.column] = _finite(quantity.value)
+    record.update({"period [s]": _finite(row.period), "stability": row.stability,
+                   "criticality": row.criticality, "status": row.status})
+    return record
+
+
+def _finite(value: float) -> float | None:
+    return value if math.isfinite(value) else None
+
+
+def to_json(rows: Sequence[SummaryRow]) -> str:
+    """:func:`records` as a JSON array of objects (null for missing values; numbers at full
+    precision)."""
+    return json.dumps(records(rows), indent=1)
+
+
+def to_csv(rows: Sequence[SummaryRow]) -> str:
+    """:func:`records` as CSV with a header line (empty cells for missing values; numbers at
+    full precision)."""
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=columns(rows), lineterminator="\n")
+    writer.writeheader()
+    for record in records(rows):
+        writer.writerow({k: "" if v is None else (repr(v) if isinstance(v, float) else v)
+                         for k, v in record.items()})
+    return buffer.getvalue()
+
+
+# ---------------------------------------------------------------------------- tables
+def number(value: float | None) -> str:
+    """A value as the table shows it: 6 significant digits, "-" where there is none."""
+    return "-" if value is None or not math.isfinite(value) else f"{value:.6g}"
+
+
+def _cell(value: object) -> str:
+    return number(value) if value is None or isinstance(value, float) else str(value)
+
+
+RUN_SHOWN = 3
+"""A table shows runs of at most this many consecutive points of one type on one branch in
+full; a longer run as its first and last row with one "... N more" row between them."""
+
+
+@dataclass(frozen=True)
+class Skipped:
+    """Where :func:`compact` left out ``count`` records of points of ``type``."""
+
+    count: int
+    type: str
+
+
+def compact(records_: Sequence[dict[str, object]], longest: int = RUN_SHOWN
+            ) -> list[dict[str, object] | Skipped]:
+    """``records_`` with every run of more than ``longest`` consecutive records of the same
+    branch and type replaced by its first record, a :class:`Skipped` and its last record
+    (e.g. the many GH points AUTO flags along a Hopf locus of a linear model)."""
+    shown: list[dict[str, object] | Skipped] = []
+    start = 0
+    while start < len(records_):
+        key = (records_[start]["branch"], records_[start]["type"])
+        end = start
+        while end + 1 < len(records_) and \
+                (records_[end + 1]["branch"], records_[end + 1]["type"]) == key:
+            end += 1
+        run = list(records_[start:end + 1])
+        shown += run if len(run) <= longest else [run[0], Skipped(len(run) - 2, str(key[1])),
+                                                  run[-1]]
+        start = end + 1
+    return shown
+
+
+def tables(result: StudyResult, dofs: Sequence[str] | None = None) -> list:
+    """One rich Table per continuation of ``result`` (its special points, as in
+    :func:`summary_rows`, long runs of one type on one branch shortened by :func:`compact`;
+    a continuation without any gets a table with a "none" caption)."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    drawn = []
+    for continuation in result.continuations:
+        rows = continuation_rows(continuation, dofs)
+        names = columns(rows)[1:]  # the continuation is the title
+        table = Table(title=escape(f"{continuation.name} ({continuation.kind}): "
+                            f"{len(rows)} special point{'s' if len(rows) != 1 else ''}"),
+                      title_justify="left", caption=None if rows else "none",
+                      header_style="bold", box=None, pad_edge=False)
+        for name in names:
+            numeric = name not in ("branch", "type", *LAST_COLUMNS[1:])
+            table.add_column(escape(name), justify="right" if numeric else "left", no_wrap=True)
+        for record in compact(records(rows)):
+            if isinstance(record, Skipped):
+                table.add_row("...", escape(f"{record.count} more {record.type}"),
+                              *[""] * (len(names) - 2))
+            else:
+                table.add_row(*(escape(_cell(record[name])) for name in names))
+        drawn.append(table)
+    return drawn
+
+
+def render(result: StudyResult, output_format: str, dofs: Sequence[str] | None = None,
+           width: int | None = None) -> str:
+    """The summary of ``result`` as text in ``output_format`` (one of :data:`FORMATS`);
+    tables are rendered ``width`` characters wide at most (None: as wide as they need)."""
+    if output_format == "csv":
+        return to_csv(summary_rows(result, dofs))
+    if output_format == "json":
+        return to_json(summary_rows(result, dofs)) + "\n"
+    if output_format != "table":
+        raise ValueError(f"unknown summary format {output_format!r}; choose from {FORMATS}")
+    from rich.console import Console
+
+    buffer = io.StringIO()
+    console = Console(file=buffer, width=width or 10_000, highlight=False, color_system=None)
+    for k, table in enumerate(tables(result, dofs)):
+        if k:
+            console.print()
+        console.print(table)
+    return "\n".join(line.rstrip() for line in buffer.getvalue().splitlines()) + "\n"

@@ -1,0 +1,67 @@
+"""What a study's figures are called: titles naming the study and its fixed parameters
+("combined-case2: K_psi = 0.3 N m/rad"), and the labels of the slices of its two-parameter
+continuations ("case 2"), read from the study text stored with a result.
+
+No matplotlib; imports :mod:`whirl_cli.study` (inside :func:`captions`) to read the stored
+study with canonical parameter names and units.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+from ..results import StudyResult
+
+
+@dataclass(frozen=True)
+class Fixed:
+    """A parameter the study fixes: canonical name, value and unit (SI)."""
+
+    name: str
+    value: float
+    unit: str
+
+    def __str__(self) -> str:
+        return f"{self.name} = {self.value:g}{' ' + self.unit if self.unit else ''}"
+
+
+@dataclass(frozen=True)
+class Captions:
+    """The study's name, the parameters it overrides (in the order written) and, per
+    two-parameter continuation, one label per slice (empty: none given)."""
+
+    study: str
+    fixed: tuple[Fixed, ...] = ()
+    slice_labels: dict[str, tuple[str, ...]] = field(default_factory=dict)
+
+    def title(self, varied: Iterable[str] = ()) -> str:
+        """``"<study>: <name> = <value> <unit>, ..."`` over the fixed parameters that are
+        not ``varied`` in the figure (just the study's name if none is left)."""
+        varied = set(varied)
+        shown = [str(f) for f in self.fixed if f.name not in varied]
+        return f"{self.study}: {', '.join(shown)}" if shown else self.study
+
+    def slice_label(self, continuation: str, k: int) -> str:
+        """The label of slice ``k`` (from 0) of ``continuation``: the study's ``label``, else
+        ``"case <k + 1>"``."""
+        labels = self.slice_labels.get(continuation, ())
+        return labels[k] if k < len(labels) and labels[k] else f"case {k + 1}"
+
+
+def captions(result: StudyResult) -> Captions:
+    """The captions of ``result`` from the study stored with it (``study_yaml``); if that does
+    not validate (e.g. a file of an older whirl), the study's name alone."""
+    from ..errors import WhirlError
+    from ..study import validate_text
+
+    try:
+        study = validate_text(str(result.attributes.get("study_yaml", "")))
+    except WhirlError:
+        return Captions(result.study_name)
+    names = study.names()
+    fixed = tuple(Fixed(names.canonical(key), float(value), names.parameter(key).unit)
+                  for key, value in study.parameters.items())
+    labels = {c.name: tuple(c.slice_labels) for c in study.continuations
+              if c.type == "two-parameter"}
+    return Captions(study.name, fixed, labels)
