@@ -6,7 +6,8 @@ study may use (:class:`~whirl_cli.study.resolve.Names`), law coefficients only u
 of a list naming its dof), a parameter given once, values and ranges inside the physical
 bounds, unique
 continuation names, ``start``, ``slices`` and ``orbits_at`` inside ``range``, ``plot_state`` a
-state of the model.
+state of the model, and what a law requires of its coefficients together (freeplay: epsilon <
+delta, K_out > K_in).
 """
 
 from __future__ import annotations
@@ -46,9 +47,9 @@ def _meaning_problems(data: dict) -> list[Problem]:
         if not isinstance(block, dict):
             continue
         dof = block_dof(block, family, _is_single(data))
-        for key, name in names.model.coefficient_names(dof).items():
-            if key in block:
-                problems += _bound_problems(loc + (key,), name, block[key], names)
+        found = [p for key, name in names.model.coefficient_names(dof).items() if key in block
+                 for p in _bound_problems(loc + (key,), name, block[key], names)]
+        problems += found or _combination_problems(loc, block, dof, names, values)
     items = data.get("continuations")
     problems += _continuation_problems(items, names, family, values)
     linear = data.get("linear")
@@ -89,6 +90,16 @@ def _law_problems(data: dict, family: str) -> list[Problem]:
         else:
             seen[dof] = loc
     return problems
+
+
+def _combination_problems(loc: Loc, block: dict, dof: str, names: Names,
+                          values: dict[str, float]) -> list[Problem]:
+    """What a law says about its coefficient values together (freeplay: epsilon < delta,
+    K_out > K_in), each at the first of its keys the block gives (else at the block)."""
+    law = names.model.law_on(dof)
+    given = {key: values[name] for key, name in names.model.coefficient_names(dof).items()}
+    return [(loc + next(((k,) for k in keys if k in block), ()), reason)
+            for keys, reason in law.problems(given)]
 
 
 def _plot_state_problems(state: Any, family: str) -> list[Problem]:
