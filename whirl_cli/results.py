@@ -291,7 +291,9 @@ class CrossCheck:
     moves most relative to its typical amplitude, SI units) or "equilibrium" (expected: the
     initial perturbation of every dof, simulated: the largest final deviation of one, both in
     units of the dofs' typical amplitudes; for the classical model rad). ``state``: "" in
-    files written before whirl recorded it.
+    files written before whirl recorded it. ``exact``: for an orbit of a model with a
+    piecewise law (freeplay), the same maximum from a simulation of the exact, unsmoothed law
+    (``passed`` needs both within the tolerance); NaN otherwise and in older files.
     """
 
     branch: str
@@ -302,6 +304,7 @@ class CrossCheck:
     simulated: float
     passed: bool
     state: str = ""
+    exact: float = float("nan")
 
 
 @dataclass(frozen=True)

@@ -245,7 +245,8 @@ def test_model_validate_fills_the_same_defaults():
         ("plots: bifurcation\n", "s.yaml:3: plots: expected a list, got 'bifurcation'"),
         (
             "nonlinearity: {type: cubic}\n",
-            "s.yaml:3: nonlinearity.type: expected one of linear, polynomial, freeplay, got 'cubic'",
+            "s.yaml:3: nonlinearity.type: expected one of linear, polynomial, freeplay, "
+            "got 'cubic'",
         ),
         (
             "nonlinearity: {type: 3}\n",

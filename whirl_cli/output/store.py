@@ -22,7 +22,8 @@ Layout (units in a ``units`` attribute on every physical dataset)::
                                     lyapunov (first Lyapunov coefficient of Hopf points)
         cross_checks/               (study `cross_check: true`) columns: branch, index, kind
                                     (orbit | equilibrium), parameter, expected, simulated,
-                                    passed, state (the dof an orbit check compares)
+                                    passed, state (the dof an orbit check compares),
+                                    exact (an orbit's max by the exact piecewise law; NaN)
     /linear/sweeps/<parameter>/     values, eigenvalues [1/s], damping_ratio, frequency [rad/s],
                                     whirl (FW | BW | --)
     /linear/grid/                   x, y, max_real (Ny, Nx) [1/s], oscillatory (Ny, Nx),
@@ -148,7 +149,7 @@ def _write_cross_checks(group: h5py.Group, checks: tuple[CrossCheck, ...]) -> No
     group.create_dataset("branch", data=_strings(c.branch for c in checks), dtype=_STR)
     group.create_dataset("index", data=np.array([c.index for c in checks], dtype=np.int64))
     group.create_dataset("kind", data=_strings(c.kind for c in checks), dtype=_STR)
-    for key in ("parameter", "expected", "simulated"):
+    for key in ("parameter", "expected", "simulated", "exact"):
         group.create_dataset(key, data=np.array([getattr(c, key) for c in checks], dtype=float))
     group.create_dataset("passed", data=np.array([c.passed for c in checks], dtype=bool))
     group.create_dataset("state", data=_strings(c.state for c in checks), dtype=_STR)
@@ -161,7 +162,8 @@ def _read_cross_checks(group: h5py.Group) -> tuple[CrossCheck, ...]:
                    _text(columns["kind"][k]), float(columns["parameter"][k]),
                    float(columns["expected"][k]), float(columns["simulated"][k]),
                    bool(columns["passed"][k]),
-                   _text(columns["state"][k]) if "state" in columns else "")
+                   _text(columns["state"][k]) if "state" in columns else "",
+                   float(columns["exact"][k]) if "exact" in columns else float("nan"))
         for k in range(len(columns["index"])))
 
 
