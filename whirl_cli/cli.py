@@ -206,7 +206,7 @@ def models() -> None:
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--kind", "kinds", multiple=True,
               type=click.Choice(["bifurcation", "linear", "projections", "period", "phase",
-                                 "boundary"]),
+                                 "boundary", "amplitude"]),
               help="Plot kind (repeatable) [default: all available].")
 @click.option("-o", "--output-dir", type=click.Path(file_okay=False, path_type=Path),
               help="Directory for the PNG files [default: next to RESULT_FILE].")
@@ -231,7 +231,7 @@ def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None,
     except OSError as error:
         raise OutputError(f"{output_dir}: cannot create the output directory "
                           f"({error.strerror or error})") from None
-    kinds = kinds or ("bifurcation", "linear", "period", "boundary")
+    kinds = kinds or ("bifurcation", "linear", "period", "boundary", "amplitude")
     for path in save_study_plots(result, kinds, output_dir, result_file.stem, state):
         click.echo(f"wrote {path}")
 

@@ -211,3 +211,75 @@ def test_doubling_delta_keeps_bifurcation_airspeeds_and_doubles_amplitudes(run):
             np.testing.assert_allclose(yb, 2 * ya, atol=1e-6 * DELTA)
         compared += 1
     assert compared == 2
+
+
+# ------------------------------------------------------------------------------ limit cycles
+LCO = f"""
+name: freeplay-lco
+model: classical
+parameters: {{K_psi: {K_PSI}}}
+nonlinearity:
+  - {{type: freeplay, dof: theta, delta: {DELTA!r}, K_out: 0.4, K_in: 0.05}}
+  - {{type: polynomial, dof: psi, K2: 100.0}}
+continuations:
+  - {{name: v, type: one-parameter, parameter: V, start: 5.0, range: [5.0, 7.2],
+      periodic: true, branch_points: false}}
+auto: {{step_max: 0.001, step_initial: 0.0001}}
+cross_check: true
+"""
+
+
+def test_freeplay_lco_cross_check_simulates_the_exact_law_too(run):
+    """The family of the origin's Hopf point (K_in = 0.05 in the gap; a cubic on yaw bends it)
+    grows out of the gap (A/delta > 1.2 at 7.2 m/s); the orbit cross-checks simulate the
+    smoothed and the exact piecewise law from AUTO's orbit, and both maxima stay within 1 % of
+    AUTO's half peak-to-peak value, also for an orbit outside the gap."""
+    (continuation,) = run(LCO).continuations
+    (family,) = [b for b in continuation.branches if b.is_periodic]
+    orbits = [x for x in continuation.cross_checks if x.kind == "orbit"]
+    assert orbits and all(x.passed for x in orbits), orbits
+    (found,) = continuation.freeplay
+    outside = 0
+    for x in orbits:
+        assert np.isfinite(x.exact) and x.state == "theta"
+        half = (family.state_max[x.index, 0] - family.state_min[x.index, 0]) / 2
+        assert abs(x.exact - x.expected) < 0.01 * half
+        assert abs(x.simulated - x.expected) < 0.01 * half
+        outside += found.amplitude_ratio[x.index] > 1.1
+    assert outside >= 1
+
+
+def test_freeplay_amplitudes_and_describing_function_estimate(run, tmp_path):
+    """A/delta of every row is the stored orbit's half peak-to-peak pitch over delta (1e-6);
+    each estimate row is a Hopf point of the linear model with K_theta = K_eq(A) (the
+    eigenvalues there have a pair on the imaginary axis, |Re| < 1e-7 |lambda|), K_eq rises
+    from K_in at A = delta; both survive the HDF5 file and draw as the amplitude plot."""
+    from whirl_cli.output import store
+    from whirl_cli.plots.files import render_study_plots
+
+    result = run(LCO)
+    (continuation,) = result.continuations
+    (family,) = [b for b in continuation.branches if b.is_periodic]
+    (found,) = continuation.freeplay
+    assert found.branch == family.name and found.dof == "theta"
+    assert found.amplitude_ratio.max() > 1.2
+    for orbit in family.orbits:
+        half = np.ptp(orbit.states[:, 0]) / 2
+        assert found.amplitude_ratio[orbit.index] == pytest.approx(half / DELTA, rel=1e-6)
+    assert found.estimate_ratio[0] == 1.0 and found.estimate_stiffness[0] == pytest.approx(0.05)
+    assert np.all(np.diff(found.estimate_stiffness) > 0)
+    model = get_model("classical")
+    for k_eq, speed in zip(found.estimate_stiffness, found.estimate_parameter, strict=True):
+        params = model.parameter_vector({"K_psi": K_PSI, "K2_psi": 100.0, "K_theta": k_eq,
+                                         "V": speed})
+        eigenvalues = np.linalg.eigvals(model.jacobian_numpy(np.zeros(4), params))
+        critical = eigenvalues[np.argmin(np.abs(eigenvalues.real))]
+        assert abs(critical.real) < 1e-7 * abs(critical) and abs(critical.imag) > 1.0
+    path = tmp_path / "lco.h5"
+    store.write(result, path)
+    (again,) = store.read(path).continuations[0].freeplay
+    for key in ("amplitude_ratio", "estimate_ratio", "estimate_stiffness",
+                "estimate_parameter"):
+        np.testing.assert_array_equal(getattr(again, key), getattr(found, key))
+    (name, png), = render_study_plots(result, ("amplitude",), "lco")
+    assert name == "lco_v_amplitude.png" and png.startswith(b"\x89PNG")

@@ -16,6 +16,8 @@ Layout (units in a ``units`` attribute on every physical dataset)::
             floquet_multipliers (N, n) complex (periodic orbits)
             orbits/<label>/ time (K,) [s], states (K, n)  attrs: point_type, index, period,
                                                                 parameters
+            freeplay_<dof>/ (periodic, freeplay law on dof) amplitude_ratio (N,) = A/delta;
+                            describing_function/ amplitude_ratio, stiffness, parameter (M,)
         special_points/             columns: branch, index, point_type, type_name, label,
                                     parameters (K, P), state (K, n), period, stable, status,
                                     criticality, note, bracket (K, 2), residual,
@@ -64,6 +66,7 @@ from ..results import (
     BranchKind,
     ContinuationResult,
     CrossCheck,
+    FreeplayAmplitudes,
     LinearGrid,
     LinearSweep,
     Orbit,
@@ -167,6 +170,31 @@ def _read_cross_checks(group: h5py.Group) -> tuple[CrossCheck, ...]:
         for k in range(len(columns["index"])))
 
 
+def _write_freeplay(branch: h5py.Group, found: FreeplayAmplitudes) -> None:
+    """``<branch>/freeplay_<dof>/``: amplitude_ratio (N,) = A/delta; describing_function/
+    amplitude_ratio, stiffness, parameter (M,) (results.FreeplayAmplitudes)."""
+    group = branch.create_group(f"freeplay_{found.dof}")
+    group.attrs["dof"] = found.dof
+    group.create_dataset("amplitude_ratio", data=found.amplitude_ratio).attrs["units"] = "1"
+    estimate = group.create_group("describing_function")
+    estimate.create_dataset("amplitude_ratio", data=found.estimate_ratio)
+    estimate.create_dataset("stiffness", data=found.estimate_stiffness)
+    estimate.create_dataset("parameter", data=found.estimate_parameter)
+
+
+def _read_freeplay(name: str, branch: h5py.Group) -> list[FreeplayAmplitudes]:
+    """The freeplay groups of the branch group ``name`` (none in files without freeplay)."""
+    found = []
+    for key in (k for k in branch if k.startswith("freeplay_")):
+        group = branch[key]
+        estimate = group["describing_function"]
+        found.append(FreeplayAmplitudes(
+            name, _text(group.attrs["dof"]), group["amplitude_ratio"][()],
+            estimate["amplitude_ratio"][()], estimate["stiffness"][()],
+            estimate["parameter"][()]))
+    return found
+
+
 def _write_boundary(group: h5py.Group, boundary: Boundary) -> None:
     group.attrs.update(parameters=list(boundary.parameter_names),
                        units=list(boundary.parameter_units), method=boundary.method,
@@ -265,6 +293,8 @@ def _image(result: StudyResult) -> bytes:
                 else 0
             for branch in continuation.branches:
                 _write_branch(_collection(group, "branches").create_group(branch.name), branch)
+            for found in continuation.freeplay:
+                _write_freeplay(group["branches"][found.branch], found)
             _write_special_points(group.create_group("special_points"),
                                   continuation.special_points, n_states)
             if continuation.cross_checks:
@@ -416,9 +446,11 @@ def read(path: Path) -> StudyResult:
             branches = tuple(_read_branch(b, g) for b, g in group.get("branches", {}).items())
             checks = _read_cross_checks(group["cross_checks"]) if "cross_checks" in group \
                 else ()
+            freeplay = tuple(f for b, g in group.get("branches", {}).items()
+                             for f in _read_freeplay(b, g))
             continuations.append(ContinuationResult(
                 name, _text(group.attrs["kind"]), branches,
-                _read_special_points(group["special_points"]), checks))
+                _read_special_points(group["special_points"]), checks, freeplay))
         sweeps = []
         for parameter, group in handle.get("linear/sweeps", {}).items():
             sweeps.append(LinearSweep(

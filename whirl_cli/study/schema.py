@@ -302,7 +302,8 @@ class TwoParameterContinuation(_Strict):
         return {names.canonical(key): tuple(value) for key, value in self.range.items()}
 
 
-PlotKind = Literal["bifurcation", "linear", "projections", "period", "phase", "boundary"]
+PlotKind = Literal["bifurcation", "linear", "projections", "period", "phase", "boundary",
+                   "amplitude"]
 Continuation = Annotated[OneParameterContinuation | TwoParameterContinuation,
                         Field(discriminator="type")]
 
