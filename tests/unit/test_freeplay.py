@@ -139,3 +139,14 @@ def test_exact_simulation_switches_pieces_on_the_breakpoints(freeplay):
         np.testing.assert_allclose(state[:4], restart, atol=1e-9)
         piece += 1 if restart[2] > 0 else -1
         assert piece in (0, 1, 2)
+
+
+def test_whirl_models_lists_freeplay_as_whirls_law():
+    from click.testing import CliRunner
+
+    from whirl_cli.cli import cli
+
+    done = CliRunner().invoke(cli, ["models"])
+    assert done.exit_code == 0, done.output
+    (line,) = [x for x in done.output.splitlines() if x.startswith("  freeplay:")]
+    assert "whirl's law (models.md 7)" in line and "K_out (= the dof's stiffness)" in line
