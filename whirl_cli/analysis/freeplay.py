@@ -59,7 +59,7 @@ def describing_estimate(model: Model, overrides: dict[str, float], dof: str, par
         k_eq = float(equivalent_stiffness(ratio * law["delta"], law["delta"], law["K_in"],
                                           law["K_out"]))
         for point in critical_points(linear, {**fixed, stiffness: k_eq}, parameter, *bounds,
-                                     points=401):
+                                     points=201):
             if point.kind == "hopf":
                 rows.append((float(ratio), k_eq, point.value))
     table = np.array(rows, dtype=float).reshape(-1, 3)
@@ -68,7 +68,7 @@ def describing_estimate(model: Model, overrides: dict[str, float], dof: str, par
 
 def freeplay_amplitudes(model: Model, overrides: dict[str, float],
                         continuation: ContinuationResult, bounds: tuple[float, float],
-                        points: int = 60) -> tuple[FreeplayAmplitudes, ...]:
+                        points: int = 40) -> tuple[FreeplayAmplitudes, ...]:
     """:class:`FreeplayAmplitudes` of every periodic branch of a one-parameter
     ``continuation`` and every freeplay dof of ``model`` (``overrides``: the study's parameter
     values by canonical name; ``bounds``: the continuation's range). The estimate spans A/delta
