@@ -77,3 +77,24 @@ def test_the_stiffness_outside_the_gap_is_set_in_the_law_only(tmp_path):
     assert result.output.splitlines() == [
         "twice.yaml:3: parameters.K_theta: set K_theta under nonlinearity (type: freeplay, "
         "dof: theta) as K_out"]
+
+
+@pytest.mark.parametrize(("continuation", "reason"), [
+    ("{name: e, type: one-parameter, parameter: epsilon_theta, range: [1.0e-5, 0.02]}",
+     "the range reaches 0.02 where epsilon must be < delta = 0.01 (the smoothing width below "
+     "the half-gap), got 0.02"),
+    ("{name: k, type: one-parameter, parameter: K_out_theta, range: [-0.3, 0.5]}",
+     "the range reaches -0.3 where K_out must be > K_in = 0.0 (stiffer outside the gap than "
+     "inside), got K_out = -0.3"),
+    ("{name: k, type: one-parameter, parameter: K_in_theta, range: [0.0, 0.4]}",
+     "the range reaches 0.4 where K_out must be > K_in = 0.4 (stiffer outside the gap than "
+     "inside), got K_out = 0.4"),
+], ids=["epsilon", "K_out", "K_in"])
+def test_a_continuation_may_not_leave_the_valid_freeplay_laws(continuation, reason, tmp_path):
+    study = tmp_path / "range.yaml"
+    study.write_text("name: fp\nmodel: classical\n"
+                     "nonlinearity: {type: freeplay, dof: theta, delta: 0.01}\n"
+                     f"continuations:\n  - {continuation}\n")
+    result = CliRunner().invoke(cli, ["validate", str(study)])
+    assert result.exit_code == 1
+    assert result.output.splitlines() == [f"range.yaml:5: continuations[0].range: {reason}"]

@@ -102,6 +102,25 @@ def _combination_problems(loc: Loc, block: dict, dof: str, names: Names,
             for keys, reason in law.problems(given)]
 
 
+def _law_range_problems(loc: Loc, canonical: str, bounds: Any, names: Names,
+                        values: dict[str, float]) -> list[Problem]:
+    """A continuation of a law coefficient (or of a stiffness a law names, freeplay's K_out)
+    whose range reaches values the law refuses together with the others (epsilon >= delta,
+    K_out <= K_in): the first such end."""
+    ends = [_finite(b) for b in bounds] if isinstance(bounds, list) and len(bounds) == 2 else []
+    for dof in names.model.family.dof_names:
+        coefficients = names.model.coefficient_names(dof)
+        if canonical not in coefficients.values():
+            continue
+        law = names.model.law_on(dof)
+        for end in (e for e in ends if e is not None):
+            given = {key: (end if name == canonical else values[name])
+                     for key, name in coefficients.items()}
+            for _, reason in law.problems(given):
+                return [(loc, f"the range reaches {end!r} where {reason}")]
+    return []
+
+
 def _plot_state_problems(state: Any, family: str) -> list[Problem]:
     """``plot_state`` a state of the model: a dof or a rate."""
     dofs = FAMILIES[family].dofs
@@ -219,6 +238,8 @@ def _continuation_problems(
             found = _range_problems(loc + ("range",), canonical, item.get("range"), names,
                                     "continued")
             found = found or _start_problems(loc, item, values[canonical])
+            found = found or _law_range_problems(loc + ("range",), canonical,
+                                                 item.get("range"), names, values)
             found += _orbits_problems(loc, item)
         problems += found
     return problems
