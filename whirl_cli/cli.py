@@ -6,7 +6,6 @@ results are still written, with each run's status); 2 usage errors (click).
 
 from __future__ import annotations
 
-import math
 import os
 import shutil
 import sys
@@ -137,7 +136,7 @@ def check(result_file: Path) -> None:
             return (f"perturbation {x.expected:.6g}, final deviation {x.simulated:.6g} "
                     "(typical amplitudes)")
         unit = model.states[model.state_names.index(x.state)].unit
-        exact = f", exact law {x.exact:.6g} {unit}" if math.isfinite(x.exact) else ""
+        exact = f", exact law {x.exact:.6g} {unit}" if x.exact is not None else ""
         return f"max {x.state} AUTO {x.expected:.6g} {unit}, simulation {x.simulated:.6g} " \
             f"{unit}{exact}"
 

@@ -293,7 +293,8 @@ class CrossCheck:
     units of the dofs' typical amplitudes; for the classical model rad). ``state``: "" in
     files written before whirl recorded it. ``exact``: for an orbit of a model with a
     piecewise law (freeplay), the same maximum from a simulation of the exact, unsmoothed law
-    (``passed`` needs both within the tolerance); NaN otherwise and in older files.
+    (``passed`` needs both within the tolerance); None otherwise and in older files (NaN in
+    the HDF5 file).
     """
 
     branch: str
@@ -304,7 +305,7 @@ class CrossCheck:
     simulated: float
     passed: bool
     state: str = ""
-    exact: float = float("nan")
+    exact: float | None = None
 
 
 @dataclass(frozen=True)

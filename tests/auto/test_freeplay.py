@@ -241,7 +241,7 @@ def test_freeplay_lco_cross_check_simulates_the_exact_law_too(run):
     (found,) = continuation.freeplay
     outside = 0
     for x in orbits:
-        assert np.isfinite(x.exact) and x.state == "theta"
+        assert x.exact is not None and np.isfinite(x.exact) and x.state == "theta"
         half = (family.state_max[x.index, 0] - family.state_min[x.index, 0]) / 2
         assert abs(x.exact - x.expected) < 0.01 * half
         assert abs(x.simulated - x.expected) < 0.01 * half
@@ -277,7 +277,9 @@ def test_freeplay_amplitudes_and_describing_function_estimate(run, tmp_path):
         assert abs(critical.real) < 1e-7 * abs(critical) and abs(critical.imag) > 1.0
     path = tmp_path / "lco.h5"
     store.write(result, path)
-    (again,) = store.read(path).continuations[0].freeplay
+    stored = store.read(path).continuations[0]
+    assert stored.cross_checks == continuation.cross_checks  # the exact-law maxima too
+    (again,) = stored.freeplay
     for key in ("amplitude_ratio", "estimate_ratio", "estimate_stiffness",
                 "estimate_parameter"):
         np.testing.assert_array_equal(getattr(again, key), getattr(found, key))

@@ -175,7 +175,7 @@ def check_orbit(model: Model, overrides: dict[str, float], branch: Branch, orbit
     expected = float(branch.state_max[orbit.index, dof])
     half_span = max(np.ptp(orbit.states[:, dof]) / 2, 1e-12)
     passed = abs(simulated - expected) / half_span <= tolerance
-    exact = float("nan")
+    exact = None
     if model.piecewise_dofs:  # freeplay: the exact law, beside the smoothed one AUTO continued
         run = integrate_exact(model, params, orbit.states[0], periods * orbit.period,
                               samples=periods * 400)

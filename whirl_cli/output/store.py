@@ -152,8 +152,10 @@ def _write_cross_checks(group: h5py.Group, checks: tuple[CrossCheck, ...]) -> No
     group.create_dataset("branch", data=_strings(c.branch for c in checks), dtype=_STR)
     group.create_dataset("index", data=np.array([c.index for c in checks], dtype=np.int64))
     group.create_dataset("kind", data=_strings(c.kind for c in checks), dtype=_STR)
-    for key in ("parameter", "expected", "simulated", "exact"):
+    for key in ("parameter", "expected", "simulated"):
         group.create_dataset(key, data=np.array([getattr(c, key) for c in checks], dtype=float))
+    group.create_dataset("exact", data=np.array(
+        [np.nan if c.exact is None else c.exact for c in checks], dtype=float))
     group.create_dataset("passed", data=np.array([c.passed for c in checks], dtype=bool))
     group.create_dataset("state", data=_strings(c.state for c in checks), dtype=_STR)
 
@@ -166,7 +168,7 @@ def _read_cross_checks(group: h5py.Group) -> tuple[CrossCheck, ...]:
                    float(columns["expected"][k]), float(columns["simulated"][k]),
                    bool(columns["passed"][k]),
                    _text(columns["state"][k]) if "state" in columns else "",
-                   float(columns["exact"][k]) if "exact" in columns else float("nan"))
+                   _exact(columns, k))
         for k in range(len(columns["index"])))
 
 
@@ -193,6 +195,12 @@ def _read_freeplay(name: str, branch: h5py.Group) -> list[FreeplayAmplitudes]:
             estimate["amplitude_ratio"][()], estimate["stiffness"][()],
             estimate["parameter"][()]))
     return found
+
+
+def _exact(columns: dict, k: int) -> float | None:
+    """The exact-law maximum of cross-check ``k`` (None: not simulated, or an older file)."""
+    value = float(columns["exact"][k]) if "exact" in columns else float("nan")
+    return value if np.isfinite(value) else None
 
 
 def _write_boundary(group: h5py.Group, boundary: Boundary) -> None:
