@@ -130,7 +130,7 @@ FREEPLAY = Law(
     "freeplay", "fp",
     "whirl's law (models.md 7): deadband of half-gap delta, stiffness K_in inside and K_out "
     "(the dof's linear stiffness, e.g. K_theta) outside, smoothed over epsilon by ln cosh",
-    (Coefficient("delta", 0.01, 0, "half-gap (freeplay)", bounds=POSITIVE, in_dof_unit=True),
+    (Coefficient("delta", 0.01, 0, "half-gap", bounds=POSITIVE, in_dof_unit=True),
      Coefficient("K_in", 0.0, 1, "stiffness inside the gap", bounds=NON_NEGATIVE),
      Coefficient("epsilon", 0.01 * EPSILON_FRACTION, 0, "smoothing width", bounds=POSITIVE,
                  in_dof_unit=True)),
