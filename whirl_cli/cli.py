@@ -166,8 +166,9 @@ def check(result_file: Path) -> None:
             return (f"perturbation {x.expected:.6g}, final deviation {x.simulated:.6g} "
                     "(typical amplitudes)")
         unit = model.states[model.state_names.index(x.state)].unit
+        exact = f", exact law {x.exact:.6g} {unit}" if x.exact is not None else ""
         return f"max {x.state} AUTO {x.expected:.6g} {unit}, simulation {x.simulated:.6g} " \
-            f"{unit}"
+            f"{unit}{exact}"
 
     wrong = 0
     for continuation in result.continuations:
@@ -224,11 +225,19 @@ def generate(check: bool, directory: Path) -> None:
 def models() -> None:
     """List the model variants with their states and parameters (units, defaults)."""
     from .models import FAMILIES, all_variants, get_model
+    from .models.laws import LAWS
 
     shipped = all_variants()
     others = [get_model(name) for name in FAMILIES
               if name not in {model.family.name for model in shipped}]
     click.echo("\n\n".join(model.describe() for model in shipped + others))
+    lines = ["", "stiffness laws (nonlinearity type; on any dof, coefficients named "
+             "<key>_<dof>):"]
+    for law in LAWS.values():
+        keys = [c.key for c in law.coefficients]
+        keys += [f"{law.stiffness_key} (= the dof's stiffness)"] if law.stiffness_key else []
+        lines.append(f"  {law.name}: {law.description}; keys {', '.join(keys)}")
+    click.echo("\n".join(lines))
 
 
 # ------------------------------------------------------------------------------------ plot
@@ -246,7 +255,7 @@ def _limits(ctx: click.Context, param: click.Parameter, value):
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--kind", "kinds", multiple=True,
               type=click.Choice(["bifurcation", "linear", "projections", "period", "phase",
-                                 "boundary"]),
+                                 "boundary", "amplitude"]),
               help="Plot kind (repeatable) [default: every kind the file has the data for]; "
                    "a kind it lacks the data for is an error.")
 @click.option("-o", "--output-dir", type=click.Path(file_okay=False, path_type=Path),

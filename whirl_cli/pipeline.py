@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .analysis import boundaries, linear, simulate
+from .analysis import boundaries, freeplay, linear, simulate
 from .auto.runner import RunOutcome, interruptible
 from .continuation.engine import Engine, Numerics
 from .continuation.loci import two_parameter
@@ -52,10 +52,14 @@ def _run_study(study: Study, workroot: Path, jobs: int,
             continuations.append(continuation)
             found_boundaries.append(boundary)
             continue
-        continuations.append(one_parameter(
+        continuation = one_parameter(
             engine, spec.name, spec.parameter, spec.start, tuple(spec.range), parameters,
             numerics, branch_points=spec.branch_points, periodic=spec.periodic,
-            orbits_at=spec.orbits_at))
+            orbits_at=spec.orbits_at)
+        if freeplay.freeplay_dofs(model):  # amplitudes / delta, describing function
+            continuation = replace(continuation, freeplay=freeplay.freeplay_amplitudes(
+                model, parameters, continuation, tuple(spec.range)))
+        continuations.append(continuation)
     if study.cross_check:
         continuations = [replace(c, cross_checks=simulate.cross_check(
             model, parameters, c.branches, jobs=jobs)) for c in continuations]

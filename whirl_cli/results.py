@@ -292,7 +292,10 @@ class CrossCheck:
     moves most relative to its typical amplitude, SI units) or "equilibrium" (expected: the
     initial perturbation of every dof, simulated: the largest final deviation of one, both in
     units of the dofs' typical amplitudes; for the classical model rad). ``state``: "" in
-    files written before whirl recorded it.
+    files written before whirl recorded it. ``exact``: for an orbit of a model with a
+    piecewise law (freeplay), the same maximum from a simulation of the exact, unsmoothed law
+    (``passed`` needs both within the tolerance); None otherwise and in older files (NaN in
+    the HDF5 file).
     """
 
     branch: str
@@ -303,17 +306,45 @@ class CrossCheck:
     simulated: float
     passed: bool
     state: str = ""
+    exact: float | None = None
+
+
+@dataclass(frozen=True)
+class FreeplayAmplitudes:
+    """A periodic branch in the units of a freeplay law on one of its dofs
+    (:mod:`whirl_cli.analysis.freeplay`, ``../shared/models.md`` section 7).
+
+    ``amplitude_ratio`` (N,): A/delta per row of ``branch``, A the dof's half peak-to-peak
+    value over the orbit and delta the law's half-gap at that row (both in the dof's unit).
+    The describing-function estimate, ``estimate_ratio`` (M,) = A/delta, ``estimate_stiffness``
+    (M,) = K_eq(A) (the stiffness's unit) and ``estimate_parameter`` (M,): a value of the
+    branch's principal parameter at which the linear model with the dof's stiffness K_eq(A)
+    has a Hopf point (one row per such point, sorted by A/delta); empty when the principal
+    parameter is one of the law's own (delta, K_in, epsilon, K_out).
+    """
+
+    branch: str
+    dof: str
+    amplitude_ratio: np.ndarray
+    estimate_ratio: np.ndarray
+    estimate_stiffness: np.ndarray
+    estimate_parameter: np.ndarray
+    stiffness_unit: str = ""  # of estimate_stiffness: the dof's stiffness unit
+    parameter_unit: str = ""  # of estimate_parameter: the branch's principal parameter's
 
 
 @dataclass(frozen=True)
 class ContinuationResult:
-    """Everything one continuation of a study produced."""
+    """Everything one continuation of a study produced. ``freeplay``: its periodic branches
+    in the units of each freeplay law, with the describing-function estimate (one-parameter
+    continuations of models with freeplay)."""
 
     name: str
     kind: str  # "one-parameter" | "two-parameter"
     branches: tuple[Branch, ...]
     special_points: tuple[SpecialPoint, ...]
     cross_checks: tuple[CrossCheck, ...] = ()
+    freeplay: tuple[FreeplayAmplitudes, ...] = ()
 
 
 @dataclass(frozen=True)

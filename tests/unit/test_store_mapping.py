@@ -23,13 +23,14 @@ STRUCTURAL = {
     results.Boundary: {"name", "loci", "intervals", "polygons"},
     results.UnsafeInterval: set(),
     results.RunRecord: {"name"},
+    results.FreeplayAmplitudes: {"branch"},
 }
 DECLARATIONS = {
     results.Branch: store.BRANCH, results.Orbit: store.ORBIT,
     results.SpecialPoint: store.SPECIAL_POINT, results.CrossCheck: store.CROSS_CHECK,
     results.LinearSweep: store.LINEAR_SWEEP, results.LinearGrid: store.LINEAR_GRID,
     results.Boundary: store.BOUNDARY, results.UnsafeInterval: store.UNSAFE_INTERVAL,
-    results.RunRecord: store.RUN,
+    results.RunRecord: store.RUN, results.FreeplayAmplitudes: store.FREEPLAY,
 }
 
 

@@ -245,16 +245,17 @@ def test_model_validate_fills_the_same_defaults():
         ("plots: bifurcation\n", "s.yaml:3: plots: expected a list, got 'bifurcation'"),
         (
             "nonlinearity: {type: cubic}\n",
-            "s.yaml:3: nonlinearity.type: expected one of linear, polynomial, got 'cubic'",
+            "s.yaml:3: nonlinearity.type: expected one of linear, polynomial, freeplay, "
+            "got 'cubic'",
         ),
         (
             "nonlinearity: {type: 3}\n",
-            "s.yaml:3: nonlinearity.type: expected one of linear, polynomial, got 3",
+            "s.yaml:3: nonlinearity.type: expected one of linear, polynomial, freeplay, got 3",
         ),
         (
             "plots: [bifurcation, bubble]\n",
             "s.yaml:3: plots[1]: expected one of bifurcation, linear, projections, period, phase, "
-            "boundary, got 'bubble'",
+            "boundary, amplitude, got 'bubble'",
         ),
         (
             "nonlinearity: {type: linear, dof: phi}\n",
@@ -649,7 +650,9 @@ def test_schema_reference_lists_every_key_with_a_description():
     rows = {line.split("|")[1].strip().strip("`"): line for line in lines[2:]}
     expected = {"name", "description", "model", "parameters", "nonlinearity", "continuations",
                 "linear", "plots", "plot_state", "cross_check", "auto", "nonlinearity[].type",
-                "nonlinearity[].dof", "nonlinearity[].K2", "nonlinearity[].K3", "linear.sweeps",
+                "nonlinearity[].dof", "nonlinearity[].K2", "nonlinearity[].K3",
+                "nonlinearity[].delta", "nonlinearity[].K_out", "nonlinearity[].K_in",
+                "nonlinearity[].epsilon", "linear.sweeps",
                 "linear.sweeps[].parameter", "linear.sweeps[].range", "linear.sweeps[].points",
                 "linear.grid", "linear.grid.x", "linear.grid.y"}
     expected |= {f"linear.grid.{axis}.{k}" for axis in "xy" for k in ("parameter", "range",

@@ -3,7 +3,8 @@ model: the independent check of what continuation claims.
 
 * A stable periodic orbit: started on AUTO's orbit, the simulation must stay on it (the maximum
   of the dof that moves most, relative to its typical amplitude, over the last periods within
-  ``tolerance`` of AUTO's).
+  ``tolerance`` of AUTO's). On a model with a piecewise law (freeplay) the exact, unsmoothed
+  law is simulated too (:func:`integrate_exact`) and must stay on it as well.
 * A stable equilibrium: a small perturbation of every dof must decay.
 
 Time in seconds, states in SI units (the classical model's rad, rad/s), as everywhere outside
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import multiprocessing
 from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -44,6 +46,112 @@ def integrate(model: Model, params: np.ndarray, y0: np.ndarray, duration: float,
     return times, states
 
 
+@dataclass(frozen=True)
+class ExactTrajectory:
+    """A simulation of the exact piecewise laws (:func:`integrate_exact`).
+
+    ``time`` (K,) s and ``states`` (K, n) SI: the samples; ``event_time`` (E,) s,
+    ``event_state`` (E, n) and ``event_dof`` (E,): where a piecewise dof reached a breakpoint
+    of its law (freeplay: |x| = delta) and the law changed piece, in order."""
+
+    time: np.ndarray
+    states: np.ndarray
+    event_time: np.ndarray
+    event_state: np.ndarray
+    event_dof: np.ndarray
+
+
+#: Most piece changes one exact simulation may make (a guard against chattering).
+MAX_EVENTS = 100_000
+
+
+def _piece(breakpoints: tuple[float, ...], x: float, rate: float) -> int:
+    """The piece a dof at ``x`` moving at ``rate`` is on: the number of breakpoints below it
+    (at a breakpoint, the piece it moves into)."""
+    below = int(np.searchsorted(breakpoints, x, side="left"))
+    at = below < len(breakpoints) and x == breakpoints[below]
+    return below + 1 if at and rate > 0 else below
+
+
+def integrate_exact(model: Model, params: np.ndarray, y0: np.ndarray, duration: float,
+                    samples: int = 4000, rtol: float = 1e-10) -> ExactTrajectory:
+    """The trajectory from ``y0`` over ``duration`` seconds with every piecewise law (the
+    model's ``piecewise_dofs``: freeplay) in its exact form, unsmoothed, sampled at
+    ``samples`` equally spaced times.
+
+    The exact law is smooth on each piece, so each piece is integrated on its own (scipy
+    ``solve_ivp``, DOP853, atol ``rtol`` x 1e-3 typical amplitudes) up to the event where a
+    piecewise dof reaches a breakpoint of its piece in the direction that leaves it (located
+    on the dense output, to round-off); the integration restarts there on the next piece.
+    The right-hand side of each piece is the model's exact numeric module
+    (:attr:`whirl_cli.models.Model.exact_numeric`), generated from the same symbolic model as
+    the smoothed one."""
+    from scipy.integrate import solve_ivp
+
+    dofs = model.piecewise_dofs
+    if not dofs:
+        raise ValueError(f"model {model.name} has no piecewise law to simulate exactly")
+    values = dict(zip(model.parameter_names, map(float, params), strict=True))
+    breakpoints = [model.breakpoints(i, values) for i in dofs]
+    n_dof = len(model.dofs)
+    state = np.asarray(y0, dtype=float).copy()
+    pieces = [_piece(b, state[i], state[n_dof + i]) for i, b in zip(dofs, breakpoints,
+                                                                     strict=True)]
+    grid = np.linspace(0.0, duration, samples)
+    scale = np.asarray(model.state_scale, dtype=float)
+    times, states = [], []
+    event_time: list[float] = []
+    event_state: list[np.ndarray] = []
+    event_dof: list[int] = []
+    start = 0.0
+    while True:
+        field, jacobian = model.exact_numeric.field_at(np.r_[params, pieces])
+        events, moves = [], []
+        for k, (i, b) in enumerate(zip(dofs, breakpoints, strict=True)):
+            if pieces[k] > 0:  # the lower end of the piece, reached going down
+                events.append(_crossing(i, b[pieces[k] - 1], -1.0))
+                moves.append((k, -1))
+            if pieces[k] < len(b):  # the upper end, reached going up
+                events.append(_crossing(i, b[pieces[k]], 1.0))
+                moves.append((k, 1))
+        inside = grid[(grid >= start) & (grid <= duration)]
+        solution = solve_ivp(lambda _t, y, f=field: f(y), (start, duration), state,
+                             method="DOP853",
+                             t_eval=inside, events=events, rtol=rtol, atol=rtol * 1e-3 * scale)
+        if solution.status < 0:
+            raise RuntimeError(f"exact time integration failed: {solution.message}")
+        times.append(solution.t)
+        states.append(solution.y.T)
+        fired = [(t[0], e) for e, t in enumerate(solution.t_events) if len(t)]
+        if solution.status == 0 or not fired:
+            break
+        start, which = min(fired)
+        state = solution.y_events[which][0].copy()
+        k, step = moves[which]
+        pieces[k] += step
+        event_time.append(start)
+        event_state.append(state.copy())
+        event_dof.append(dofs[k])
+        if len(event_time) > MAX_EVENTS:
+            raise RuntimeError(f"exact time integration: more than {MAX_EVENTS} piece changes "
+                               "(chattering at a breakpoint)")
+    time = np.concatenate(times)
+    keep = np.concatenate([[True], np.diff(time) > 0])  # a sample at an event appears twice
+    return ExactTrajectory(time[keep], np.concatenate(states)[keep], np.array(event_time),
+                           np.array(event_state).reshape(-1, model.n_states),
+                           np.array(event_dof, dtype=int))
+
+
+def _crossing(dof: int, value: float, direction: float):
+    """A terminal solve_ivp event: state ``dof`` passes ``value`` in ``direction``."""
+    def event(_t, y):
+        return y[dof] - value
+
+    event.terminal = True
+    event.direction = direction
+    return event
+
+
 def _parameters(model: Model, overrides: dict[str, float], names: tuple[str, ...],
                 values: np.ndarray) -> np.ndarray:
     return model.parameter_vector({**overrides, **dict(zip(names, map(float, values),
@@ -54,7 +162,8 @@ def check_orbit(model: Model, overrides: dict[str, float], branch: Branch, orbit
                 periods: int = 10, tolerance: float = ORBIT_TOLERANCE) -> CrossCheck:
     """Start on ``orbit`` and simulate ``periods`` periods; the max of the dof that moves most
     (relative to its typical amplitude) over the last two periods must match AUTO's within
-    ``tolerance`` (relative to its half peak-to-peak amplitude)."""
+    ``tolerance`` (relative to its half peak-to-peak amplitude). With a piecewise law
+    (freeplay) the exact law's simulation must too; its max is stored as ``exact``."""
     dofs = len(model.dofs)
     spans = np.ptp(orbit.states[:, :dofs], axis=0) / np.asarray(model.state_scale[:dofs])
     dof = int(np.argmax(spans))
@@ -64,9 +173,16 @@ def check_orbit(model: Model, overrides: dict[str, float], branch: Branch, orbit
     last = time >= (periods - 2) * orbit.period
     simulated = float(states[last, dof].max())
     expected = float(branch.state_max[orbit.index, dof])
-    error = abs(simulated - expected) / max(np.ptp(orbit.states[:, dof]) / 2, 1e-12)
+    half_span = max(np.ptp(orbit.states[:, dof]) / 2, 1e-12)
+    passed = abs(simulated - expected) / half_span <= tolerance
+    exact = None
+    if model.piecewise_dofs:  # freeplay: the exact law, beside the smoothed one AUTO continued
+        run = integrate_exact(model, params, orbit.states[0], periods * orbit.period,
+                              samples=periods * 400)
+        exact = float(run.states[run.time >= (periods - 2) * orbit.period, dof].max())
+        passed = passed and abs(exact - expected) / half_span <= tolerance
     return CrossCheck(branch.name, orbit.index, "orbit", float(orbit.parameters[0]), expected,
-                      simulated, bool(error <= tolerance), model.state_names[dof])
+                      simulated, bool(passed), model.state_names[dof], exact)
 
 
 def check_equilibrium(model: Model, overrides: dict[str, float], branch: Branch, index: int,

@@ -13,6 +13,12 @@ matrix depends on the parameters only, so every derivative of a with respect to 
 M^-1 times the same derivative of R. Only R and its derivatives are differentiated
 symbolically (never an inverted mass matrix: n^4 derivatives of M^-1 R would blow up for a full
 8 x 8 M); the solve with M is numeric, in the generated code.
+
+``exact=True`` builds the reference form instead: every law that smooths a piecewise law
+(freeplay) gives its exact restoring force on the piece named by one more parameter per such
+dof (``piece_<dof>``, after the model's parameters), so each piece is smooth; the time
+simulation of the exact law switches pieces at the breakpoints
+(:func:`whirl_cli.analysis.simulate.integrate_exact`). Never given to AUTO.
 """
 
 from __future__ import annotations
@@ -30,6 +36,7 @@ class Symbolic:
     """The symbols and expressions of one variant (physical SI units, time in seconds)."""
 
     model: Model
+    exact: bool = False
 
     @cached_property
     def q(self) -> tuple[sp.Symbol, ...]:
@@ -45,14 +52,17 @@ class Symbolic:
 
     @cached_property
     def parameters(self) -> tuple[sp.Symbol, ...]:
-        return tuple(sp.Symbol(p.name, real=True) for p in self.model.parameters)
+        """The model's parameters, and with ``exact`` the piece of each piecewise dof."""
+        pieces = self.model.piece_names if self.exact else ()
+        return tuple(sp.Symbol(name, real=True)
+                     for name in (*self.model.parameter_names, *pieces))
 
     @cached_property
     def _built(self) -> tuple[sp.Matrix, sp.Matrix]:
         family = self.model.family
         q = dict(zip(family.dof_names, self.q, strict=True))
         v = {d.name: s for d, s in zip(family.dofs, self.v, strict=True)}
-        p = {par.name: s for par, s in zip(self.model.parameters, self.parameters, strict=True)}
+        p = {str(s): s for s in self.parameters}
         mass, forces = family.equations(q, v, p)
         mass, forces = sp.Matrix(mass), sp.Matrix(forces)
         n = len(family.dofs)
@@ -64,7 +74,11 @@ class Symbolic:
         stiffness = []
         for dof, law in zip(family.dofs, self.model.law_objects, strict=True):
             keys = {c.key: p[law.parameter_name(c.key, dof.name)] for c in law.coefficients}
-            stiffness.append(law.moment(q[dof.name], p[dof.stiffness], keys))
+            if self.exact and law.exact is not None:
+                piece = p[f"piece_{dof.name}"]
+                stiffness.append(law.exact(q[dof.name], p[dof.stiffness], keys, piece))
+            else:
+                stiffness.append(law.moment(q[dof.name], p[dof.stiffness], keys))
         residual = forces - sp.Matrix(stiffness)
         undeclared = (residual.free_symbols | mass.free_symbols) - set(self.states) \
             - set(self.parameters)

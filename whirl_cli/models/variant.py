@@ -133,7 +133,15 @@ class Model:
         for p in self.parameters:
             for a in p.aliases:
                 table[a] = p.name
+        table.update(self.law_stiffness_aliases())
         return table
+
+    def law_stiffness_aliases(self) -> dict[str, str]:
+        """Aliases of the stiffnesses a law names itself: ``K_out_theta`` -> ``K_theta`` for
+        freeplay on pitch (its ``stiffness_key`` on that dof)."""
+        return {law.parameter_name(law.stiffness_key, dof.name): dof.stiffness
+                for dof, law in zip(self.family.dofs, self.law_objects, strict=True)
+                if law.stiffness_key is not None}
 
     def canonical(self, name: str) -> str:
         """Parameter name for ``name`` or one of its aliases; KeyError if unknown."""
@@ -151,9 +159,38 @@ class Model:
         return self.law_objects[self.family.dof_names.index(dof)]
 
     def coefficient_names(self, dof: str) -> dict[str, str]:
-        """The law on ``dof``: its study keys and the parameters they become (K2 -> K2_theta)."""
+        """The law on ``dof``: its study keys and the parameters they become (K2 -> K2_theta;
+        a law's ``stiffness_key`` becomes the dof's stiffness: freeplay's K_out -> K_theta)."""
         law = self.law_on(dof)
-        return {c.key: law.parameter_name(c.key, dof) for c in law.coefficients}
+        names = {c.key: law.parameter_name(c.key, dof) for c in law.coefficients}
+        if law.stiffness_key is not None:
+            names[law.stiffness_key] = self.family.dof(dof).stiffness
+        return names
+
+    def law_values(self, dof: str, values: dict[str, float]) -> dict[str, float]:
+        """The coefficients of the law on ``dof`` by study key, from parameter values by
+        canonical name (unset ones at their datum)."""
+        full = {**self.defaults(), **values}
+        return {key: full[name] for key, name in self.coefficient_names(dof).items()}
+
+    @property
+    def piecewise_dofs(self) -> tuple[int, ...]:
+        """Indices of the dofs whose law smooths a piecewise one (freeplay): the exact law's
+        pieces switch at breakpoints of these dofs (:meth:`breakpoints`)."""
+        return tuple(i for i, law in enumerate(self.law_objects) if law.exact is not None)
+
+    def breakpoints(self, dof: int, values: dict[str, float]) -> tuple[float, ...]:
+        """Where the pieces of the exact law on the ``dof``-th dof meet, in its unit (for
+        these parameter values by canonical name; unset ones at their datum)."""
+        law = self.law_objects[dof]
+        assert law.breakpoints is not None, f"the {law.name} law has no pieces"
+        return tuple(law.breakpoints(self.law_values(self.family.dof_names[dof], values)))
+
+    @property
+    def piece_names(self) -> tuple[str, ...]:
+        """The extra parameters of the exact-law numeric module: ``piece_<dof>`` per
+        piecewise dof, the index of the piece it is on (0 below its first breakpoint)."""
+        return tuple(f"piece_{self.family.dof_names[i]}" for i in self.piecewise_dofs)
 
     def law_parameter_names(self) -> frozenset[str]:
         """Every law coefficient parameter (set in a study's law blocks, not ``parameters``)."""
@@ -177,9 +214,7 @@ class Model:
         names; unset ones at their datum): the family's own terms are, and every law is K x."""
         if not self.family.linear:
             return False
-        full = {**self.defaults(), **values}
-        return all(law.is_linear({key: full[name] for key, name in
-                                  self.coefficient_names(dof).items()})
+        return all(law.is_linear(self.law_values(dof, values))
                    for dof, law in zip(self.family.dof_names, self.law_objects, strict=True))
 
     # ------------------------------------------------------------------ numbers
@@ -189,6 +224,15 @@ class Model:
         from .numeric import load
 
         return load(self)
+
+    @cached_property
+    def exact_numeric(self):
+        """The numeric functions of the exact piecewise laws (:attr:`piecewise_dofs`), one
+        piece per dof chosen by the trailing parameters :attr:`piece_names`; the other laws
+        as in :attr:`numeric`. For the reference simulation only (not continuable)."""
+        from .numeric import load
+
+        return load(self, exact=True)
 
     def rhs_numpy(self, y: np.ndarray, params: np.ndarray) -> np.ndarray:
         """dy/dt in SI units. ``y``: (n,) or (n, M); ``params``: (P,) or (P, M)."""
@@ -223,6 +267,12 @@ class Model:
             alias = f" (alias {', '.join(p.aliases)})" if p.aliases else ""
             lines.append(f"    {p.name:<10} {p.default:<12.6g} {p.unit:<14} {p.description}{alias}"
                          f"; {p.bounds.text()}")
+        for dof, law in zip(self.family.dof_names, self.law_objects, strict=True):
+            if law.stiffness_key is not None:
+                names = self.coefficient_names(dof)
+                lines.append(f"  {law.name} on {dof}: {law.description}; "
+                             f"{law.stiffness_key} is {names[law.stiffness_key]} (alias "
+                             f"{law.parameter_name(law.stiffness_key, dof)})")
         if self.notes:
             lines.append("  notes: " + self.notes)
         return "\n".join(lines)

@@ -28,8 +28,9 @@ REQUIRED = object()
 class Field:
     """Where a dataclass field ``name`` is stored in its object's group.
 
-    ``stored``: "attribute" or "dataset". ``kind``: "text", "int", "float", "bool" (each
-    element converted on reading) or "array" (read as stored). ``key``: its HDF5 name, if not
+    ``stored``: "attribute" or "dataset". ``kind``: "text", "int", "float", "bool",
+    "optional_float" (None stored as NaN; each element converted on reading) or "array"
+    (read as stored). ``key``: its HDF5 name, if not
     ``name``; ``units``: the ``units`` attribute of its dataset. Either may be a function of
     the object's ``kind`` attribute (periodic branches store Floquet multipliers where
     equilibria store eigenvalues). ``columns``: (names field, units field or None) of the
@@ -76,8 +77,15 @@ def _strings(values) -> np.ndarray:
     return np.array([str(v) for v in values], dtype=object)
 
 
+def _optional(value) -> float | None:
+    """A float stored NaN where the dataclass holds None."""
+    number = float(value)
+    return number if np.isfinite(number) else None
+
+
 _CONVERT: dict[str, Callable[[Any], Any]] = {
-    "text": text, "int": int, "float": float, "bool": bool, "array": lambda v: v}
+    "text": text, "int": int, "float": float, "bool": bool, "array": lambda v: v,
+    "optional_float": _optional}
 _NUMPY = {"int": np.int64, "float": float, "bool": bool}
 
 
@@ -88,6 +96,8 @@ def _encoded(values, kind: str) -> dict:
         return {"data": _strings(array.ravel()).reshape(array.shape), "dtype": _STR}
     if kind in _NUMPY:
         return {"data": np.asarray(values).astype(_NUMPY[kind])}
+    if kind == "optional_float":
+        return {"data": np.array([np.nan if v is None else v for v in values], dtype=float)}
     return {"data": values}
 
 

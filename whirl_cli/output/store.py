@@ -16,13 +16,19 @@ Layout (units in a ``units`` attribute on every physical dataset)::
             floquet_multipliers (N, n) complex (periodic orbits)
             orbits/<label>/ time (K,) [s], states (K, n)  attrs: point_type, index, period,
                                                                 parameters
+            freeplay_<dof>/ amplitude_ratio (N,) A/delta; describing_function/ amplitude_ratio,
+                            stiffness, parameter (M,)  attrs: dof
+            freeplay_<dof>/ (periodic, freeplay law on dof) amplitude_ratio (N,) = A/delta;
+                            describing_function/ amplitude_ratio, stiffness, parameter (M,)
         special_points/             columns: branch, index, point_type, type_name, label,
                                     parameters (K, P), state (K, n), period, stable, status,
                                     criticality, note, bracket (K, 2), residual,
                                     lyapunov (first Lyapunov coefficient of Hopf points)
         cross_checks/               (study `cross_check: true`) columns: branch, index, kind
                                     (orbit | equilibrium), parameter, expected, simulated,
-                                    passed, state (the dof an orbit check compares)
+                                    passed, state (the dof an orbit check compares), exact
+                                    (the exact freeplay law's maximum; NaN where none),
+                                    exact (an orbit's max by the exact piecewise law; NaN)
     /linear/sweeps/<parameter>/     values, eigenvalues [1/s], damping_ratio, frequency [rad/s],
                                     whirl (FW | BW | --)
     /linear/grid/                   x, y, max_real (Ny, Nx) [1/s], oscillatory (Ny, Nx),
@@ -68,6 +74,7 @@ from ..results import (
     BranchKind,
     ContinuationResult,
     CrossCheck,
+    FreeplayAmplitudes,
     LinearGrid,
     LinearSweep,
     Orbit,
@@ -135,6 +142,17 @@ CROSS_CHECK = (
     Field("parameter", kind="float"), Field("expected", kind="float"),
     Field("simulated", kind="float"), Field("passed", kind="bool"),
     Field("state", kind="text", default=""),  # older files: not recorded
+    Field("exact", kind="optional_float", default=None),  # NaN in the file where none
+)
+#: The :class:`FreeplayAmplitudes` of a periodic branch, in ``<branch>/freeplay_<dof>``.
+FREEPLAY = (
+    Field("dof", "attribute", "text"),
+    Field("amplitude_ratio", units="1"),
+    Field("estimate_ratio", key="describing_function/amplitude_ratio", units="1"),
+    Field("estimate_stiffness", key="describing_function/stiffness",
+          unit_field="stiffness_unit"),
+    Field("estimate_parameter", key="describing_function/parameter",
+          unit_field="parameter_unit"),
 )
 #: A :class:`LinearSweep` in ``linear/sweeps/<parameter>``.
 LINEAR_SWEEP = (
@@ -192,6 +210,8 @@ def _write_continuation(group: h5py.Group, continuation: ContinuationResult) -> 
     group.attrs["kind"] = continuation.kind
     for branch in continuation.branches:
         _write_branch(_collection(group, "branches").create_group(branch.name), branch)
+    for found in continuation.freeplay:
+        _write_freeplay(group["branches"][found.branch], found)
     points = continuation.special_points
     first = continuation.branches[0] if continuation.branches else None
     states = {"names": list(first.state_names) if first else [],
@@ -216,7 +236,8 @@ def _cross_check_units(checks, branch: Branch) -> dict[str, dict]:
             for c in checks]
     return {"parameter": {"names": [branch.parameter_names[0]],
                           "units": [branch.parameter_units[0]]},
-            "expected": {"units": rows}, "simulated": {"units": rows}}
+            "expected": {"units": rows}, "simulated": {"units": rows},
+            "exact": {"units": rows}}
 
 
 def _lyapunov_unit(state_units: tuple[str, ...]) -> str:
@@ -225,6 +246,16 @@ def _lyapunov_unit(state_units: tuple[str, ...]) -> str:
     dofs = set(state_units[: len(state_units) // 2])
     unit = dofs.pop() if len(dofs) == 1 else "state_unit"
     return f"1/(s {unit}^2)" if unit != "1" else "1/s"
+
+
+def _write_freeplay(branch: h5py.Group, found: FreeplayAmplitudes) -> None:
+    write_record(branch.create_group(f"freeplay_{found.dof}"), found, FREEPLAY)
+
+
+def _read_freeplay(name: str, branch: h5py.Group) -> list[FreeplayAmplitudes]:
+    """The freeplay groups of the branch group ``name`` (none in files without freeplay)."""
+    return [FreeplayAmplitudes(branch=name, **read_record(branch[key], FREEPLAY))
+            for key in branch if key.startswith("freeplay_")]
 
 
 def _write_boundary(group: h5py.Group, boundary: Boundary) -> None:
@@ -323,12 +354,14 @@ def _read_branch(name: str, group: h5py.Group) -> Branch:
 
 
 def _read_continuation(name: str, group: h5py.Group) -> ContinuationResult:
+    branches = group.get("branches", {})
     return ContinuationResult(
         name, text(group.attrs["kind"]),
-        tuple(_read_branch(b, g) for b, g in group.get("branches", {}).items()),
+        tuple(_read_branch(b, g) for b, g in branches.items()),
         read_table(group["special_points"], SpecialPoint, SPECIAL_POINT),
         read_table(group["cross_checks"], CrossCheck, CROSS_CHECK)
-        if "cross_checks" in group else ())
+        if "cross_checks" in group else (),
+        tuple(f for b, g in branches.items() for f in _read_freeplay(b, g)))
 
 
 def _read_boundary(name: str, group: h5py.Group) -> Boundary:

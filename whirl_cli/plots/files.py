@@ -18,6 +18,7 @@ from ..errors import OutputError, WhirlError
 from ..results import Branch, ContinuationResult, PointType, StudyResult
 from .captions import Captions, captions
 from .diagrams import bifurcation_diagram, period_plot, phase_plane, projections_figure
+from .freeplay import amplitude_diagram, has_amplitudes
 from .key import _PLOTTED_KINDS
 from .linear import linear_sweep_plot
 from .maps import _oriented_grid, boundary_plot, overhang_diagram, slice_continuation
@@ -25,7 +26,8 @@ from .maps import _oriented_grid, boundary_plot, overhang_diagram, slice_continu
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-PLOT_KINDS = ("bifurcation", "linear", "projections", "period", "phase", "boundary")
+PLOT_KINDS = ("bifurcation", "linear", "projections", "period", "phase", "boundary",
+              "amplitude")
 """Kinds accepted by :func:`save_study_plots`."""
 
 PHASE_ORBITS = 12
@@ -59,6 +61,8 @@ def missing_data(result: StudyResult, kind: str) -> str:
     if kind == "boundary" and not result.boundaries and result.linear_grid is None:
         return "no stability boundary (a two-parameter continuation) and no linear grid " \
                "(linear.grid)"
+    if kind == "amplitude" and not any(has_amplitudes(c) for c in result.continuations):
+        return "no freeplay amplitudes (a periodic branch of a model with a freeplay law)"
     return ""
 
 
@@ -86,6 +90,9 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
       dofs: psi vs theta for the classical model; at most :data:`PHASE_ORBITS` orbits, those
       stored at ``orbits_at`` values first, the others spread along the branch);
     * "linear" -> ``<stem>_linear_<parameter>.png`` per linear sweep;
+    * "amplitude" -> ``<stem>_<continuation>_amplitude.png`` per continuation with freeplay
+      amplitudes (:func:`~whirl_cli.plots.freeplay.amplitude_diagram`: A/delta, the
+      describing-function estimate dashed);
     * "boundary" -> per boundary of ``result.boundaries``: ``<stem>_<boundary>_boundary.png``
       (:func:`boundary_plot` with ``result.linear_grid`` if it is over the same parameters, the
       slices as cases) and ``<stem>_<boundary>_slice_<k>_overhang.png`` per slice k
@@ -204,6 +211,11 @@ def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str,
                              s, hz=view.hz, title=caption().title({s.parameter}))))
     if "boundary" in kinds:
         jobs += _boundary_jobs(result, stem, state, caption, view)
+    if "amplitude" in kinds:
+        for continuation in result.continuations:
+            if has_amplitudes(continuation):
+                jobs.append((f"{stem}_{continuation.name}_amplitude.png",
+                             lambda c=continuation: amplitude_diagram(c)))
     return jobs
 
 

@@ -6,7 +6,8 @@ study may use (:class:`~whirl_cli.study.resolve.Names`), law coefficients only u
 of a list naming its dof), a parameter given once, values and ranges inside the physical
 bounds, unique
 continuation names, ``start``, ``slices`` and ``orbits_at`` inside ``range``, ``plot_state`` a
-state of the model.
+state of the model, and what a law requires of its coefficients together (freeplay: epsilon <
+delta, K_out > K_in).
 """
 
 from __future__ import annotations
@@ -46,9 +47,9 @@ def _meaning_problems(data: dict) -> list[Problem]:
         if not isinstance(block, dict):
             continue
         dof = block_dof(block, family, _is_single(data))
-        for key, name in names.model.coefficient_names(dof).items():
-            if key in block:
-                problems += _bound_problems(loc + (key,), name, block[key], names)
+        found = [p for key, name in names.model.coefficient_names(dof).items() if key in block
+                 for p in _bound_problems(loc + (key,), name, block[key], names)]
+        problems += found or _combination_problems(loc, block, dof, names, values)
     items = data.get("continuations")
     problems += _continuation_problems(items, names, family, values)
     linear = data.get("linear")
@@ -89,6 +90,35 @@ def _law_problems(data: dict, family: str) -> list[Problem]:
         else:
             seen[dof] = loc
     return problems
+
+
+def _combination_problems(loc: Loc, block: dict, dof: str, names: Names,
+                          values: dict[str, float]) -> list[Problem]:
+    """What a law says about its coefficient values together (freeplay: epsilon < delta,
+    K_out > K_in), each at the first of its keys the block gives (else at the block)."""
+    law = names.model.law_on(dof)
+    given = {key: values[name] for key, name in names.model.coefficient_names(dof).items()}
+    return [(loc + next(((k,) for k in keys if k in block), ()), reason)
+            for keys, reason in law.problems(given)]
+
+
+def _law_range_problems(loc: Loc, canonical: str, bounds: Any, names: Names,
+                        values: dict[str, float]) -> list[Problem]:
+    """A continuation of a law coefficient (or of a stiffness a law names, freeplay's K_out)
+    whose range reaches values the law refuses together with the others (epsilon >= delta,
+    K_out <= K_in): the first such end."""
+    ends = [_finite(b) for b in bounds] if isinstance(bounds, list) and len(bounds) == 2 else []
+    for dof in names.model.family.dof_names:
+        coefficients = names.model.coefficient_names(dof)
+        if canonical not in coefficients.values():
+            continue
+        law = names.model.law_on(dof)
+        for end in (e for e in ends if e is not None):
+            given = {key: (end if name == canonical else values[name])
+                     for key, name in coefficients.items()}
+            for _, reason in law.problems(given):
+                return [(loc, f"the range reaches {end!r} where {reason}")]
+    return []
 
 
 def _plot_state_problems(state: Any, family: str) -> list[Problem]:
@@ -208,6 +238,8 @@ def _continuation_problems(
             found = _range_problems(loc + ("range",), canonical, item.get("range"), names,
                                     "continued")
             found = found or _start_problems(loc, item, values[canonical])
+            found = found or _law_range_problems(loc + ("range",), canonical,
+                                                 item.get("range"), names, values)
             found += _orbits_problems(loc, item)
         problems += found
     return problems

@@ -1,7 +1,8 @@
 """Model-dependent defaults of a study, filled on the raw data before the schema checks it.
 
 ``nonlinearity`` (one law mapping, or a list of them) gets its ``dof`` where a single law leaves
-it out (the family's first dof); continuations and linear sweeps get canonical parameter names
+it out (the family's first dof) and the defaults a law derives from other values (freeplay's
+``epsilon`` = delta/100); continuations and linear sweeps get canonical parameter names
 (``K1`` -> ``K_theta``), ``start`` (the parameter's study value) and the ``slices`` of a
 two-parameter continuation. :class:`whirl_cli.study.schema.Study` applies them (a
 before-validator) and the meaning checks (:mod:`whirl_cli.study.checks`) read the study values,
@@ -149,6 +150,7 @@ def _study_values(data: dict, names: Names) -> dict[str, float]:
     for _, block in blocks:
         if not isinstance(block, dict):
             continue
+        block = _with_derived_defaults(block)
         dof = block_dof(block, data["model"], _is_single(data))
         if dof not in names.model.family.dof_names:
             continue
@@ -158,12 +160,29 @@ def _study_values(data: dict, names: Names) -> dict[str, float]:
     return values
 
 
+def _with_derived_defaults(block: Any) -> Any:
+    """A raw law block with the defaults its law derives from other values (freeplay's
+    epsilon = delta/100) filled; anything else unchanged."""
+    law = LAWS.get(block.get("type")) if isinstance(block, dict) else None
+    if law is None:
+        return block
+    given = {key: float(value) for key, value in block.items()
+             if isinstance(key, str) and _finite(value) is not None}
+    return {**block, **law.derived_defaults(given)}
+
+
 def _resolved(data: dict) -> dict:
-    """``data`` with dof, canonical parameter names and start values filled where possible."""
+    """``data`` with dof, law defaults, canonical parameter names and start values filled
+    where possible."""
     names = _names_of_data(data)
     if names is None:
         return data
     data = dict(data)
+    laws = data.get("nonlinearity")
+    if isinstance(laws, list | tuple):
+        data["nonlinearity"] = [_with_derived_defaults(b) for b in laws]
+    elif laws is not None:
+        data["nonlinearity"] = _with_derived_defaults(laws)
     block = data.get("nonlinearity", {"type": "linear"})
     first = names.model.family.dofs[0].name
     if isinstance(block, dict) and block.get("dof") is None:

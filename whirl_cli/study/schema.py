@@ -133,9 +133,11 @@ class _Strict(BaseModel):
 
 
 _TYPE_DOC = (
-    "Stiffness law: `linear` (linear springs; the polynomial law with K2 = K3 = 0) or "
+    "Stiffness law: `linear` (linear springs; the polynomial law with K2 = K3 = 0), "
     "`polynomial` (restoring force K x + K2 x^3 + K3 x^5 on `dof`, K the dof's linear "
-    "stiffness, e.g. K_theta; x in the dof's unit, rad for angles)."
+    "stiffness, e.g. K_theta; x in the dof's unit, rad for angles) or `freeplay` (whirl's "
+    "law, models.md 7: a deadband of half-gap `delta`, stiffness `K_in` inside and `K_out` "
+    "outside, smoothed over `epsilon` by ln cosh)."
 )
 _DOF_DOC = (
     "Degree of freedom the law acts on (classical: `theta` pitch, `psi` yaw); a dof has at most "
@@ -161,7 +163,30 @@ class Polynomial(_Strict):
                        "N m/rad^5); leaves the study as `K3_<dof>`.")
 
 
-LawBlock = Annotated[Linear | Polynomial, Field(discriminator="type")]
+class Freeplay(_Strict):
+    """whirl's freeplay law on one degree of freedom (models.md section 7).
+
+    After validation ``epsilon`` is filled (delta/100 when the study gives none); ``K_out``
+    unset leaves the dof's stiffness at its datum."""
+
+    type: Literal["freeplay"] = Field(description=_TYPE_DOC)
+    dof: Text | None = Field(None, description=_DOF_DOC)
+    delta: Number = Field(description="Half-gap of the deadband, in the dof's unit (rad for "
+                          "angles), > 0; leaves the study as `delta_<dof>`.")
+    K_out: Number | None = Field(
+        None, description="Stiffness outside the gap, force per unit (classical: N m/rad), "
+        "> `K_in`: it is the dof's linear stiffness parameter (`K_theta` on pitch; also "
+        "`K_out_<dof>`), so results, continuations and the linear model name it so; "
+        "`parameters` may not set it beside the law. Unset: that parameter's datum.")
+    K_in: Number = Field(0.0, description="Stiffness inside the gap, force per unit, >= 0; "
+                         "leaves the study as `K_in_<dof>`.")
+    epsilon: Number | None = Field(
+        None, description="Smoothing width, in the dof's unit, > 0 and < `delta` (the "
+        "smoothed law's largest error, (K_out - K_in) epsilon ln2 / 2, is at x = +-delta); "
+        "leaves the study as `epsilon_<dof>`. Unset: delta/100.")
+
+
+LawBlock = Annotated[Linear | Polynomial | Freeplay, Field(discriminator="type")]
 
 
 def _as_laws(value: Any) -> Any:
@@ -310,7 +335,8 @@ class TwoParameterContinuation(_Strict):
         return tuple(s.label for s in self.slices)
 
 
-PlotKind = Literal["bifurcation", "linear", "projections", "period", "phase", "boundary"]
+PlotKind = Literal["bifurcation", "linear", "projections", "period", "phase", "boundary",
+                   "amplitude"]
 Continuation = Annotated[OneParameterContinuation | TwoParameterContinuation,
                         Field(discriminator="type")]
 
@@ -454,7 +480,7 @@ class Study(_Strict):
         return self._path
 
     @property
-    def laws(self) -> tuple[Linear | Polynomial, ...]:
+    def laws(self) -> tuple[Linear | Polynomial | Freeplay, ...]:
         """The law blocks (after validation every one names its dof)."""
         return self.nonlinearity
 
@@ -476,5 +502,7 @@ class Study(_Strict):
         values = {names.canonical(k): v for k, v in self.parameters.items()}
         for law in self.laws:
             for key, name in names.model.coefficient_names(law.dof).items():
-                values[name] = float(getattr(law, key, 0.0))
+                value = getattr(law, key, 0.0)
+                if value is not None:  # None: freeplay's K_out unset (the dof's datum)
+                    values[name] = float(value)
         return values

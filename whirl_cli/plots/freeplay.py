@@ -1,0 +1,69 @@
+"""Freeplay figures: periodic branches as A/delta against the continuation parameter, with the
+describing-function estimate dashed (``../shared/models.md`` section 7)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..results import ContinuationResult
+from .key import (
+    PLOT_KEY,
+    _new_figure,
+    _plot_styled,
+    axis_label,
+    branch_style,
+    stability_segments,
+)
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+#: Style of the describing-function estimate (dashed black).
+ESTIMATE_STYLE = {"color": "black", "linestyle": "--", "linewidth": 1.0}
+
+
+def amplitude_diagram(continuation: ContinuationResult) -> Figure:
+    """A/delta (A: half peak-to-peak of the freeplay dof, delta its half-gap) of every periodic
+    branch with freeplay amplitudes (``continuation.freeplay``) against its principal
+    parameter, stable solid blue and unstable dotted red (:data:`PLOT_KEY`), and the
+    describing-function estimate of each branch dashed; a dotted line marks A/delta = 1 (the
+    gap). Without freeplay amplitudes the axes stay empty."""
+    ax = _new_figure().add_subplot()
+    by_name = {b.name: b for b in continuation.branches}
+    first: dict[str, object] = {}
+    estimate = None
+    dofs = []
+    x_label = None
+    for found in continuation.freeplay:
+        branch = by_name.get(found.branch)
+        if branch is None:
+            continue
+        dofs.append(found.dof)
+        x_label = axis_label(branch.parameter_names[0], branch.parameter_units[0])
+        for xs, ys, stable in stability_segments(branch.parameters[:, 0], found.amplitude_ratio,
+                                                 branch.stable, branch.stability_known):
+            _plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)
+        if len(found.estimate_ratio):
+            (estimate,) = ax.plot(found.estimate_parameter, found.estimate_ratio,
+                                  label="_estimate", **ESTIMATE_STYLE)
+    handles = [first[key] for key in PLOT_KEY if key in first]
+    labels = [str(PLOT_KEY[key]["label"]) for key in PLOT_KEY if key in first]
+    if estimate is not None:
+        handles.append(estimate)
+        labels.append("describing function (one harmonic)")
+    if dofs:
+        ax.axhline(1.0, color="grey", linestyle=":", linewidth=0.8)
+        ax.set_xlabel(x_label)
+        ax.set_ylabel(axis_label(f"A/delta of {', '.join(sorted(set(dofs)))}", "1"))
+        ax.set_ylim(bottom=0.0)
+    if handles:
+        ax.legend(handles, labels, fontsize="small")
+    ax.set_title(f"{continuation.name}: amplitude in half-gaps")
+    return ax.figure
+
+
+def has_amplitudes(continuation: ContinuationResult) -> bool:
+    """True if the continuation has freeplay amplitudes to draw."""
+    return any(np.size(f.amplitude_ratio) for f in continuation.freeplay)
