@@ -12,13 +12,20 @@ from pathlib import Path
 
 import numpy as np
 
-from .analysis import boundaries, freeplay, linear, simulate
+from .analysis import boundaries, freeplay, linear, seeds, simulate
 from .auto.runner import RunOutcome, interruptible
 from .continuation.engine import Engine, Numerics
 from .continuation.loci import two_parameter
 from .continuation.one_parameter import one_parameter
+from .continuation.periodic import OrbitStart
 from .output.provenance import provenance
-from .results import Boundary, ContinuationResult, ParameterValue, StudyResult
+from .results import (
+    Boundary,
+    ContinuationResult,
+    ParameterValue,
+    SeedOutcome,
+    StudyResult,
+)
 from .study import Study
 
 
@@ -52,10 +59,12 @@ def _run_study(study: Study, workroot: Path, jobs: int,
             continuations.append(continuation)
             found_boundaries.append(boundary)
             continue
+        starts, outcomes = seeded_orbits(model, parameters, spec)
         continuation = one_parameter(
             engine, spec.name, spec.parameter, spec.start, tuple(spec.range), parameters,
             numerics, branch_points=spec.branch_points, periodic=spec.periodic,
-            orbits_at=spec.orbits_at)
+            orbits_at=spec.orbits_at, start_orbits=starts)
+        continuation = replace(continuation, seeds=outcomes)
         if freeplay.freeplay_dofs(model):  # amplitudes / delta, describing function
             continuation = replace(continuation, freeplay=freeplay.freeplay_amplitudes(
                 model, parameters, continuation, tuple(spec.range)))
@@ -78,6 +87,32 @@ def _run_study(study: Study, workroot: Path, jobs: int,
         linear_sweeps=tuple(sweeps), runs=engine.records() if engine else (),
         attributes=provenance(study), boundaries=tuple(found_boundaries), linear_grid=grid,
         parameters=resolved_parameters(model, parameters))
+
+
+def seeded_orbits(model, overrides: dict[str, float], spec
+                  ) -> tuple[tuple[OrbitStart, ...], tuple[SeedOutcome, ...]]:
+    """The continuation's ``seeds`` simulated at its start value: one orbit start per distinct
+    limit cycle they settle on, and what became of every seed (issue 15, item 3)."""
+    if not spec.seeds:
+        return (), ()
+    values = {**overrides, spec.parameter: float(spec.start)}
+    params = model.parameter_vector(values)
+    if spec.seeds == "auto":
+        initial = seeds.auto_seeds(model, values)
+    else:
+        initial = [seeds.seed_state(model, given) for given in spec.seeds]
+    settled = [seeds.settle(model, params, y0) for y0 in initial]
+    kept = seeds.distinct(settled)
+    families = {k: f"periodic_o{n}" for n, k in enumerate(kept, 1)}
+    starts = tuple(OrbitStart(replace(settled[k].orbit, parameters=np.array([spec.start])),
+                              float(spec.start), f"seed {k + 1} settled by time simulation")
+                   for k in kept)
+    outcomes = tuple(
+        SeedOutcome(k + 1, s.seed, s.kind, s.orbit.period if s.orbit else float("nan"),
+                    families.get(k) or families.get(seeds.same_as(settled, k, kept), ""),
+                    s.message)
+        for k, s in enumerate(settled))
+    return starts, outcomes
 
 
 def resolved_parameters(model, overrides: dict[str, float]) -> tuple[ParameterValue, ...]:

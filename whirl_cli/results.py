@@ -334,10 +334,26 @@ class FreeplayAmplitudes:
 
 
 @dataclass(frozen=True)
+class SeedOutcome:
+    """What became of one seed of a continuation (``whirl_cli.analysis.seeds``): ``seed``
+    (n,) the initial state (SI), ``kind`` what it settled on (periodic | equilibrium |
+    diverged | unsettled), ``period`` (s, periodic only, else NaN) and ``branch`` the
+    family continued from it (``periodic_o<k>``; a seed that settled on an orbit another seed
+    found names that family; "" for the others); ``message``: what the simulation saw."""
+
+    index: int
+    seed: np.ndarray
+    kind: str
+    period: float
+    branch: str
+    message: str
+
+
+@dataclass(frozen=True)
 class ContinuationResult:
     """Everything one continuation of a study produced. ``freeplay``: its periodic branches
     in the units of each freeplay law, with the describing-function estimate (one-parameter
-    continuations of models with freeplay)."""
+    continuations of models with freeplay). ``seeds``: what its seeds settled on."""
 
     name: str
     kind: str  # "one-parameter" | "two-parameter"
@@ -345,6 +361,7 @@ class ContinuationResult:
     special_points: tuple[SpecialPoint, ...]
     cross_checks: tuple[CrossCheck, ...] = ()
     freeplay: tuple[FreeplayAmplitudes, ...] = ()
+    seeds: tuple[SeedOutcome, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -24,6 +24,7 @@ STRUCTURAL = {
     results.UnsafeInterval: set(),
     results.RunRecord: {"name"},
     results.FreeplayAmplitudes: {"branch"},
+    results.SeedOutcome: set(),
 }
 DECLARATIONS = {
     results.Branch: store.BRANCH, results.Orbit: store.ORBIT,
@@ -31,6 +32,7 @@ DECLARATIONS = {
     results.LinearSweep: store.LINEAR_SWEEP, results.LinearGrid: store.LINEAR_GRID,
     results.Boundary: store.BOUNDARY, results.UnsafeInterval: store.UNSAFE_INTERVAL,
     results.RunRecord: store.RUN, results.FreeplayAmplitudes: store.FREEPLAY,
+    results.SeedOutcome: store.SEED,
 }
 
 
@@ -79,7 +81,11 @@ def synthetic_result() -> results.StudyResult:
             "c", "one-parameter", (branch("b_equilibrium", results.BranchKind.EQUILIBRIUM, 4),
                                    branch("b_periodic", results.BranchKind.PERIODIC, 3),
                                    branch("failed", results.BranchKind.PERIODIC, 0)), (point,),
-            (results.CrossCheck("b_periodic", 1, "orbit", 0.5, 1.0, 1.001, True, "q1"),)),
+            (results.CrossCheck("b_periodic", 1, "orbit", 0.5, 1.0, 1.001, True, "q1"),),
+            seeds=(results.SeedOutcome(1, np.array([0.1, 0.0]), "periodic", 0.2, "b_periodic",
+                                       "settled"),
+                   results.SeedOutcome(2, np.array([0.0, 0.2]), "equilibrium", float("nan"),
+                                       "", "at rest"))),
                    results.ContinuationResult("empty", "one-parameter", (), ())),
         (results.LinearSweep("V", "m/s", np.arange(3.0), np.ones((3, 2)) * 1j,
                              np.zeros((3, 2)), np.ones((3, 2)),

@@ -24,6 +24,8 @@ Layout (units in a ``units`` attribute on every physical dataset)::
                                     parameters (K, P), state (K, n), period, stable, status,
                                     criticality, note, bracket (K, 2), residual,
                                     lyapunov (first Lyapunov coefficient of Hopf points)
+        seeds/                      (continuation `seeds`) columns: index, seed (K, n), kind,
+                                    period, branch, message
         cross_checks/               (study `cross_check: true`) columns: branch, index, kind
                                     (orbit | equilibrium), parameter, expected, simulated,
                                     passed, state (the dof an orbit check compares), exact
@@ -80,6 +82,7 @@ from ..results import (
     Orbit,
     ParameterValue,
     RunRecord,
+    SeedOutcome,
     SpecialPoint,
     StudyResult,
     UnsafeInterval,
@@ -143,6 +146,12 @@ CROSS_CHECK = (
     Field("simulated", kind="float"), Field("passed", kind="bool"),
     Field("state", kind="text", default=""),  # older files: not recorded
     Field("exact", kind="optional_float", default=None),  # NaN in the file where none
+)
+#: The :class:`SeedOutcome` table of a continuation (``seeds/``).
+SEED = (
+    Field("index", kind="int"), Field("seed", width="states"), Field("kind", kind="text"),
+    Field("period", kind="float", units="s"), Field("branch", kind="text"),
+    Field("message", kind="text"),
 )
 #: The :class:`FreeplayAmplitudes` of a periodic branch, in ``<branch>/freeplay_<dof>``.
 FREEPLAY = (
@@ -222,6 +231,9 @@ def _write_continuation(group: h5py.Group, continuation: ContinuationResult) -> 
         "state": states,
         "bracket": {"units": first.parameter_units[0] if first else ""},
         "lyapunov": {"units": _lyapunov_unit(first.state_units) if first else ""}})
+    if continuation.seeds:
+        write_table(group.create_group("seeds"), continuation.seeds, SEED,
+                    {"states": len(first.state_names) if first else 0}, {"seed": states})
     if continuation.cross_checks and first is not None:
         write_table(group.create_group("cross_checks"), continuation.cross_checks,
                     CROSS_CHECK, attributes=_cross_check_units(continuation.cross_checks, first))
@@ -361,7 +373,8 @@ def _read_continuation(name: str, group: h5py.Group) -> ContinuationResult:
         read_table(group["special_points"], SpecialPoint, SPECIAL_POINT),
         read_table(group["cross_checks"], CrossCheck, CROSS_CHECK)
         if "cross_checks" in group else (),
-        tuple(f for b, g in branches.items() for f in _read_freeplay(b, g)))
+        tuple(f for b, g in branches.items() for f in _read_freeplay(b, g)),
+        read_table(group["seeds"], SeedOutcome, SEED) if "seeds" in group else ())
 
 
 def _read_boundary(name: str, group: h5py.Group) -> Boundary:

@@ -5,9 +5,9 @@ study may use (:class:`~whirl_cli.study.resolve.Names`), law coefficients only u
 ``nonlinearity``, each law on a dof of the model and each dof with at most one law (every law
 of a list naming its dof), a parameter given once, values and ranges inside the physical
 bounds, unique
-continuation names, ``start``, ``slices`` and ``orbits_at`` inside ``range``, ``plot_state`` a
-state of the model, and what a law requires of its coefficients together (freeplay: epsilon <
-delta, K_out > K_in).
+continuation names, ``start``, ``slices`` and ``orbits_at`` inside ``range``, ``plot_state`` and
+seed keys states of the model, and what a law requires of its coefficients together
+(freeplay: epsilon < delta, K_out > K_in).
 """
 
 from __future__ import annotations
@@ -241,8 +241,20 @@ def _continuation_problems(
             found = found or _law_range_problems(loc + ("range",), canonical,
                                                  item.get("range"), names, values)
             found += _orbits_problems(loc, item)
+            found += _seed_problems(loc, item.get("seeds"), family)
         problems += found
     return problems
+
+
+def _seed_problems(loc: Loc, seeds: Any, family: str) -> list[Problem]:
+    """Seeds naming states the model lacks."""
+    dofs = FAMILIES[family].dofs
+    states = [d.name for d in dofs] + [d.rate for d in dofs]
+    if not isinstance(seeds, list):
+        return []
+    return [(loc + ("seeds", k, name), _choice_reason(states, repr(name)))
+            for k, seed in enumerate(seeds) if isinstance(seed, dict)
+            for name in seed if isinstance(name, str) and name not in states]
 
 
 def _orbits_problems(loc: Loc, item: dict) -> list[Problem]:

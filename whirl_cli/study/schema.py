@@ -90,6 +90,18 @@ def _as_range(value: Any) -> tuple[float, float]:
     return lower, upper
 
 
+def _as_seeds(value: Any) -> str | tuple[dict[str, float], ...]:
+    """``auto``, or a list of mappings state name -> finite number."""
+    if value == "auto":
+        return value
+    if not isinstance(value, list) or not all(
+            isinstance(seed, dict) and all(isinstance(k, str) and _finite(v) is not None
+                                           for k, v in seed.items()) for seed in value):
+        _fail("expected `auto` or a list of mappings state -> number, e.g. [{{theta: 4}}], "
+              "got {got}")
+    return tuple({k: float(v) for k, v in seed.items()} for seed in value)
+
+
 def _at_most_orbits(values: tuple) -> tuple:
     if len(values) > ORBITS_MAX:
         _fail(f"at most {ORBITS_MAX} values, got {len(values)}")
@@ -235,6 +247,14 @@ class OneParameterContinuation(_Strict):
         (),
         description="Parameter values (in its unit) at which every branch stores a labelled "
         "solution: orbit profiles for phase-plane plots (AUTO UZR).",
+    )
+    seeds: Annotated[Any, BeforeValidator(_as_seeds)] = Field(
+        (),
+        description="Initial states simulated at `start` until they settle; every distinct "
+        "limit cycle found is continued both ways (cycles no Hopf point leads to). A list of "
+        "mappings state name -> value (angles in deg, rates in deg/s, other states in their "
+        "unit; unnamed states 0), or `auto`: each nonlinear dof displaced alone by 2, 4 and 8 "
+        "times its law's size (freeplay: delta) or 0.05, 0.2 and 0.5 typical amplitudes.",
     )
 
     def start_value(self, study: Study) -> float:
