@@ -79,3 +79,16 @@ def test_generate_check_detects_drift(tmp_path):
     repaired = CliRunner().invoke(cli, ["generate", "--dir", str(copy)])
     assert repaired.exit_code == 0 and "wrote" in repaired.output
     assert CliRunner().invoke(cli, ["generate", "--check", "--dir", str(copy)]).exit_code == 0
+
+
+def test_every_shipped_study_validates_and_its_variant_is_committed():
+    """auto_equations/ holds the variants the shipped studies use (SHIPPED), and every study
+    under studies/ is valid."""
+    from whirl_cli.models import SHIPPED
+    from whirl_cli.study import load_study
+
+    shipped = {get_model(family, laws).name for family, laws in SHIPPED}
+    studies = sorted((ROOT / "studies").rglob("*.yaml"))
+    assert len(studies) >= 30
+    used = {load_study(path).variant().name for path in studies}
+    assert used <= shipped, used - shipped

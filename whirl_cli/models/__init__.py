@@ -31,7 +31,11 @@ __all__ = ["Bounds", "Dof", "Family", "Model", "Parameter", "State", "FAMILIES",
 FAMILIES: dict[str, Family] = {f.name: f for f in (classical.FAMILY, oscillators.FAMILY)}
 
 #: The variants the shipped studies use: (family, law per dof).
-SHIPPED: tuple[tuple[str, tuple[str, ...]], ...] = (("classical", ("polynomial", "polynomial")),)
+SHIPPED: tuple[tuple[str, tuple[str, ...]], ...] = (
+    ("classical", ("polynomial", "polynomial")),
+    ("classical", ("freeplay", "polynomial")),  # studies/freeplay
+    ("classical", ("polynomial", "freeplay")),
+)
 
 
 @cache
