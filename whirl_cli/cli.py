@@ -267,8 +267,10 @@ def _limits(ctx: click.Context, param: click.Parameter, value):
 @click.option("--ylim", nargs=2, type=float, callback=_limits, metavar="LOW HIGH",
               help="y-axis limits of every figure, in the units shown (degrees for angles).")
 @click.option("--hz", is_flag=True, help="Frequencies in Hz instead of rad/s (linear sweeps).")
+@click.option("--artefacts", is_flag=True,
+              help="Also draw special points flagged as smoothing artefacts (freeplay).")
 def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None,
-         state: str | None, xlim, ylim, hz: bool) -> None:
+         state: str | None, xlim, ylim, hz: bool, artefacts: bool) -> None:
     """Draw the plots of a whirl result file."""
     from .output import store
     from .plots.files import View, available_kinds, missing_data, save_study_plots
@@ -294,7 +296,7 @@ def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None,
     except OSError as error:
         raise OutputError(f"{output_dir}: cannot create the output directory "
                           f"({error.strerror or error})") from None
-    view = View(xlim=xlim, ylim=ylim, hz=hz)
+    view = View(xlim=xlim, ylim=ylim, hz=hz, artefacts=artefacts)
     for path in save_study_plots(result, kinds, output_dir, result_file.stem, state,
                                  view=view):
         click.echo(f"wrote {path}")

@@ -14,6 +14,7 @@ import numpy as np
 
 from .analysis import boundaries, freeplay, linear, seeds, simulate
 from .auto.runner import RunOutcome, interruptible
+from .continuation import persistence
 from .continuation.engine import Engine, Numerics
 from .continuation.loci import two_parameter
 from .continuation.one_parameter import one_parameter
@@ -60,11 +61,20 @@ def _run_study(study: Study, workroot: Path, jobs: int,
             found_boundaries.append(boundary)
             continue
         starts, outcomes = seeded_orbits(model, parameters, spec)
-        continuation = one_parameter(
-            engine, spec.name, spec.parameter, spec.start, tuple(spec.range), parameters,
-            numerics, branch_points=spec.branch_points, periodic=spec.periodic,
-            orbits_at=spec.orbits_at, start_orbits=starts)
-        continuation = replace(continuation, seeds=outcomes)
+
+        def continued(name: str, values: dict[str, float], spec=spec, starts=starts):
+            return one_parameter(
+                engine, name, spec.parameter, spec.start, tuple(spec.range), values,
+                numerics, branch_points=spec.branch_points, periodic=spec.periodic,
+                orbits_at=spec.orbits_at, start_orbits=starts)
+
+        continuation = replace(continued(spec.name, parameters), seeds=outcomes)
+        if model.smoothing_parameters:  # special points must persist as the smoothing shrinks
+            refined = [continued(f"{spec.name}_eps{k}", persistence.refined_parameters(
+                parameters, model.smoothing_parameters, factor))
+                for k, factor in enumerate(persistence.FACTORS, 1)]
+            continuation = persistence.annotate(continuation, refined,
+                                                spec.range[1] - spec.range[0])
         if freeplay.freeplay_dofs(model):  # amplitudes / delta, describing function
             continuation = replace(continuation, freeplay=freeplay.freeplay_amplitudes(
                 model, parameters, continuation, tuple(spec.range)))

@@ -194,6 +194,10 @@ class SpecialPoint:
     residual: float = float("nan")  # relative rms fit residual (bracketed global points)
     lyapunov: float = float("nan")  # first Lyapunov coefficient (Hopf points of equilibria)
     parameter_units: tuple[str, ...] = ()  # of parameter_names; () in schema-1 files
+    #: the principal parameter recomputed with every smoothing width halved and quartered
+    #: (laws that smooth a piecewise one, e.g. freeplay; NaN: not recomputed or not found)
+    refined: np.ndarray = field(default_factory=lambda: np.full(2, np.nan))
+    artefact: bool = False  # does not persist as the smoothing shrinks (see ``note``)
 
     @property
     def type_name(self) -> str:

@@ -91,3 +91,51 @@ def test_bad_seeds_are_refused():
         text = STUDY.replace("seeds: auto", f"seeds: {bad}")
         with pytest.raises(StudyError, match=reason):
             validate_text(text)
+
+
+@cache
+def coarse():
+    """The same study with a deliberately coarse smoothing, epsilon = delta/10."""
+    study = validate_text(STUDY.replace("K_out: 0.4}", f"K_out: 0.4, epsilon: {DELTA / 10!r}}}"))
+    return study, run_study(study, Path(tempfile.mkdtemp(prefix="whirl-test-")))
+
+
+def lowest_fold(result):
+    folds = [p for p in result.continuations[0].special_points if p.type_name == "LPC"]
+    return min(folds, key=lambda p: p.parameters[0])
+
+
+def marker_points(result, artefacts: bool) -> int:
+    """Special-point markers the bifurcation diagram draws (counted on the figure)."""
+    from whirl_cli.plots.files import View, _named_jobs
+
+    (_, make), = _named_jobs(result, ("bifurcation",), "x", None, View(artefacts=artefacts))
+    figure = make()
+    return sum(len(line.get_xdata()) for ax in figure.axes for line in ax.get_lines()
+               if line.get_linestyle() in ("None", "", " ") and line.get_marker() not in
+               (None, "None", ""))
+
+
+def test_special_points_are_recomputed_as_the_smoothing_shrinks():
+    """Issue 15, item 4: every special point is found again at epsilon/2 and epsilon/4; the
+    lowest fold of cycles (where LCOs start) persists, to 2e-3 of the range, at both the
+    study's epsilon = delta/100 and a coarse delta/10, and there moves towards one value."""
+    for _, result in (computed(), coarse()):
+        fold = lowest_fold(result)
+        assert not fold.artefact, fold.note
+        assert np.all(np.abs(fold.refined - fold.parameters[0]) < 2e-3 * 3.0)
+    assert abs(lowest_fold(coarse()[1]).refined[-1] - lowest_fold(computed()[1]).parameters[0]) \
+        < 1e-3
+
+
+def test_a_coarse_smoothing_yields_artefacts_that_are_flagged_and_hidden():
+    """At epsilon = delta/10 the smoothed corners create special points (near 7.95 m/s) that
+    vanish or wander as epsilon shrinks: flagged, said in the note, hidden from the diagrams
+    unless asked for."""
+    _, result = coarse()
+    points = result.continuations[0].special_points
+    flagged = [p for p in points if p.artefact]
+    assert flagged and all("smoothing artefact" in p.note for p in flagged)
+    assert all(np.isnan(p.refined).any() or np.nanmax(np.abs(np.diff(np.concatenate(
+        [p.parameters[:1], p.refined])))) > 2e-3 * 3.0 for p in flagged)
+    assert marker_points(result, artefacts=True) > marker_points(result, artefacts=False)

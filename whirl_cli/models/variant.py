@@ -187,6 +187,14 @@ class Model:
         return tuple(law.breakpoints(self.law_values(self.family.dof_names[dof], values)))
 
     @property
+    def smoothing_parameters(self) -> tuple[str, ...]:
+        """The parameters that set how much a law smooths a piecewise one (freeplay's
+        ``epsilon_<dof>``; the exact law returns as they go to 0)."""
+        return tuple(law.parameter_name(law.smoothing_key, dof)
+                     for dof, law in zip(self.family.dof_names, self.law_objects, strict=True)
+                     if law.smoothing_key is not None)
+
+    @property
     def piece_names(self) -> tuple[str, ...]:
         """The extra parameters of the exact-law numeric module: ``piece_<dof>`` per
         piecewise dof, the index of the piece it is on (0 below its first breakpoint)."""

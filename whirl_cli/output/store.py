@@ -23,7 +23,8 @@ Layout (units in a ``units`` attribute on every physical dataset)::
         special_points/             columns: branch, index, point_type, type_name, label,
                                     parameters (K, P), state (K, n), period, stable, status,
                                     criticality, note, bracket (K, 2), residual,
-                                    lyapunov (first Lyapunov coefficient of Hopf points)
+                                    lyapunov (first Lyapunov coefficient of Hopf points),
+                                    refined (K, 2), artefact (persistence as epsilon shrinks)
         seeds/                      (continuation `seeds`) columns: index, seed (K, n), kind,
                                     period, branch, message
         cross_checks/               (study `cross_check: true`) columns: branch, index, kind
@@ -133,6 +134,8 @@ SPECIAL_POINT = (
     Field("bracket", width=2),  # units: the principal parameter's
     Field("residual", kind="float", units="1"),
     Field("lyapunov", kind="float", default=float("nan")),  # units: see _lyapunov_unit
+    Field("refined", width=2, default=lambda: np.full(2, np.nan)),  # units: the bracket's
+    Field("artefact", kind="bool", default=False),
 )
 #: The resolved :class:`ParameterValue` table of a study (``parameters/``; schema 2).
 PARAMETER = (
@@ -230,6 +233,7 @@ def _write_continuation(group: h5py.Group, continuation: ContinuationResult) -> 
         "states": len(first.state_names) if first else 0}, {
         "state": states,
         "bracket": {"units": first.parameter_units[0] if first else ""},
+        "refined": {"units": first.parameter_units[0] if first else ""},
         "lyapunov": {"units": _lyapunov_unit(first.state_units) if first else ""}})
     if continuation.seeds:
         write_table(group.create_group("seeds"), continuation.seeds, SEED,

@@ -115,7 +115,8 @@ def _row(continuation: ContinuationResult, point: SpecialPoint, branch: Branch |
                                               strict=False))
     return SummaryRow(continuation.name, point.branch, type_name(point.point_type), parameters,
                       _amplitudes(point, reference, dofs), float(point.period),
-                      _stability(point, branch), point.criticality, point.status)
+                      _stability(point, branch), point.criticality,
+                      point.status + (" (smoothing artefact)" if point.artefact else ""))
 
 
 def _parameter_unit(name: str, branch: Branch | None, branches: Sequence[Branch]) -> str:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import io
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cache
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -38,11 +38,13 @@ PHASE_ORBITS = 12
 class View:
     """How the figures of :func:`save_study_plots` are drawn beyond their data: axis limits
     (in the units shown, applied to every axes of every figure; None: from the data) and
-    frequencies in Hz instead of rad/s (linear sweeps)."""
+    frequencies in Hz instead of rad/s (linear sweeps); ``artefacts``: draw the special points
+    flagged as smoothing artefacts too (hidden by default)."""
 
     xlim: tuple[float, float] | None = None
     ylim: tuple[float, float] | None = None
     hz: bool = False
+    artefacts: bool = False
 
 
 def missing_data(result: StudyResult, kind: str) -> str:
@@ -158,6 +160,13 @@ def _viewed(figure: Figure, view: View) -> Figure:
     return figure
 
 
+def _without_artefacts(result: StudyResult) -> StudyResult:
+    """``result`` without the special points flagged as smoothing artefacts."""
+    return replace(result, continuations=tuple(
+        replace(c, special_points=tuple(p for p in c.special_points if not p.artefact))
+        for c in result.continuations))
+
+
 def _named_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: str | None,
                 view: View = View()):
     """(unique filesystem-safe file name, figure factory) pairs of the requested kinds."""
@@ -177,6 +186,8 @@ def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str,
                  state: str | None, view: View = View()):
     """(file name, figure factory) pairs for the requested kinds, in a stable order."""
     caption = cache(lambda: captions(result))  # read the stored study once, when drawing
+    if not view.artefacts:
+        result = _without_artefacts(result)
     jobs = []
     if "bifurcation" in kinds:
         for continuation in result.continuations:

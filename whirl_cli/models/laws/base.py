@@ -57,6 +57,8 @@ class Law:
     increasing dof values where its pieces meet, and ``exact(x, k, c, piece)``, the restoring
     force on piece ``piece`` (a symbol taking 0 .. len(breakpoints), piece j lying between
     breakpoints j - 1 and j), smooth on each piece. ``exact`` None: the law is exact as it is.
+    ``smoothing_key``: the coefficient that sets the smoothing (the exact law returns as it
+    goes to 0; freeplay's epsilon), for the persistence check of special points.
     """
 
     name: str
@@ -70,6 +72,7 @@ class Law:
     derived_defaults: Callable[[Mapping[str, float]], dict[str, float]] = _no_defaults
     exact: Callable[..., object] | None = None
     breakpoints: Callable[[Mapping[str, float]], tuple[float, ...]] | None = None
+    smoothing_key: str | None = None
 
     def parameter_name(self, key: str, dof: str) -> str:
         """The model parameter a study's ``key`` of a law on ``dof`` becomes: K2 -> K2_theta."""

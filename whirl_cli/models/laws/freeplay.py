@@ -141,4 +141,5 @@ FREEPLAY = Law(
     derived_defaults=_derived_defaults,
     exact=_exact,
     breakpoints=_breakpoints,
+    smoothing_key="epsilon",
 )
