@@ -96,7 +96,7 @@ def test_names_and_variants(model):
     """Parameters are named by what they are: the dofs' stiffnesses K_theta, K_psi and the
     law coefficients by dof; one program serves laws on either dof (zeros where unused)."""
     assert model.name == "classical_poly"
-    assert [v.name for v in all_variants()] == ["classical_poly"]
+    assert [v.name for v in all_variants()] == ["classical_poly", "gimballed_poly"]
     assert {"K_theta", "K_psi", "K2_theta", "K3_theta", "K2_psi", "K3_psi"} <= set(
         model.parameter_names)
     assert model.parameter("K2_psi").unit == "N m/rad^3"

@@ -114,6 +114,23 @@ class Model:
                 matrix[row, index] = factor
         return matrix
 
+    @cached_property
+    def mode_groups(self) -> tuple[tuple[str, tuple[int, ...], np.ndarray], ...]:
+        """(name, dof indices, path matrix (2, n)) per mode group of the family (one group
+        ``all`` unless it declares more): a mode belongs to the group holding most of its
+        energy, and its whirl sense is that of the group's path (path_matrix @ state)."""
+        import numpy as np
+
+        groups = []
+        for group in self.family.groups:
+            matrix = np.zeros((2, self.n_states))
+            for row, terms in enumerate(group.path):
+                for index, factor in terms:
+                    matrix[row, index] = factor
+            groups.append((group.name, tuple(self.family.dof_names.index(d) for d in group.dofs),
+                           matrix))
+        return tuple(groups)
+
     # ------------------------------------------------------------------ names and lookup
     @property
     def n_states(self) -> int:
@@ -203,6 +220,10 @@ class Model:
         """(d2f/dy2, d3f/dy3) at one point, shapes (n, n, n) and (n, n, n, n), SI units:
         entry [i, j, k(, m)] is the derivative of dy_i/dt by y_j, y_k (and y_m)."""
         return self.numeric.tensors(y, params)
+
+    def mass_numpy(self, params: np.ndarray) -> np.ndarray:
+        """The mass matrix M(p), (n_dof, n_dof), or (M, n_dof, n_dof) for params (P, M)."""
+        return self.numeric.mass_matrix(params)
 
     def field_at(self, params: np.ndarray):
         """(f, J): dy/dt (SI) and its Jacobian as fast functions of the state alone, for fixed
