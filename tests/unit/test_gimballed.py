@@ -223,6 +223,13 @@ def test_declared_as_provisional_with_units_and_bounds():
     assert "provisional" in (GIMBALLED.family.description + GIMBALLED.notes).lower()
     import whirl_cli.models.gimballed as module
     assert "PROVISIONAL" in module.__doc__
+    from click.testing import CliRunner
+
+    from whirl_cli.cli import cli
+    listed = CliRunner().invoke(cli, ["models"]).output
+    block = listed[listed.index("gimballed_poly:"):]
+    assert "[provisional: whirl's own derivation]" in block.splitlines()[0]
+    assert "mode groups: nacelle (theta, psi), gimbal (beta_y, beta_z)" in block
 
 
 BAD = """\

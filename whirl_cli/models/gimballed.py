@@ -128,8 +128,8 @@ def equations(q: dict, v: dict, p: dict):
 
 FAMILY = Family(
     name="gimballed",
-    description="gimballed-hub rotor-nacelle, classical nacelle + rotor on a gimbal "
-                "(provisional: whirl's derivation, models.md section 8)",
+    description="gimballed-hub rotor-nacelle: the classical nacelle with its rotor on a gimbal "
+                "(models.md section 8)",
     dofs=DOFS,
     parameters=PARAMETERS,
     equations=equations,

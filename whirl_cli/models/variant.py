@@ -244,6 +244,11 @@ class Model:
             alias = f" (alias {', '.join(p.aliases)})" if p.aliases else ""
             lines.append(f"    {p.name:<10} {p.default:<12.6g} {p.unit:<14} {p.description}{alias}"
                          f"; {p.bounds.text()}")
+        if self.family.mode_groups:
+            lines.append("  mode groups: " + ", ".join(
+                f"{g.name} ({', '.join(g.dofs)})" for g in self.family.mode_groups))
+        for constraint in self.family.constraints:
+            lines.append(f"  constraint: {constraint.reason}")
         if self.notes:
             lines.append("  notes: " + self.notes)
         return "\n".join(lines)
