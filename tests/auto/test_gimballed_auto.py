@@ -161,11 +161,14 @@ def test_combined_files_plots_of_a_gimbal_state_and_compare(combined, tmp_path):
 
 # ------------------------------------------------------------------------------ onset study
 def test_onset_study_hopf_locus_against_eigenvalues(tmp_path):
-    """studies/gimballed/linear_onset_kbeta.yaml: every 5th point of the Hopf locus in
-    (V, K_beta) by AUTO is where the eigenvalues give the onset at that K_beta (1e-5 of V's
-    range); the locus spans soft to stiff gimbals; the K_beta sweep stores mode groups."""
-    study = load_study(GIMBALLED_STUDIES / "linear_onset_kbeta.yaml")
-    result = run_study(study, tmp_path, jobs=2)
+    """studies/gimballed/linear_onset_kbeta.yaml through ``whirl sweep``: every 5th point of
+    the Hopf locus in (V, K_beta) by AUTO is where the eigenvalues give the onset at that
+    K_beta (1e-5 of V's range); the locus spans soft to stiff gimbals; the K_beta sweep
+    stores mode groups."""
+    done = CliRunner().invoke(cli, ["sweep", str(GIMBALLED_STUDIES / "linear_onset_kbeta.yaml"),
+                                    "-o", str(tmp_path), "--jobs", "1"])
+    assert done.exit_code == 0, done.output
+    result = store.read(tmp_path / "gimballed-linear-onset-kbeta.h5")
     (boundary,) = result.boundaries
     curves = [curve for kind, curve in boundary.loci.values() if kind == "hopf"]
     assert curves
