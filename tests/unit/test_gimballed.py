@@ -281,3 +281,13 @@ def test_a_law_on_an_unknown_dof_is_refused(tmp_path):
     assert _problems(tmp_path, text) == [
         "bad.yaml:3: nonlinearity.dof: expected one of theta, psi, beta_y, beta_z, got "
         "'beta_x'"]
+
+
+def test_linear_plot_names_each_mode_by_group_and_whirl():
+    """The linear-sweep figure's legend: "<group> <whirl>" for a model with mode groups."""
+    from whirl_cli.plots.linear import linear_sweep_plot
+
+    sweep = linear.sweep(GIMBALLED, {}, "K_beta", np.linspace(2.0, 50.0, 25))
+    figure = linear_sweep_plot(sweep)
+    labels = {line.get_label() for line in figure.axes[0].get_lines()}
+    assert labels == {"nacelle BW", "nacelle FW", "gimbal BW", "gimbal FW"}
