@@ -34,8 +34,10 @@ GIMBALLED_STUDIES = ROOT / "studies" / "gimballed"
 MODEL = get_model("gimballed")
 
 
-def k1_study(model: str, extra: str = "") -> str:
-    """Linear springs, K_psi = 0.3, K_theta from 0.5 down to -0.3, equilibria only.
+def k1_study(model: str, extra: str = "", law: str = "{type: linear}",
+             periodic: bool = False) -> str:
+    """K_psi = 0.3, K_theta from 0.5 down to -0.3 (linear springs and equilibria only unless
+    ``law`` and ``periodic`` say otherwise).
 
     The step is capped at 0.003 of the range: with K_beta = 1e6 the Jacobian's entries reach
     ~1e7 in AUTO's units while its trace stays ~1, so AUTO takes the system for conservative
@@ -45,11 +47,11 @@ def k1_study(model: str, extra: str = "") -> str:
 name: k1-{model}
 model: {model}
 parameters: {{K_psi: 0.3{extra}}}
-nonlinearity: {{type: linear}}
+nonlinearity: {law}
 auto: {{step_max: 0.003}}
 continuations:
   - {{name: k1, type: one-parameter, parameter: K_theta, start: 0.5, range: [-0.3, 0.5],
-      periodic: false, branch_points: true}}
+      periodic: {str(periodic).lower()}, branch_points: true}}
 """
 
 
@@ -68,6 +70,27 @@ def test_stiff_gimbal_hopf_and_branch_points_are_the_classical(tmp_path):
     for kind in (PointType.HB, PointType.BP):
         found, expected = points(rigid, kind), points(reference, kind)
         assert len(found) == len(expected) == (2 if kind == PointType.HB else 1)
+        np.testing.assert_allclose(found, expected, rtol=1e-3)
+
+
+def test_stiff_gimbal_combined_law_folds_of_cycles_are_the_classical(tmp_path):
+    """K_beta = 1e6 with the combined pitch law (K2 = -10, K3 = 350) at K_psi = 0.3: the Hopf
+    points of every equilibrium branch and the folds of cycles of the periodic families equal
+    the classical model's (combined case 2, same AUTO settings; 1e-3 relative)."""
+    law = "{type: polynomial, dof: theta, K2: -10.0, K3: 350.0}"
+    rigid = run_study(validate_text(k1_study("gimballed", ", K_beta: 1.0e+6", law, True)),
+                      tmp_path / "rigid", jobs=2)
+    reference = run_study(validate_text(k1_study("classical", "", law, True)),
+                          tmp_path / "classical", jobs=2)
+
+    def located(result, kind):
+        (continuation,) = result.continuations
+        return sorted(float(p.parameters[0]) for p in continuation.special_points
+                      if p.point_type == kind)
+
+    for kind in (PointType.HB, PointType.LPC):
+        found, expected = located(rigid, kind), located(reference, kind)
+        assert len(found) == len(expected) >= (3 if kind == PointType.LPC else 6)
         np.testing.assert_allclose(found, expected, rtol=1e-3)
 
 
