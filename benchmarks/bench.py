@@ -28,8 +28,11 @@
     Because the basin between the unstable and stable cycle is thin near the fold, a bracket
     is first found by marching up from the seed in steps of 0.005 (short runs, the upper end
     confirmed with the full ``D``), then bisected to ``--fold-tol``.
+(g) the 8-state gimballed model: code generation (numeric module and Fortran) and compilation
+    of ``gimballed_poly`` in a cold cache (target: under 60 s), then ``whirl run`` of every
+    study in studies/gimballed (target: under 20 s each).
 
-Run: ``.venv/bin/python benchmarks/bench.py [--only abcdef] [--exclude GLOB] [--fold-tol 1e-5]
+Run: ``.venv/bin/python benchmarks/bench.py [--only abcdefg] [--exclude GLOB] [--fold-tol 1e-5]
 [--fold-periods 3000]``. With all 26 chapter-3 studies it takes about 35 minutes on two cores,
 most of it in the two-parameter ``boundary_*`` studies (``--exclude 'boundary_*.yaml'`` leaves
 them out); other load on the machine shows in the numbers (the load average is printed).
@@ -415,9 +418,39 @@ def fold_figures(scratch: Path, tol: float, periods: int) -> None:
 
 
 # ------------------------------------------------------------------------------ main
+def gimballed_figures(scratch: Path, env: dict[str, str]) -> None:
+    """(g): cold-cache codegen + compile of the 8-state variant, then its studies."""
+    from whirl_cli.auto import toolchain
+    from whirl_cli.auto.codegen import fortran_source
+    from whirl_cli.models import get_model
+    from whirl_cli.models.numeric import numeric_source
+
+    heading("(g) gimballed model (8 states)")
+    model = get_model("gimballed")
+    cold = scratch / "gimballed-cache"
+    previous = os.environ.get("WHIRL_CACHE_DIR")
+    os.environ["WHIRL_CACHE_DIR"] = str(cold)
+    try:
+        started = time.perf_counter()
+        numeric_source(model)
+        generated = time.perf_counter()
+        toolchain.compile_equations(fortran_source(model), model.name)
+        done = time.perf_counter()
+    finally:
+        if previous is not None:
+            os.environ["WHIRL_CACHE_DIR"] = previous
+    print(f"  {model.name}: numeric module {generated - started:.2f} s, Fortran + compile "
+          f"{done - generated:.2f} s, total {done - started:.2f} s (target < 60 s)", flush=True)
+    for path in sorted((ROOT / "studies" / "gimballed").glob("*.yaml")):
+        timed = run(WHIRL + ["run", str(path), "-o", str(scratch / f"{path.stem}.h5"),
+                             "--overwrite"], env)
+        print(f"  whirl run {path.stem:<24} {timed.seconds:6.2f} s  exit {timed.returncode}"
+              f"{'' if timed.seconds < 20 else '  (over 20 s)'}", flush=True)
+
+
 def main(argv: Sequence[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--only", default="abcdef",
+    parser.add_argument("--only", default="abcdefg",
                         help="letters of the figures to produce, e.g. 'ad' [default: all]")
     parser.add_argument("--fold-tol", type=float, default=1e-5,
                         help="bracket width at which the bisection of (f) stops [N m/rad]")
@@ -448,6 +481,8 @@ def main(argv: Sequence[str] | None = None) -> None:
             per_case(studies, scratch, env)
         if "f" in only:
             fold_figures(scratch, options.fold_tol, options.fold_periods)
+        if "g" in only:
+            gimballed_figures(scratch, env)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
     print(f"\nload average at the end: {load()}")

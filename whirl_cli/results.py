@@ -210,7 +210,8 @@ class LinearSweep:
 
     ``eigenvalues``: (M, n) complex [1/s]; ``damping_ratio``: (M, n) [-]; ``frequency``: (M, n)
     [rad/s]; ``whirl``: (M, n) str, "FW", "BW" or "--" for real eigenvalues. Modes are ordered by
-    frequency per point.
+    frequency per point. ``mode_group``: (M, n) str, the model's mode group holding most of
+    each mode's energy (e.g. "nacelle", "gimbal"); None for a model with one group.
     """
 
     parameter: str
@@ -220,6 +221,7 @@ class LinearSweep:
     damping_ratio: np.ndarray
     frequency: np.ndarray
     whirl: np.ndarray
+    mode_group: np.ndarray | None = None
 
 
 @dataclass(frozen=True)

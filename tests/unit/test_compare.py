@@ -236,6 +236,23 @@ def test_linear_sweeps_compare_elementwise():
     assert difference.path == "/linear/sweeps/V/whirl[3, 0]"
 
 
+def test_mode_groups_compare_when_stored():
+    """Mode groups (models with several, e.g. gimballed) compare element by element; stored
+    in one file and not the other is a difference; absent in both (one group) agrees."""
+    base = make_result()
+    sweep = base.linear_sweeps[0]
+    groups = np.array([["nacelle", "gimbal"]] * 11, dtype=object)
+    grouped = replace(base, linear_sweeps=(replace(sweep, mode_group=groups),))
+    assert compare_results(grouped, grouped) == []
+    other = groups.copy()
+    other[5, 1] = "nacelle"
+    (difference,) = compare_results(grouped, replace(base, linear_sweeps=(replace(
+        sweep, mode_group=other),)))
+    assert difference.path == "/linear/sweeps/V/mode_group[5, 1]"
+    (difference,) = compare_results(base, grouped)
+    assert difference.path == "/linear/sweeps/V/mode_group"
+
+
 def test_run_status_is_compared_but_not_wall_time():
     base = make_result()
     slower = replace(base, runs=(replace(base.runs[0], wall_seconds=5.0, n_points=7),))

@@ -98,7 +98,8 @@ def test_names_and_variants(model):
     assert model.name == "classical_poly"
     # the shipped variants: polynomial laws, and those of the freeplay studies
     assert [v.name for v in all_variants()] == [
-        "classical_poly", "classical_fp_theta_poly_psi", "classical_poly_theta_fp_psi"]
+        "classical_poly", "classical_fp_theta_poly_psi", "classical_poly_theta_fp_psi",
+        "gimballed_poly"]
     assert {"K_theta", "K_psi", "K2_theta", "K3_theta", "K2_psi", "K3_psi"} <= set(
         model.parameter_names)
     assert model.parameter("K2_psi").unit == "N m/rad^3"

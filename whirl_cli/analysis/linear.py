@@ -5,8 +5,15 @@ Everything is vectorised over points: Jacobians are stacked into an (M, n, n) ar
 
 Conventions: eigenvalues lambda = sigma + i omega in 1/s (physical time). Damping ratio
 zeta = -sigma / |lambda| (positive = damped), frequency omega = |Im lambda| in rad/s. Modes are
-ordered per point by frequency, then by real part. Whirl direction is read from the eigenvector:
-the hub path in the plane normal to the spin axis (+x) turns with the spin (FW) or against it (BW).
+ordered per point by frequency, then by real part.
+
+Mode identification is generic, from what the model declares (``Model.mode_groups``): a mode
+belongs to the group of dofs (e.g. nacelle or gimbal) holding most of its energy, the share of
+dof i being Re(conj(q_i) (M q)_i) / (q^H M q) for the displacement part q of the eigenvector
+(the kinetic-energy split, |lambda|^2 (q^H M q) / 2 in total; defined for lambda = 0 too).
+Whirl direction is read from the eigenvector: the path of the mode's group (for a nacelle the
+hub, for a disc its tilt) in the plane normal to the spin axis (+x) turns with the spin (FW) or
+against it (BW).
 """
 
 from __future__ import annotations
@@ -56,28 +63,59 @@ def jacobians(model: Model, params: np.ndarray, equilibrium: np.ndarray | None =
     return np.broadcast_to(jac, (params.shape[1], model.n_states, model.n_states))
 
 
-def whirl_direction(model: Model, eigenvalues: np.ndarray, eigenvectors: np.ndarray
-                    ) -> np.ndarray:
-    """"FW"/"BW"/"--" per eigenvalue: sense of the hub path relative to the spin (+x).
+def energy_shares(model: Model, params: np.ndarray, eigenvectors: np.ndarray) -> np.ndarray:
+    """(M, n_dof, n): each dof's share of each mode's energy (see the module doc; the shares
+    of a mode sum to 1). ``params`` (P, M), ``eigenvectors`` (M, n, n) with modes as columns."""
+    n_dof = model.n_states // 2
+    q = eigenvectors[..., :n_dof, :]
+    mass = np.broadcast_to(model.mass_numpy(params), (len(eigenvectors), n_dof, n_dof))
+    split = np.real(np.conj(q) * np.einsum("mij,mjk->mik", mass, q))
+    total = split.sum(axis=-2, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(total > 0, split / total, 1.0 / n_dof)
 
-    For a mode y = Re(v e^{i omega t}), the hub components Y, Z (``model.hub_matrix`` @ v)
-    trace a path that turns about +x (with the spin, FW) when Im(conj(Y) Z) * omega < 0.
+
+def mode_groups(model: Model, params: np.ndarray, eigenvectors: np.ndarray) -> np.ndarray:
+    """(M, n) index into ``model.mode_groups`` of the group holding most of each mode's
+    energy (0 everywhere for a model with one group)."""
+    groups = model.mode_groups
+    if len(groups) == 1:
+        return np.zeros(eigenvectors.shape[::2], dtype=int)
+    shares = energy_shares(model, params, eigenvectors)
+    per_group = np.stack([shares[:, list(dofs), :].sum(axis=1) for _, dofs, _ in groups],
+                         axis=1)
+    return np.argmax(per_group, axis=1)
+
+
+def whirl_direction(model: Model, eigenvalues: np.ndarray, eigenvectors: np.ndarray,
+                    groups: np.ndarray | None = None) -> np.ndarray:
+    """"FW"/"BW"/"--" per eigenvalue: sense of the mode's group path relative to the spin (+x).
+
+    For a mode y = Re(v e^{i omega t}), the path components Y, Z (the group's path matrix @ v;
+    ``groups`` (M, n) their indices into ``model.mode_groups``, default the first group) trace
+    a curve that turns about +x (with the spin, FW) when Im(conj(Y) Z) * omega < 0.
     """
-    hub = np.einsum("hi,...ik->...hk", model.hub_matrix, eigenvectors)
-    hub_y, hub_z = hub[..., 0, :], hub[..., 1, :]
-    sense = np.imag(np.conj(hub_y) * hub_z) * np.sign(eigenvalues.imag)
+    groups = np.zeros(eigenvalues.shape, dtype=int) if groups is None else groups
+    sense = np.zeros(eigenvalues.shape)
+    for k, (_, _, path) in enumerate(model.mode_groups):
+        hub = np.einsum("hi,...ik->...hk", path, eigenvectors)
+        hub_y, hub_z = hub[..., 0, :], hub[..., 1, :]
+        sense = np.where(groups == k, np.imag(np.conj(hub_y) * hub_z), sense)
+    sense = sense * np.sign(eigenvalues.imag)
     oscillatory = np.abs(eigenvalues.imag) > 1e-9 * np.maximum(np.abs(eigenvalues), 1.0)
     return np.where(~oscillatory, NON_OSCILLATORY, np.where(sense < 0, FORWARD, BACKWARD))
 
 
 def analyse(model: Model, params: np.ndarray, equilibrium: np.ndarray | None = None
-            ) -> tuple[np.ndarray, np.ndarray]:
-    """Eigenvalues (M, n) sorted per point (by |omega|, then sigma) and their whirl labels."""
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Eigenvalues (M, n) sorted per point (by |omega|, then sigma), their whirl labels and
+    their mode groups (indices into ``model.mode_groups``)."""
     eigenvalues, eigenvectors = np.linalg.eig(jacobians(model, params, equilibrium))
     order = np.lexsort((eigenvalues.real, -eigenvalues.imag, np.abs(eigenvalues.imag)), axis=-1)
     eigenvalues = np.take_along_axis(eigenvalues, order, axis=-1)
     eigenvectors = np.take_along_axis(eigenvectors, order[:, None, :], axis=-1)
-    return eigenvalues, whirl_direction(model, eigenvalues, eigenvectors)
+    groups = mode_groups(model, params, eigenvectors)
+    return eigenvalues, whirl_direction(model, eigenvalues, eigenvectors, groups), groups
 
 
 def sweep(model: Model, overrides: dict[str, float], parameter: str, values: np.ndarray,
@@ -85,13 +123,15 @@ def sweep(model: Model, overrides: dict[str, float], parameter: str, values: np.
     """Linear analysis at every value of ``parameter`` (others at datum + ``overrides``)."""
     values = np.asarray(values, dtype=float)
     params = parameter_matrix(model, overrides, parameter, values)
-    eigenvalues, whirl = analyse(model, params, equilibrium)
+    eigenvalues, whirl, groups = analyse(model, params, equilibrium)
     modulus = np.abs(eigenvalues)
     with np.errstate(invalid="ignore", divide="ignore"):
         damping = np.where(modulus > 0, -eigenvalues.real / modulus, 0.0)
     name = model.canonical(parameter)
+    names = np.array([g[0] for g in model.mode_groups], dtype=object)
     return LinearSweep(name, model.parameter(name).unit, values, eigenvalues, damping,
-                       np.abs(eigenvalues.imag), whirl)
+                       np.abs(eigenvalues.imag), whirl,
+                       names[groups] if len(names) > 1 else None)
 
 
 def _oscillatory_growth(model: Model, params: np.ndarray) -> np.ndarray:

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..auto import runner, toolchain
 from ..auto.codegen import fortran_source, source_key
-from ..auto.parse import read_branch
+from ..auto.parse import parse_s, read_branch
 from ..interrupts import thread_map
 from ..models import Model
 from ..results import Branch, PointType, RunRecord, SpecialPoint
@@ -110,6 +110,11 @@ class Engine:
         wrote the solution labelled ``label``."""
         for name in reversed(runs.split("+")):  # the latest run of a chain of restarts
             if any(found == label for _, found in self.outcomes[name].labels):
+                return name
+        for name in reversed(runs.split("+")):  # a regular (NPR) point: no type on stdout
+            outcome = self.outcomes[name]
+            if outcome.has_output and any(solution.lab == label for solution in parse_s(
+                    outcome.file("s").read_text(errors="replace"))):
                 return name
         raise KeyError(f"label {label} not found in runs {runs}")
 

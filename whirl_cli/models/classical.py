@@ -70,9 +70,10 @@ NOTES = (
 )
 
 
-def aerodynamic_coefficients(p: dict):
-    """(k_d, k_c, c_a): direct and cross aerodynamic stiffness [N m/rad], damping [N m s/rad],
-    as sympy expressions of the parameter symbols ``p`` (by name)."""
+def aerodynamic_integrals(p: dict):
+    """(Q, mu, A_1, A_2, A_3): the moment scale Q [N m], the regularised advance ratio mu and
+    the radial integrals (models.md 2.2; A'_1 = mu A_1, A'_2 = mu A_2), as sympy expressions
+    of the parameter symbols ``p`` (by name)."""
     import sympy as sp
 
     V, Omega, R, c = p["V"], p["Omega"], p["R"], p["c"]
@@ -83,6 +84,14 @@ def aerodynamic_coefficients(p: dict):
     a2 = (c / R) * (mu / 2) * (root - mu**2 * ash)
     a3 = (c / R) * ((2 - 3 * mu**2) * root + 3 * mu**4 * ash) / 8
     q = p["N"] * p["rho"] * p["C_l_alpha"] * R**5 * Omega**2 / 4
+    return q, mu, a1, a2, a3
+
+
+def aerodynamic_coefficients(p: dict):
+    """(k_d, k_c, c_a): direct and cross aerodynamic stiffness [N m/rad], damping [N m s/rad],
+    as sympy expressions of the parameter symbols ``p`` (by name)."""
+    q, mu, a1, a2, a3 = aerodynamic_integrals(p)
+    Omega = p["Omega"]
     k_d = q * p["a"] * mu * a1
     k_c = q * mu * a2
     c_a = q * (a3 + p["a"] ** 2 * a1) / Omega

@@ -122,6 +122,36 @@ class Dof:
         return f"{self.unit}/s"
 
 
+#: A combination of first-order states giving one component of a path: ((state index,
+#: factor), ...).
+Combination = tuple[tuple[int, float], ...]
+
+
+@dataclass(frozen=True)
+class ModeGroup:
+    """Dofs whose modes are told apart from the other groups' by their eigenvector energy
+    (e.g. nacelle vs gimbal), and the path in the plane normal to the spin axis (+x) whose
+    sense tells forward from backward whirl for this group's modes: components (y, z), each a
+    :data:`Combination` of the first-order states (for a nacelle the hub, for a disc its tilt).
+    """
+
+    name: str
+    dofs: tuple[str, ...]
+    path: tuple[Combination, Combination]
+
+
+@dataclass(frozen=True)
+class Constraint:
+    """A physical condition on several parameters at once (e.g. I_y - I_d > 0): ``holds``
+    takes the values by name (SI units). A study whose values break it is refused, with
+    ``reason`` (e.g. "the nacelle-only inertia I_n = I_y - I_d must be > 0") reported at
+    the first of ``names`` the study sets."""
+
+    names: tuple[str, ...]
+    holds: Callable[[dict], bool] = field(repr=False, compare=False)
+    reason: str = ""
+
+
 #: The equations of a family: given a symbol for every dof (``q[name]``), rate (``v[name]``)
 #: and parameter (``p[name]``), return (M, G): the mass matrix (n x n, parameters only) and
 #: the generalised forces other than the structural stiffness (n x 1), as sympy matrices in
@@ -136,7 +166,10 @@ class Family:
     ``time_scale``: a reference frequency in rad/s (AUTO's time is tau = time_scale * t).
     ``hub``: the hub displacement normal to the spin axis (+x), components (y, z), each a
     combination ((state index, factor), ...) of the first-order states: it tells forward from
-    backward whirl. ``symmetric``: the equations are invariant under y -> -y (equilibria and
+    backward whirl. ``mode_groups``: the dofs by mode group with each group's whirl path
+    (default: one group, all dofs, the hub path). ``constraints``: conditions on several
+    parameters at once (each parameter's own range is its ``bounds``). ``symmetric``: the
+    equations are invariant under y -> -y (equilibria and
     secondary branches come in +/- pairs). ``linear``: apart from the stiffness laws, the
     equations are linear in the states (so a study without nonlinear law coefficients is a
     linear system). ``provisional``: whirl's own derivation, not yet checked against the
@@ -149,7 +182,9 @@ class Family:
     parameters: tuple[Parameter, ...]
     equations: Equations = field(repr=False, compare=False)
     time_scale: float = 1.0
-    hub: tuple[tuple[tuple[int, float], ...], tuple[tuple[int, float], ...]] = ((), ())
+    hub: tuple[Combination, Combination] = ((), ())
+    mode_groups: tuple[ModeGroup, ...] = ()
+    constraints: tuple[Constraint, ...] = ()
     symmetric: bool = True
     linear: bool = True
     provisional: bool = False
@@ -175,6 +210,19 @@ class Family:
         for p in self.parameters:
             if len(p.name) > AUTO_NAME_LENGTH:
                 raise ValueError(f"model {self.name}: parameter name {p.name!r} too long")
+        grouped = [d for g in self.mode_groups for d in g.dofs]
+        if self.mode_groups and sorted(grouped) != sorted(self.dof_names):
+            raise ValueError(f"model {self.name}: mode groups must hold every dof once, got "
+                             f"{grouped}")
+        datum = {p.name: p.default for p in self.parameters}
+        for c in self.constraints:
+            if not set(c.names) <= set(datum) or not c.holds(datum):
+                raise ValueError(f"model {self.name}: constraint on {c.names} fails at datum")
+
+    @property
+    def groups(self) -> tuple[ModeGroup, ...]:
+        """The declared mode groups, or one group ``all`` of every dof with the hub path."""
+        return self.mode_groups or (ModeGroup("all", self.dof_names, self.hub),)
 
     @property
     def dof_names(self) -> tuple[str, ...]:

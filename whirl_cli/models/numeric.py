@@ -229,6 +229,10 @@ class Numeric:
         self.diagonal = bool(module["DIAGONAL_MASS"])
         self.tensor_index = np.asarray(module["TENSOR_INDEX"], dtype=int)
 
+    def mass_matrix(self, params) -> np.ndarray:
+        """M with the points first: (..., n_dof, n_dof)."""
+        return self._mass(params)
+
     def _mass(self, params) -> np.ndarray:
         """M with the points first: (..., n_dof, n_dof)."""
         entries = _stack(self.mass(tuple(params)), axis=-1)

@@ -114,6 +114,23 @@ class Model:
                 matrix[row, index] = factor
         return matrix
 
+    @cached_property
+    def mode_groups(self) -> tuple[tuple[str, tuple[int, ...], np.ndarray], ...]:
+        """(name, dof indices, path matrix (2, n)) per mode group of the family (one group
+        ``all`` unless it declares more): a mode belongs to the group holding most of its
+        energy, and its whirl sense is that of the group's path (path_matrix @ state)."""
+        import numpy as np
+
+        groups = []
+        for group in self.family.groups:
+            matrix = np.zeros((2, self.n_states))
+            for row, terms in enumerate(group.path):
+                for index, factor in terms:
+                    matrix[row, index] = factor
+            groups.append((group.name, tuple(self.family.dof_names.index(d) for d in group.dofs),
+                           matrix))
+        return tuple(groups)
+
     # ------------------------------------------------------------------ names and lookup
     @property
     def n_states(self) -> int:
@@ -256,6 +273,10 @@ class Model:
         entry [i, j, k(, m)] is the derivative of dy_i/dt by y_j, y_k (and y_m)."""
         return self.numeric.tensors(y, params)
 
+    def mass_numpy(self, params: np.ndarray) -> np.ndarray:
+        """The mass matrix M(p), (n_dof, n_dof), or (M, n_dof, n_dof) for params (P, M)."""
+        return self.numeric.mass_matrix(params)
+
     def field_at(self, params: np.ndarray):
         """(f, J): dy/dt (SI) and its Jacobian as fast functions of the state alone, for fixed
         parameter values (for time integration)."""
@@ -281,6 +302,11 @@ class Model:
                 lines.append(f"  {law.name} on {dof}: {law.description}; "
                              f"{law.stiffness_key} is {names[law.stiffness_key]} (alias "
                              f"{law.parameter_name(law.stiffness_key, dof)})")
+        if self.family.mode_groups:
+            lines.append("  mode groups: " + ", ".join(
+                f"{g.name} ({', '.join(g.dofs)})" for g in self.family.mode_groups))
+        for constraint in self.family.constraints:
+            lines.append(f"  constraint: {constraint.reason}")
         if self.notes:
             lines.append("  notes: " + self.notes)
         return "\n".join(lines)

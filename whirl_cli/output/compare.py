@@ -581,15 +581,25 @@ def compare_linear_sweep(a: LinearSweep, b: LinearSweep, rtol: float) -> list[Di
     for key in ("values", "eigenvalues", "damping_ratio", "frequency"):
         x, y = np.asarray(getattr(a, key)), np.asarray(getattr(b, key))
         found += _compare_arrays(f"{path}/{key}", x, y, rtol)
-    if a.whirl.shape != b.whirl.shape or (a.whirl != b.whirl).any():
-        bad = np.argwhere(a.whirl != b.whirl) if a.whirl.shape == b.whirl.shape else [[0]]
-        at = tuple(int(i) for i in bad[0])
-        found.append(Difference(f"{path}/whirl{list(at)}",
-                                str(a.whirl[at]) if a.whirl.shape == b.whirl.shape else
-                                str(a.whirl.shape), str(b.whirl[at]) if a.whirl.shape ==
-                                b.whirl.shape else str(b.whirl.shape),
-                                f"{len(bad)} element(s) differ"))
+    found += _compare_labels(f"{path}/whirl", a.whirl, b.whirl)
+    if (a.mode_group is None) != (b.mode_group is None):
+        found.append(Difference(f"{path}/mode_group", "absent" if a.mode_group is None else
+                                "stored", "absent" if b.mode_group is None else "stored"))
+    elif a.mode_group is not None:
+        found += _compare_labels(f"{path}/mode_group", a.mode_group, b.mode_group)
     return found
+
+
+def _compare_labels(path: str, a: np.ndarray, b: np.ndarray) -> list[Difference]:
+    """Text arrays (whirl directions, mode groups) equal element by element."""
+    a, b = np.asarray(a), np.asarray(b)
+    if a.shape == b.shape and not (a != b).any():
+        return []
+    bad = np.argwhere(a != b) if a.shape == b.shape else [[0]]
+    at = tuple(int(i) for i in bad[0])
+    same = a.shape == b.shape
+    return [Difference(f"{path}{list(at)}", str(a[at]) if same else str(a.shape),
+                       str(b[at]) if same else str(b.shape), f"{len(bad)} element(s) differ")]
 
 
 def _compare_arrays(path: str, x: np.ndarray, y: np.ndarray, rtol: float) -> list[Difference]:

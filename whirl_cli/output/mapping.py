@@ -38,7 +38,8 @@ class Field:
     them; ``unit_field``: the object's field holding the dataset's ``units`` attribute.
     ``width``: columns of a table's 2-D column (an int, or the name of a context value), so
     that an empty table keeps its shape. ``default``: the value where an older file lacks the
-    field (a function of nothing, or a value). ``derived``: written from the object's
+    field (a function of nothing, or a value); a dataset with default None is optional: not
+written when the object's value is None. ``derived``: written from the object's
     attribute of that name, never read (e.g. a point type's name beside its code).
     """
 
@@ -139,6 +140,8 @@ def write_record(group: h5py.Group, obj, fields: Sequence[Field]) -> None:
     for field in fields:
         if field.stored == "dataset":
             value = getattr(obj, field.name)
+            if value is None and field.default is None:
+                continue  # an optional dataset, absent (read back as None)
             dataset = group.create_dataset(field.hdf5_key(kind), **_encoded(value, field.kind))
             _attach(dataset, field, obj, kind)
 

@@ -171,7 +171,7 @@ LINEAR_SWEEP = (
     Field("parameter", "attribute", "text"),
     Field("values", unit_field="unit"), Field("eigenvalues", units="1/s"),
     Field("damping_ratio", units="1"), Field("frequency", units="rad/s"),
-    Field("whirl", kind="text"),
+    Field("whirl", kind="text"), Field("mode_group", kind="text", default=None),
 )
 #: A :class:`LinearGrid` in ``linear/grid`` (its contour lines: collections of their own).
 LINEAR_GRID = (

@@ -22,7 +22,8 @@ def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = 
 
     One line per column of ``sweep.eigenvalues``, drawn only where Im(lambda) > 0 so each
     conjugate pair appears once (real eigenvalues are not drawn). Lines are labelled with their
-    whirl direction ("BW"/"FW", numbered if repeated); the damping panel has a zero line.
+    whirl direction ("BW"/"FW", after the mode group for models with several: "nacelle BW";
+    numbered if repeated); the damping panel has a zero line.
     Title: ``title`` (None: ``"linear analysis vs <parameter>"``).
     """
     figure = _new_figure(figsize=(6.4, 6.4))
@@ -45,14 +46,18 @@ def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = 
 
 
 def _mode_labels(sweep: LinearSweep) -> list[tuple[int, str]]:
-    """(column, label) of the columns with Im(lambda) > 0 somewhere; label = majority whirl."""
+    """(column, label) of the columns with Im(lambda) > 0 somewhere; label = majority whirl
+    (with its mode group first, "gimbal FW", for a model with several groups)."""
     modes = []
     for column in range(sweep.eigenvalues.shape[1]):
         upper = sweep.eigenvalues[:, column].imag > 0
         if not upper.any():
             continue
-        names, counts = np.unique(np.asarray(sweep.whirl)[upper, column].astype(str),
-                                  return_counts=True)
+        labels = np.asarray(sweep.whirl)[upper, column].astype(str)
+        if sweep.mode_group is not None:
+            labels = np.char.add(np.char.add(
+                np.asarray(sweep.mode_group)[upper, column].astype(str), " "), labels)
+        names, counts = np.unique(labels, return_counts=True)
         modes.append((column, str(names[np.argmax(counts)])))
     totals = {label: sum(1 for _, other in modes if other == label) for _, label in modes}
     seen: dict[str, int] = {}

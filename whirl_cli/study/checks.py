@@ -4,10 +4,11 @@ They add to the structural problems (malformed parts are left to those): paramet
 study may use (:class:`~whirl_cli.study.resolve.Names`), law coefficients only under
 ``nonlinearity``, each law on a dof of the model and each dof with at most one law (every law
 of a list naming its dof), a parameter given once, values and ranges inside the physical
-bounds, unique
-continuation names, ``start``, ``slices`` and ``orbits_at`` inside ``range``, ``plot_state`` and
-seed keys states of the model, and what a law requires of its coefficients together
-(freeplay: epsilon < delta, K_out > K_in).
+bounds, the family's constraints on several parameters at once (e.g. I_d < I_y, for the
+study's values and at each end of a range), unique continuation names, ``start``,
+``slices`` and ``orbits_at`` inside ``range``, ``plot_state`` and seed keys states of the
+model, and what a law requires of its coefficients together (freeplay: epsilon < delta,
+K_out > K_in).
 """
 
 from __future__ import annotations
@@ -42,6 +43,7 @@ def _meaning_problems(data: dict) -> list[Problem]:
         return []
     values = _study_values(data, names)
     problems = _override_problems(data.get("parameters"), names, family)
+    problems += _constraint_problems(data.get("parameters"), names, family, values)
     problems += _plot_state_problems(data.get("plot_state"), family)
     for loc, block in law_blocks(data):
         if not isinstance(block, dict):
@@ -55,12 +57,12 @@ def _meaning_problems(data: dict) -> list[Problem]:
     linear = data.get("linear")
     sweeps = linear.get("sweeps") if isinstance(linear, dict) else None
     for i, sweep in _dict_items(sweeps):
-        problems += _sweep_problems(("linear", "sweeps", i), sweep, names, family)
+        problems += _sweep_problems(("linear", "sweeps", i), sweep, names, family, values)
     grid = linear.get("grid") if isinstance(linear, dict) else None
     for axis in ("x", "y"):
         spec = grid.get(axis) if isinstance(grid, dict) else None
         if isinstance(spec, dict):
-            problems += _sweep_problems(("linear", "grid", axis), spec, names, family)
+            problems += _sweep_problems(("linear", "grid", axis), spec, names, family, values)
     return problems
 
 
@@ -130,14 +132,17 @@ def _plot_state_problems(state: Any, family: str) -> list[Problem]:
     return [(("plot_state",), _choice_reason(states, repr(state)))]
 
 
-def _sweep_problems(loc: Loc, spec: dict, names: Names, family: str) -> list[Problem]:
+def _sweep_problems(loc: Loc, spec: dict, names: Names, family: str,
+                    values: dict[str, float]) -> list[Problem]:
     """The parameter and range of a linear sweep or grid axis."""
     name = spec.get("parameter")
     found = _parameter_problems(loc + ("parameter",), name, names, family)
     if found or not isinstance(name, str):
         return found
-    return _range_problems(loc + ("range",), names.canonical(name), spec.get("range"),
-                           names, "swept")
+    canonical = names.canonical(name)
+    return _range_problems(loc + ("range",), canonical, spec.get("range"), names, "swept") \
+        or _range_constraint_problems(loc + ("range",), canonical, spec.get("range"), family,
+                                      values)
 
 
 def _dict_items(items: Any) -> Iterator[tuple[int, dict]]:
@@ -169,6 +174,40 @@ def _override_problems(parameters: Any, names: Names, family: str) -> list[Probl
             found = found or _bound_problems(loc, canonical, value, names)
         problems += found
     return problems
+
+
+def _broken(family: str, values: dict[str, float]) -> list:
+    """The family's constraints that ``values`` (canonical name -> SI value) break."""
+    return [c for c in FAMILIES[family].constraints if not c.holds(values)]
+
+
+def _constraint_problems(parameters: Any, names: Names, family: str,
+                         values: dict[str, float]) -> list[Problem]:
+    """Constraints the study's values break, reported at the first of their parameters the
+    study sets under ``parameters`` (at ``parameters`` if it sets none of them)."""
+    given = {names.canonical(k): k for k in parameters if isinstance(k, str)
+             and k in names.known_parameter_names()} if isinstance(parameters, dict) else {}
+    problems: list[Problem] = []
+    for constraint in _broken(family, values):
+        keys = [given[n] for n in constraint.names if n in given]
+        loc = ("parameters", keys[0]) if keys else ("parameters",)
+        shown = ", ".join(f"{n} = {values[n]:g}" for n in constraint.names)
+        problems.append((loc, f"{constraint.reason}, got {shown}"))
+    return problems
+
+
+def _range_constraint_problems(loc: Loc, canonical: str, bounds: Any, family: str,
+                               values: dict[str, float]) -> list[Problem]:
+    """A range end of ``canonical`` at which a constraint of the family breaks."""
+    if not (isinstance(bounds, list) and len(bounds) == 2):
+        return []
+    for end in (_finite(b) for b in bounds):
+        if end is None:
+            continue
+        for constraint in _broken(family, {**values, canonical: end}):
+            if canonical in constraint.names:
+                return [(loc, f"the range reaches {end!r}, where {constraint.reason}")]
+    return []
 
 
 def _law_coefficient_reason(name: str, names: Names) -> str:
@@ -236,7 +275,8 @@ def _continuation_problems(
         if not found and isinstance(parameter, str):
             canonical = names.canonical(parameter)
             found = _range_problems(loc + ("range",), canonical, item.get("range"), names,
-                                    "continued")
+                                    "continued") or _range_constraint_problems(
+                loc + ("range",), canonical, item.get("range"), family, values)
             found = found or _start_problems(loc, item, values[canonical])
             found = found or _law_range_problems(loc + ("range",), canonical,
                                                  item.get("range"), names, values)
