@@ -337,6 +337,9 @@ class FreeplayAmplitudes:
     estimate_parameter: np.ndarray
     stiffness_unit: str = ""  # of estimate_stiffness: the dof's stiffness unit
     parameter_unit: str = ""  # of estimate_parameter: the branch's principal parameter's
+    #: Hopf points of the linear model with the dof's stiffness at K_out, in that parameter
+    #: (the linear flutter onset freeplay cycles undercut; empty where not computed)
+    onset: np.ndarray = field(default_factory=lambda: np.empty(0))
 
 
 @dataclass(frozen=True)

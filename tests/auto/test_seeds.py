@@ -139,3 +139,21 @@ def test_a_coarse_smoothing_yields_artefacts_that_are_flagged_and_hidden():
     assert all(np.isnan(p.refined).any() or np.nanmax(np.abs(np.diff(np.concatenate(
         [p.parameters[:1], p.refined])))) > 2e-3 * 3.0 for p in flagged)
     assert marker_points(result, artefacts=True) > marker_points(result, artefacts=False)
+
+
+def test_the_amplitude_diagram_marks_the_linear_onset():
+    """Issue 15, item 7: A/delta against airspeed with the linear onset at K_theta = K_out
+    (stored with the amplitudes) drawn as a vertical line, and the describing function."""
+    from whirl_cli.plots.freeplay import amplitude_diagram
+
+    _, result = computed()
+    continuation = result.continuations[0]
+    (found,) = continuation.freeplay
+    np.testing.assert_allclose(found.onset, [linear_onset()], rtol=1e-9)
+    figure = amplitude_diagram(continuation)
+    verticals = [line for line in figure.axes[0].get_lines()
+                 if len(set(line.get_xdata())) == 1 and line.get_linestyle() == "-."]
+    assert [line.get_xdata()[0] for line in verticals] == pytest.approx([linear_onset()])
+    labels = [t.get_text() for t in figure.axes[0].get_legend().get_texts()]
+    assert "linear onset (stiffness K_out)" in labels
+    assert "describing function (one harmonic)" in labels

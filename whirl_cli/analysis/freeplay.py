@@ -43,6 +43,21 @@ def amplitude_ratio(model: Model, overrides: dict[str, float], branch: Branch,
     return amplitude / delta
 
 
+def linear_onsets(model: Model, overrides: dict[str, float], dof: str, parameter: str,
+                  bounds: tuple[float, float]) -> np.ndarray:
+    """The Hopf points (values of ``parameter`` in ``bounds``) of the linear model with the
+    stiffness of ``dof`` at the law's K_out: where linear analysis puts the flutter onset,
+    which freeplay cycles undercut."""
+    law = model.law_values(dof, overrides)
+    linear = get_model(model.family.name)
+    known = set(linear.parameter_names)
+    fixed = {k: v for k, v in overrides.items() if k in known}
+    stiffness = model.family.dof(dof).stiffness
+    return np.array([p.value for p in critical_points(
+        linear, {**fixed, stiffness: law["K_out"]}, parameter, *bounds, points=401)
+        if p.kind == "hopf"], dtype=float)
+
+
 def describing_estimate(model: Model, overrides: dict[str, float], dof: str, parameter: str,
                         bounds: tuple[float, float], ratios: np.ndarray
                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -89,7 +104,10 @@ def freeplay_amplitudes(model: Model, overrides: dict[str, float],
                 estimate = describing_estimate(model, overrides, dof, parameter, bounds,
                                                np.linspace(1.0, top, points))
             stiffness = next(d.stiffness for d in model.dofs if d.name == dof)
+            onset = np.empty(0) if parameter in own or parameter not in linear_names else \
+                linear_onsets(model, overrides, dof, parameter, bounds)
             found.append(FreeplayAmplitudes(branch.name, dof, ratio, *estimate,
                                             stiffness_unit=model.parameter(stiffness).unit,
-                                            parameter_unit=branch.parameter_units[0]))
+                                            parameter_unit=branch.parameter_units[0],
+                                            onset=onset))
     return tuple(found)

@@ -22,6 +22,8 @@ if TYPE_CHECKING:
 
 #: Style of the describing-function estimate (dashed black).
 ESTIMATE_STYLE = {"color": "black", "linestyle": "--", "linewidth": 1.0}
+#: The linear flutter onset with the dof's stiffness at K_out (dash-dotted grey).
+ONSET_STYLE = {"color": "grey", "linestyle": "-.", "linewidth": 1.0}
 
 
 def amplitude_diagram(continuation: ContinuationResult) -> Figure:
@@ -29,11 +31,13 @@ def amplitude_diagram(continuation: ContinuationResult) -> Figure:
     branch with freeplay amplitudes (``continuation.freeplay``) against its principal
     parameter, stable solid blue and unstable dotted red (:data:`PLOT_KEY`), and the
     describing-function estimate of each branch dashed; a dotted line marks A/delta = 1 (the
-    gap). Without freeplay amplitudes the axes stay empty."""
+    gap), dash-dotted vertical lines the linear onset with the stiffness at K_out. Without
+    freeplay amplitudes the axes stay empty."""
     ax = _new_figure().add_subplot()
     by_name = {b.name: b for b in continuation.branches}
     first: dict[str, object] = {}
     estimate = None
+    onsets: set[float] = set()
     dofs = []
     x_label = None
     for found in continuation.freeplay:
@@ -48,11 +52,17 @@ def amplitude_diagram(continuation: ContinuationResult) -> Figure:
         if len(found.estimate_ratio):
             (estimate,) = ax.plot(found.estimate_parameter, found.estimate_ratio,
                                   label="_estimate", **ESTIMATE_STYLE)
+        onsets.update(float(v) for v in found.onset)
     handles = [first[key] for key in PLOT_KEY if key in first]
     labels = [str(PLOT_KEY[key]["label"]) for key in PLOT_KEY if key in first]
     if estimate is not None:
         handles.append(estimate)
         labels.append("describing function (one harmonic)")
+    for k, value in enumerate(sorted(onsets)):
+        line = ax.axvline(value, **ONSET_STYLE)
+        if k == 0:
+            handles.append(line)
+            labels.append("linear onset (stiffness K_out)")
     if dofs:
         ax.axhline(1.0, color="grey", linestyle=":", linewidth=0.8)
         ax.set_xlabel(x_label)
