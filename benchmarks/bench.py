@@ -31,8 +31,11 @@
 (g) the 8-state gimballed model: code generation (numeric module and Fortran) and compilation
     of ``gimballed_poly`` in a cold cache (target: under 60 s), then ``whirl run`` of every
     study in studies/gimballed (target: under 20 s each).
+(h) freeplay: ``whirl run`` of every study in studies/freeplay (seeds, simulation, AUTO,
+    persistence in epsilon, plots; target: under 10 s) beside the time a time-marching sweep
+    at 0.025 m/s steps would take for one branch of the same cycles.
 
-Run: ``.venv/bin/python benchmarks/bench.py [--only abcdefg] [--exclude GLOB] [--fold-tol 1e-5]
+Run: ``.venv/bin/python benchmarks/bench.py [--only abcdefgh] [--exclude GLOB] [--fold-tol 1e-5]
 [--fold-periods 3000]``. With all 26 chapter-3 studies it takes about 35 minutes on two cores,
 most of it in the two-parameter ``boundary_*`` studies (``--exclude 'boundary_*.yaml'`` leaves
 them out); other load on the machine shows in the numbers (the load average is printed).
@@ -448,9 +451,38 @@ def gimballed_figures(scratch: Path, env: dict[str, str]) -> None:
               f"{'' if timed.seconds < 20 else '  (over 20 s)'}", flush=True)
 
 
+def freeplay_figures(scratch: Path, env: dict[str, str], step: float = 0.025) -> None:
+    """(h): the freeplay airspeed studies (seeds, simulation, AUTO, persistence, plots) against
+    the time a time-marching sweep at ``step`` m/s would take for the same curve (one seed
+    settled per airspeed, measured at the study's start)."""
+    import numpy as np
+
+    from whirl_cli.analysis import seeds
+    from whirl_cli.study import load_study
+
+    heading("(h) freeplay: continuation from seeds vs a time-marching sweep")
+    for path in sorted((ROOT / "studies" / "freeplay").glob("*.yaml")):
+        timed = run(WHIRL + ["run", str(path), "-o", str(scratch / f"{path.stem}.h5"),
+                             "--overwrite"], env)
+        study = load_study(path)
+        spec = study.continuations[0]
+        model = study.variant()
+        values = {**study.parameter_values(), spec.parameter: spec.start}
+        seed = seeds.auto_seeds(model, values)[1]  # 4 half-gaps: on the cycle
+        params = model.parameter_vector(values)
+        started = time.perf_counter()
+        seeds.settle(model, params, seed)
+        one = time.perf_counter() - started
+        speeds = int(np.ceil((spec.range[1] - spec.range[0]) / step)) + 1
+        print(f"  whirl run {path.stem:<16} {timed.seconds:6.2f} s  exit {timed.returncode}"
+              f"{'' if timed.seconds < 10 else '  (over 10 s)'}; time marching: {speeds} "
+              f"airspeeds x {one:.2f} s = {speeds * one:.1f} s "
+              f"({speeds * one / timed.seconds:.1f} x), one branch of cycles only", flush=True)
+
+
 def main(argv: Sequence[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--only", default="abcdefg",
+    parser.add_argument("--only", default="abcdefgh",
                         help="letters of the figures to produce, e.g. 'ad' [default: all]")
     parser.add_argument("--fold-tol", type=float, default=1e-5,
                         help="bracket width at which the bisection of (f) stops [N m/rad]")
@@ -483,6 +515,8 @@ def main(argv: Sequence[str] | None = None) -> None:
             fold_figures(scratch, options.fold_tol, options.fold_periods)
         if "g" in only:
             gimballed_figures(scratch, env)
+        if "h" in only:
+            freeplay_figures(scratch, env)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
     print(f"\nload average at the end: {load()}")
