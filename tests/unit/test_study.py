@@ -254,8 +254,8 @@ def test_model_validate_fills_the_same_defaults():
         ),
         (
             "plots: [bifurcation, bubble]\n",
-            "s.yaml:3: plots[1]: expected one of bifurcation, linear, projections, period, phase, "
-            "boundary, amplitude, got 'bubble'",
+            "s.yaml:3: plots[1]: expected one of bifurcation, linear, root_locus, projections, "
+            "period, phase, boundary, amplitude, got 'bubble'",
         ),
         (
             "nonlinearity: {type: linear, dof: phi}\n",

@@ -20,14 +20,14 @@ from .captions import Captions, captions
 from .diagrams import bifurcation_diagram, period_plot, phase_plane, projections_figure
 from .freeplay import amplitude_diagram, has_amplitudes
 from .key import _PLOTTED_KINDS
-from .linear import linear_sweep_plot
+from .linear import linear_sweep_plot, root_locus_plot
 from .maps import _oriented_grid, boundary_plot, overhang_diagram, slice_continuation
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-PLOT_KINDS = ("bifurcation", "linear", "projections", "period", "phase", "boundary",
-              "amplitude")
+PLOT_KINDS = ("bifurcation", "linear", "root_locus", "projections", "period", "phase",
+              "boundary", "amplitude")
 """Kinds accepted by :func:`save_study_plots`."""
 
 PHASE_ORBITS = 12
@@ -58,7 +58,7 @@ def missing_data(result: StudyResult, kind: str) -> str:
     if kind == "phase" and not any(b.is_periodic and b.orbits and len(b.state_names) >= 2
                                    for c in result.continuations for b in c.branches):
         return "no stored orbits on a periodic branch (periodic: true; orbits_at stores more)"
-    if kind == "linear" and not result.linear_sweeps:
+    if kind in ("linear", "root_locus") and not result.linear_sweeps:
         return "no linear sweep (linear.sweeps)"
     if kind == "boundary" and not result.boundaries and result.linear_grid is None:
         return "no stability boundary (a two-parameter continuation) and no linear grid " \
@@ -92,6 +92,8 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
       dofs: psi vs theta for the classical model; at most :data:`PHASE_ORBITS` orbits, those
       stored at ``orbits_at`` values first, the others spread along the branch);
     * "linear" -> ``<stem>_linear_<parameter>.png`` per linear sweep;
+    * "root_locus" -> ``<stem>_root_locus_<parameter>.png`` per linear sweep
+      (:func:`~whirl_cli.plots.linear.root_locus_plot`);
     * "amplitude" -> ``<stem>_<continuation>_amplitude.png`` per continuation with freeplay
       amplitudes (:func:`~whirl_cli.plots.freeplay.amplitude_diagram`: A/delta, the
       describing-function estimate dashed);
@@ -220,6 +222,11 @@ def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str,
             jobs.append((f"{stem}_linear_{sweep.parameter}.png",
                          lambda s=sweep: linear_sweep_plot(
                              s, hz=view.hz, title=caption().title({s.parameter}))))
+    if "root_locus" in kinds:
+        for sweep in result.linear_sweeps:
+            jobs.append((f"{stem}_root_locus_{sweep.parameter}.png",
+                         lambda s=sweep: root_locus_plot(s, title=caption().title(
+                             {s.parameter}))))
     if "boundary" in kinds:
         jobs += _boundary_jobs(result, stem, state, caption, view)
     if "amplitude" in kinds:

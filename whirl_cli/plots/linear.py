@@ -1,4 +1,5 @@
-"""Figures of linear sweeps: frequency and damping ratio of each mode against the parameter.
+"""Figures of linear sweeps: frequency and damping ratio of each mode against the parameter;
+the root locus (eigenvalues in the complex plane, coloured by the parameter).
 """
 
 from __future__ import annotations
@@ -42,6 +43,40 @@ def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = 
     if ax_freq.get_lines():
         ax_freq.legend(fontsize="small")
     ax_freq.set_title(f"linear analysis vs {sweep.parameter}" if title is None else title)
+    return figure
+
+
+#: Markers of the root locus by whirl direction (real roots: "--").
+WHIRL_MARKERS = {"FW": "o", "BW": "s", "--": "x"}
+
+
+def root_locus_plot(sweep: LinearSweep, title: str | None = None) -> Figure:
+    """The eigenvalues of every point of ``sweep`` in the complex plane [1/s], coloured by
+    the parameter (colour bar), one marker per whirl direction (circle FW, square BW, cross
+    real), with the imaginary axis drawn: a root crossing it to the right is a Hopf point
+    (flutter), through the origin a divergence. Title: ``title`` (None: ``"root locus vs
+    <parameter>"``)."""
+    figure = _new_figure()
+    ax = figure.add_subplot()
+    whirl = np.asarray(sweep.whirl).astype(str)
+    values = np.repeat(np.asarray(sweep.values)[:, None], sweep.eigenvalues.shape[1], axis=1)
+    scale = None
+    for direction, marker in WHIRL_MARKERS.items():
+        chosen = whirl == direction
+        if chosen.any():
+            scale = ax.scatter(sweep.eigenvalues.real[chosen], sweep.eigenvalues.imag[chosen],
+                               c=values[chosen], cmap="viridis", marker=marker, s=9,
+                               vmin=float(np.min(sweep.values)),
+                               vmax=float(np.max(sweep.values)),
+                               label={"--": "real root"}.get(direction, direction))
+    ax.axvline(0.0, color="black", linewidth=0.8, label="_imaginary axis")
+    ax.axhline(0.0, color="grey", linewidth=0.5, label="_real axis")
+    if scale is not None:
+        figure.colorbar(scale, ax=ax, label=axis_label(sweep.parameter, sweep.unit))
+        ax.legend(fontsize="small", loc="upper left")
+    ax.set_xlabel(axis_label("Re lambda", "1/s"))
+    ax.set_ylabel(axis_label("Im lambda", "rad/s"))
+    ax.set_title(f"root locus vs {sweep.parameter}" if title is None else title)
     return figure
 
 

@@ -355,8 +355,8 @@ class TwoParameterContinuation(_Strict):
         return tuple(s.label for s in self.slices)
 
 
-PlotKind = Literal["bifurcation", "linear", "projections", "period", "phase", "boundary",
-                   "amplitude"]
+PlotKind = Literal["bifurcation", "linear", "root_locus", "projections", "period", "phase",
+                   "boundary", "amplitude"]
 Continuation = Annotated[OneParameterContinuation | TwoParameterContinuation,
                         Field(discriminator="type")]
 
