@@ -30,11 +30,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from ..declaration import NON_NEGATIVE, POSITIVE
 from .base import Coefficient, Law, LawProblem
+
+if TYPE_CHECKING:  # numpy is imported where the describing function is computed
+    import numpy as np
 
 #: The smoothing width a study gets when it gives none, as a fraction of delta.
 EPSILON_FRACTION = 0.01
@@ -121,6 +123,8 @@ def equivalent_stiffness(amplitude, delta: float, k_in: float, k_out: float) -> 
                   delta^2/A^2)]}      (A > delta; K_in for A <= delta),
 
     rising from K_in at A = delta towards K_out. ``amplitude``: A (array), in the dof's unit."""
+    import numpy as np
+
     ratio = np.clip(delta / np.maximum(np.asarray(amplitude, dtype=float), 1e-300), 0.0, 1.0)
     share = 1.0 - (2.0 / math.pi) * (np.arcsin(ratio) + ratio * np.sqrt(1.0 - ratio**2))
     return k_in + (k_out - k_in) * share
