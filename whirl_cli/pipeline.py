@@ -119,7 +119,7 @@ def seeded_orbits(model, overrides: dict[str, float], spec
                    for k in kept)
     outcomes = tuple(
         SeedOutcome(k + 1, s.seed, s.kind, s.orbit.period if s.orbit else float("nan"),
-                    families.get(k) or families.get(seeds.same_as(settled, k, kept), ""),
+                    families.get(seeds.same_as(settled, k, kept), ""),
                     s.message)
         for k, s in enumerate(settled))
     return starts, outcomes

@@ -150,24 +150,20 @@ def distinct(found: list[Settled], tolerance: float = 1e-2) -> list[int]:
     approach a weakly attracting cycle slowly: 1e-3 apart after hundreds of periods)."""
     kept: list[int] = []
     for k, settled in enumerate(found):
-        if settled.kind != "periodic":
-            continue
-        mine = _signature(settled.orbit)
-        if not any(np.allclose(mine, _signature(found[j].orbit), rtol=tolerance, atol=0)
-                   for j in kept):
+        if settled.kind == "periodic" and same_as(found, k, kept, tolerance) is None:
             kept.append(k)
     return kept
 
 
-def _signature(orbit: Orbit) -> np.ndarray:
-    return np.concatenate([[orbit.period], np.ptp(orbit.states, axis=0)])
-
-
 def same_as(found: list[Settled], k: int, kept: list[int], tolerance: float = 1e-2) -> int | None:
-    """The kept outcome whose orbit outcome ``k`` settled on too (None if none, or not
-    periodic)."""
+    """The first of ``kept`` whose orbit outcome ``k`` settled on too, as :func:`distinct`
+    tells orbits apart (``k`` itself if kept; None if none, or not periodic)."""
     if found[k].kind != "periodic":
         return None
     mine = _signature(found[k].orbit)
     return next((j for j in kept if np.allclose(mine, _signature(found[j].orbit),
                                                 rtol=tolerance, atol=0)), None)
+
+
+def _signature(orbit: Orbit) -> np.ndarray:
+    return np.concatenate([[orbit.period], np.ptp(orbit.states, axis=0)])

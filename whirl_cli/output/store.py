@@ -165,7 +165,8 @@ FREEPLAY = (
           unit_field="stiffness_unit"),
     Field("estimate_parameter", key="describing_function/parameter",
           unit_field="parameter_unit"),
-    Field("onset", key="linear_onset", default=lambda: np.empty(0)),  # units: the parameter's
+    Field("onset", key="linear_onset", unit_field="parameter_unit",
+          default=lambda: np.empty(0)),
 )
 #: A :class:`LinearSweep` in ``linear/sweeps/<parameter>``.
 LINEAR_SWEEP = (
@@ -266,9 +267,7 @@ def _lyapunov_unit(state_units: tuple[str, ...]) -> str:
 
 
 def _write_freeplay(branch: h5py.Group, found: FreeplayAmplitudes) -> None:
-    group = branch.create_group(f"freeplay_{found.dof}")
-    write_record(group, found, FREEPLAY)
-    group["linear_onset"].attrs["units"] = found.parameter_unit
+    write_record(branch.create_group(f"freeplay_{found.dof}"), found, FREEPLAY)
 
 
 def _read_freeplay(name: str, branch: h5py.Group) -> list[FreeplayAmplitudes]:
