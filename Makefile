@@ -43,9 +43,14 @@ generate: setup
 
 # Every study under studies/ (resumable: up-to-date outputs are skipped) -> results/<name>.h5
 SWEEP_JOBS ?= $(shell nproc 2>/dev/null || echo 2)
-.PHONY: sweep references bench
+.PHONY: sweep references bench figures
 sweep: setup
 	$(BIN)/whirl sweep studies -o results --jobs $(SWEEP_JOBS)
+
+# Every thesis chapter-3 figure (sheets/thesis_ch3) -> figures/fig3_<n>.png + figures/index.html,
+# running the studies they need into results/ (up-to-date results are reused)
+figures: setup
+	$(BIN)/whirl figures sheets/thesis_ch3 -o figures --results results --jobs $(SWEEP_JOBS)
 
 # Regenerate the committed HDF5 references of tests/regression (a deliberate act: review the
 # `whirl compare` output against the old files before committing the new ones).

@@ -63,7 +63,6 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     from .study import load_study
 
     study = load_study(study_file)  # first: a bad study is refused fast, before any import
-    from .pipeline import run_study
 
     output = output or Path(f"{study.name}.h5")
     if output.exists() and not overwrite:
@@ -84,25 +83,14 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
                       f"{outcome.wall_seconds:7.3f} s{detail}", soft_wrap=True)
 
     console.print(f"whirl {__version__}: {study.path} -> {output}", soft_wrap=True)
-    from .interrupts import catching, held_signals
-    from .output.study_files import publish_study
+    from . import api
+    from .interrupts import catching
     from .verdict import verdict
 
     with catching():  # an interrupt while plots are drawn is never lost either
-        with held_signals():  # the work directory is made and removed whole
-            if keep_runs:
-                keep_runs.mkdir(parents=True, exist_ok=True)
-                workroot = Path(tempfile.mkdtemp(prefix=f"{study.name}-", dir=keep_runs))
-            else:
-                workroot = Path(tempfile.mkdtemp(prefix="whirl-"))
-        try:
-            result = run_study(study, workroot, jobs=jobs, on_run=report)
-        finally:
-            with held_signals():
-                if not keep_runs:
-                    shutil.rmtree(workroot, ignore_errors=True)
-        published = publish_study(result, output, study.plots if plots else (), overwrite,
-                                  state=study.plot_state)
+        result = api.run(study, jobs=jobs, on_run=report, keep_runs=keep_runs)
+        published = api.save(result, output, study.plots if plots else (), overwrite,
+                             state=study.plot_state)
     for path in published.paths:
         console.print(f"wrote {path}", soft_wrap=True)
     found = verdict(result, published.plot_error)
@@ -132,14 +120,14 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
 def summary(result_file: Path, output_format: str) -> None:
     """Print the special points of a result file: type, parameters, amplitude of every dof
     (angles in degrees), period, stability, criticality, status."""
-    from .output import store
+    from . import api
     from .output.summary import render
 
     if not result_file.exists():
         raise OutputError(f"{result_file}: no such file")
     if result_file.is_dir():
         raise OutputError(f"{result_file}: is a directory, not a result file")
-    result = store.read(result_file)
+    result = api.read(result_file)
     study = _stored_study(result)
     dofs = study.variant().family.dof_names if study is not None else None
     width = shutil.get_terminal_size().columns if sys.stdout.isatty() else None
@@ -153,11 +141,11 @@ def check(result_file: Path) -> None:
     """Check the stable orbits and equilibria of a result file by time simulation."""
     from dataclasses import replace
 
+    from . import api
     from .analysis import simulate
-    from .output import store
     from .study import validate_text
 
-    result = store.read(result_file)
+    result = api.read(result_file)
     study = validate_text(str(result.attributes.get("study_yaml", "")), result_file.name)
     model, parameters, names = study.variant(), study.parameter_values(), study.names()
 
@@ -272,10 +260,10 @@ def _limits(ctx: click.Context, param: click.Parameter, value):
 def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None,
          state: str | None, xlim, ylim, hz: bool, artefacts: bool) -> None:
     """Draw the plots of a whirl result file."""
-    from .output import store
+    from . import api
     from .plots.files import View, available_kinds, missing_data, save_study_plots
 
-    result = store.read(result_file)
+    result = api.read(result_file)
     states = {s for c in result.continuations for b in c.branches for s in b.state_names}
     if state is None:
         state = _stored_plot_state(result)
@@ -393,6 +381,40 @@ def sweep(paths: tuple[Path, ...], out_dir: Path, jobs: int, dask_address: str |
         raise SystemExit(128 + getattr(error, "signum", 2)) from None  # 130 SIGINT, 143 TERM
     if tally.failures:
         raise WhirlError(f"{len(tally.failures)} of {tally.total} studies failed")
+
+
+# ------------------------------------------------------------------------------------ figures
+@cli.command()
+@click.argument("paths", nargs=-1, required=True, type=click.Path(path_type=Path))
+@click.option("-o", "--out-dir", type=click.Path(file_okay=False, path_type=Path),
+              default=Path("figures"), show_default=True,
+              help="Directory for fig<n>.png and index.html.")
+@click.option("--results", "results_dir", type=click.Path(file_okay=False, path_type=Path),
+              default=Path("results"), show_default=True,
+              help="Directory of the studies' <study name>.h5 (reused when up to date).")
+@click.option("-j", "--jobs", type=click.IntRange(1, 256), default=os.cpu_count() or 1,
+              show_default=True, help="Studies run in parallel (local worker processes).")
+@click.option("--force", is_flag=True, help="Rerun studies whose output is up to date.")
+def figures(paths: tuple[Path, ...], out_dir: Path, results_dir: Path, jobs: int,
+            force: bool) -> None:
+    """Draw the figures of the sheets in PATHS (files, or directories searched for *.yaml):
+    run the studies they name (as `whirl sweep`, reusing up-to-date results), write one PNG per
+    sheet and an index.html. Exit 1 if any figure could not be drawn."""
+    from .figures.build import make_figures
+
+    try:
+        outcomes = make_figures(paths, out_dir, results_dir, jobs=jobs, force=force,
+                                console=_console())
+    except KeyboardInterrupt as error:
+        click.echo("interrupted", err=True)
+        raise SystemExit(128 + getattr(error, "signum", 2)) from None
+    drawn = [o for o in outcomes if o.image is not None]
+    for outcome in outcomes:
+        if outcome.image is None:
+            click.echo(f"figure {outcome.sheet.figure}: not drawn: {outcome.problem}", err=True)
+    click.echo(f"{len(drawn)} of {len(outcomes)} figures -> {out_dir / 'index.html'}")
+    if len(drawn) < len(outcomes):
+        raise WhirlError(f"{len(outcomes) - len(drawn)} of {len(outcomes)} figures not drawn")
 
 
 # ------------------------------------------------------------------------------------ compare

@@ -28,6 +28,7 @@ from .key import (
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
+    from matplotlib.gridspec import SubplotSpec
 
 _PERIOD_POINTS = (PointType.HB, PointType.LPC, PointType.PD, PointType.TR, PointType.BPC,
                   PointType.HOMOCLINIC, PointType.HETEROCLINIC)
@@ -93,7 +94,8 @@ def _draw_bifurcation(ax: Axes, continuation: ContinuationResult, branches: list
 
 
 def projections_figure(continuation: ContinuationResult, which: Sequence[str] = ("max",),
-                       degrees: bool = True, title: str | None = None) -> Figure:
+                       degrees: bool = True, title: str | None = None,
+                       region: SubplotSpec | None = None) -> Figure:
     """One bifurcation diagram per state on a grid of ceil(n/2) x 2 axes sharing the x-axis.
 
     The states are those common to every plotted (equilibrium or periodic) branch, in the order
@@ -101,16 +103,23 @@ def projections_figure(continuation: ContinuationResult, which: Sequence[str] = 
     deg/s unless ``degrees`` is False; ``which`` as there). Only the first panel has a legend and
     only the bottom panels an x label; the figure title is ``title`` (None: the continuation's
     name). Without
-    plotted branches the figure has one empty axes.
+    plotted branches the figure has one empty axes. ``region``: draw into this part of an
+    existing figure (a sheet's panel; the title then goes on the panel's first axes) instead
+    of a new figure.
     """
     states = _common_states(continuation)
     rows = max(1, -(-len(states) // 2))
-    figure = _new_figure(figsize=(10.0, 3.2 * rows + 0.6), layout="constrained")
+    if region is None:
+        figure = _new_figure(figsize=(10.0, 3.2 * rows + 0.6), layout="constrained")
+        grid = figure.add_gridspec(rows, 2)
+    else:
+        figure = region.get_gridspec().figure
+        grid = region.subgridspec(rows, 2)
     title = continuation.name if title is None else title
     if not states:
-        figure.add_subplot().set_title(title)
+        figure.add_subplot(grid[:, :]).set_title(title)
         return figure
-    axes = figure.subplots(rows, 2, sharex=True, squeeze=False).ravel()
+    axes = grid.subplots(sharex=True, squeeze=False).ravel()
     for k, (ax, state) in enumerate(zip(axes, states, strict=False)):
         bifurcation_diagram(continuation, state=state, which=which, ax=ax, degrees=degrees)
         ax.set_title("")
@@ -123,7 +132,10 @@ def projections_figure(continuation: ContinuationResult, which: Sequence[str] = 
     if len(states) % 2 and len(states) > 1:  # lone last panel: label its neighbour's x
         axes[len(states) - 2].xaxis.set_tick_params(labelbottom=True)
         axes[len(states) - 2].set_xlabel(axes[len(states) - 1].get_xlabel())
-    figure.suptitle(title)
+    if region is None:
+        figure.suptitle(title)
+    else:
+        axes[0].set_title(title)
     return figure
 
 
@@ -135,7 +147,8 @@ def _common_states(continuation: ContinuationResult) -> tuple[str, ...]:
     return tuple(s for s in branches[0].state_names if all(s in b.state_names for b in branches))
 
 
-def period_plot(continuation: ContinuationResult, title: str | None = None) -> Figure:
+def period_plot(continuation: ContinuationResult, title: str | None = None,
+                ax: Axes | None = None) -> Figure:
     """Period [s] of every periodic branch against its principal parameter (SI unit).
 
     Lines follow :data:`PLOT_KEY` (stable solid blue, unstable dotted red) split as in
@@ -145,9 +158,11 @@ def period_plot(continuation: ContinuationResult, title: str | None = None) -> F
     estimate, the period at the last point of their branch). A "bracketed" global point also
     gets its bracket drawn as a horizontal error bar at the top of the data. The y-axis is
     logarithmic if the largest period exceeds 20 times the smallest. Without periodic branches
-    the axes stay empty. Title: ``title`` (None: ``"<continuation>: period"``).
+    the axes stay empty. Title: ``title`` (None: ``"<continuation>: period"``). Draws on ``ax``
+    if given, else on a new figure; returns the figure.
     """
-    ax = _new_figure().add_subplot()
+    if ax is None:
+        ax = _new_figure().add_subplot()
     periodic = [b for b in continuation.branches if b.is_periodic]
     first: dict[str, object] = {}
     for branch in periodic:

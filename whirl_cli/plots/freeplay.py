@@ -18,6 +18,7 @@ from .key import (
 )
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
 #: Style of the describing-function estimate (dashed black).
@@ -26,14 +27,16 @@ ESTIMATE_STYLE = {"color": "black", "linestyle": "--", "linewidth": 1.0}
 ONSET_STYLE = {"color": "grey", "linestyle": "-.", "linewidth": 1.0}
 
 
-def amplitude_diagram(continuation: ContinuationResult) -> Figure:
+def amplitude_diagram(continuation: ContinuationResult, ax: Axes | None = None) -> Figure:
     """A/delta (A: half peak-to-peak of the freeplay dof, delta its half-gap) of every periodic
     branch with freeplay amplitudes (``continuation.freeplay``) against its principal
     parameter, stable solid blue and unstable dotted red (:data:`PLOT_KEY`), and the
     describing-function estimate of each branch dashed; a dotted line marks A/delta = 1 (the
     gap), dash-dotted vertical lines the linear onset with the stiffness at K_out. Without
-    freeplay amplitudes the axes stay empty."""
-    ax = _new_figure().add_subplot()
+    freeplay amplitudes the axes stay empty. Draws on ``ax`` if given, else on a new figure;
+    returns the figure."""
+    if ax is None:
+        ax = _new_figure().add_subplot()
     by_name = {b.name: b for b in continuation.branches}
     first: dict[str, object] = {}
     estimate = None

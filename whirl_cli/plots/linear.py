@@ -13,11 +13,12 @@ from ..units import HZ_PER_RAD_S
 from .key import _colours, _new_figure, axis_label
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
 
-def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = None
-                      ) -> Figure:
+def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = None,
+                      axes: tuple[Axes, Axes] | None = None) -> Figure:
     """Frequency [rad/s, or Hz if ``hz``] (top) and damping ratio [-] (bottom) of each mode vs
     the parameter.
 
@@ -25,10 +26,13 @@ def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = 
     conjugate pair appears once (real eigenvalues are not drawn). Lines are labelled with their
     whirl direction ("BW"/"FW", after the mode group for models with several: "nacelle BW";
     numbered if repeated); the damping panel has a zero line.
-    Title: ``title`` (None: ``"linear analysis vs <parameter>"``).
+    Title: ``title`` (None: ``"linear analysis vs <parameter>"``). Draws on ``axes``
+    (frequency, damping) if given, else on a new figure; returns the figure.
     """
-    figure = _new_figure(figsize=(6.4, 6.4))
-    ax_freq, ax_damp = figure.subplots(2, 1, sharex=True)
+    if axes is None:
+        axes = _new_figure(figsize=(6.4, 6.4)).subplots(2, 1, sharex=True)
+    ax_freq, ax_damp = axes
+    figure = ax_freq.figure
     for (column, label), colour in zip(_mode_labels(sweep), _colours(), strict=False):
         upper = sweep.eigenvalues[:, column].imag > 0
         freq = np.where(upper, sweep.frequency[:, column], np.nan) * (HZ_PER_RAD_S if hz
@@ -50,14 +54,16 @@ def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = 
 WHIRL_MARKERS = {"FW": "o", "BW": "s", "--": "x"}
 
 
-def root_locus_plot(sweep: LinearSweep, title: str | None = None) -> Figure:
+def root_locus_plot(sweep: LinearSweep, title: str | None = None, ax: Axes | None = None
+                    ) -> Figure:
     """The eigenvalues of every point of ``sweep`` in the complex plane [1/s], coloured by
     the parameter (colour bar), one marker per whirl direction (circle FW, square BW, cross
     real), with the imaginary axis drawn: a root crossing it to the right is a Hopf point
     (flutter), through the origin a divergence. Title: ``title`` (None: ``"root locus vs
-    <parameter>"``)."""
-    figure = _new_figure()
-    ax = figure.add_subplot()
+    <parameter>"``). Draws on ``ax`` if given, else on a new figure; returns the figure."""
+    if ax is None:
+        ax = _new_figure().add_subplot()
+    figure = ax.figure
     whirl = np.asarray(sweep.whirl).astype(str)
     values = np.repeat(np.asarray(sweep.values)[:, None], sweep.eigenvalues.shape[1], axis=1)
     scale = None

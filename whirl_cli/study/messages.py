@@ -32,9 +32,9 @@ _MAPPING_ERRORS = {"dict_type", "model_type", "model_attributes_type"}
 _LIST_ERRORS = {"tuple_type", "list_type"}
 
 
-def _translate(error: Any, tree: _Tree) -> Problem:
-    """One pydantic error as (key path, reason)."""
-    loc, owner, annotation = _walk(error["loc"])
+def _translate(error: Any, tree: _Tree, root: type[BaseModel] = Study) -> Problem:
+    """One pydantic error of a file validated as ``root`` as (key path, reason)."""
+    loc, owner, annotation = _walk(error["loc"], root)
     if loc[:2] == ("nonlinearity", 0) and isinstance(tree.data.get("nonlinearity"), dict):
         loc = loc[:1] + loc[2:]  # one law mapping counts as a list of one: report at it
     kind = error["type"]
@@ -63,14 +63,14 @@ def _choice_reason(options: Any, got: str) -> str:
     return f"expected one of {', '.join(map(str, options))}, got {got}"
 
 
-def _walk(loc: tuple) -> tuple[Loc, type[BaseModel], Any]:
+def _walk(loc: tuple, root: type[BaseModel] = Study) -> tuple[Loc, type[BaseModel], Any]:
     """A pydantic loc as (YAML key path, model owning its last key, annotation at its end).
 
     Union tags in the loc (``nonlinearity.polynomial.K2``) are not YAML keys and are dropped.
     """
     path: list[str | int] = []
-    owner: type[BaseModel] = Study
-    annotation: Any = Study
+    owner: type[BaseModel] = root
+    annotation: Any = root
     for part in loc:
         annotation = _strip(annotation)
         members = _union_members(annotation)

@@ -49,16 +49,17 @@ class SweepItem:
         return self.study.name if self.study is not None else self.source.name
 
 
-def find_studies(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
+def find_studies(paths: Iterable[str | os.PathLike[str]], what: str = "study files"
+                 ) -> list[Path]:
     """Study files named by ``paths``: files as given, directories searched recursively for
-    ``*.yaml`` (sorted); each file once, in the order found."""
+    ``*.yaml`` (sorted); each file once, in the order found. ``what`` names them in errors."""
     found: list[Path] = []
     seen: set[Path] = set()
     for entry in map(Path, paths):
         if entry.is_dir():
             candidates = sorted(p for p in entry.rglob("*.yaml") if p.is_file())
             if not candidates:
-                raise WhirlError(f"{entry}: no study files (*.yaml) in this directory")
+                raise WhirlError(f"{entry}: no {what} (*.yaml) in this directory")
         elif entry.exists():
             candidates = [entry]
         else:

@@ -1,0 +1,64 @@
+"""The Python API: the README's example runs as written (real AUTO), and its results are the
+CLI's (same dataclasses, the same numbers as an independent eigenvalue computation)."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import os
+import re
+
+import numpy as np
+import pytest
+
+from whirl_cli import api
+from whirl_cli.analysis import linear
+from whirl_cli.errors import WhirlError
+
+from ..conftest import ROOT
+
+
+def readme_example() -> str:
+    text = (ROOT / "README.md").read_text()
+    section = text[text.index("## Python API"):]
+    return re.search(r"```python\n(.*?)```", section, re.S).group(1)
+
+
+def test_readme_example_runs(tmp_path, monkeypatch):
+    pytest.importorskip("matplotlib")
+    monkeypatch.chdir(tmp_path)
+    os.symlink(ROOT / "studies", tmp_path / "studies")
+    printed = io.StringIO()
+    namespace: dict = {}
+    with contextlib.redirect_stdout(printed):
+        exec(compile(readme_example(), "README.md", "exec"), namespace)  # noqa: S102
+    assert (tmp_path / "linear-case2.h5").is_file()
+    assert (tmp_path / "linear-case2.png").read_bytes()[:4] == b"\x89PNG"
+    table = namespace["table"]
+    hopf = table[table["type"] == "HB"]
+    assert len(hopf) == 2
+    # the Hopf values AUTO found are where the linear model's eigenvalues cross Re = 0
+    study = api.load(ROOT / "studies/thesis_ch3/linear_case2.yaml")
+    model = study.variant()
+    for k1 in hopf["K_theta [N m/rad]"]:
+        around = linear.sweep(model, study.parameter_values(), "K_theta",
+                              np.array([k1 - 1e-5, k1 + 1e-5]))
+        leading = around.eigenvalues.real.max(axis=1)
+        assert leading[0] * leading[1] < 0, (k1, leading)
+    assert "Hopf points at K_theta =" in printed.getvalue()
+
+
+def test_special_points_without_pandas_is_a_clear_error(monkeypatch, tmp_path):
+    import builtins
+
+    real_import = builtins.__import__
+
+    def no_pandas(name, *args, **kwargs):
+        if name == "pandas":
+            raise ImportError("no pandas")
+        return real_import(name, *args, **kwargs)
+
+    result = api.run(ROOT / "studies/thesis_ch3/linear_datum_omega.yaml")
+    monkeypatch.setattr(builtins, "__import__", no_pandas)
+    with pytest.raises(WhirlError, match=r"pip install 'whirl\[pandas\]'"):
+        api.special_points(result)

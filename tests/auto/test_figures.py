@@ -1,0 +1,109 @@
+"""``whirl figures`` on the real AUTO: sheets run the studies they need, draw one PNG per
+sheet and an index; a second run reuses every result; a figure that cannot be drawn is
+reported and the others still are; every shipped sheet is valid."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import h5py
+import pytest
+from click.testing import CliRunner
+
+from whirl_cli.cli import cli
+from whirl_cli.figures.build import load_sheets, make_figures
+from whirl_cli.output import store
+
+from ..conftest import ROOT
+from .test_sweep import copy_studies
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def sheets(folder: Path) -> Path:
+    folder.mkdir()
+    (folder / "fig9_1.yaml").write_text(
+        'figure: "9.1"\ncaption: bifurcation and linear sweep\nlayout: [1, 2]\npanels:\n'
+        "  - {kind: bifurcation, study: ../studies/linear_case2.yaml}\n"
+        "  - {kind: linear, study: ../studies/linear_datum_airspeed.yaml}\n")
+    (folder / "fig9_2.yaml").write_text(
+        'figure: "9.2"\ncaption: two results on one axes\npanels:\n'
+        "  - kind: bifurcation\n    overlay:\n"
+        "      - {study: ../studies/linear_case2.yaml, label: case 2}\n"
+        "      - {study: ../studies/linear_datum_airspeed.yaml, label: datum}\n")
+    return folder
+
+
+def test_figures_run_draw_index_and_reuse(tmp_path):
+    copy_studies(tmp_path / "studies")
+    folder = sheets(tmp_path / "sheets")
+    out, results = tmp_path / "figures", tmp_path / "results"
+    outcomes = make_figures([folder], out, results, jobs=2)
+    assert [o.problem for o in outcomes] == ["", ""]
+    assert sorted(p.name for p in out.iterdir()) == ["fig9_1.png", "fig9_2.png", "index.html"]
+    for name in ("fig9_1.png", "fig9_2.png"):
+        assert (out / name).read_bytes()[:8] == PNG_MAGIC
+    page = (out / "index.html").read_text()
+    assert page.index("Figure 9.1") < page.index("Figure 9.2")
+    assert "studies/linear_case2.yaml" in page and "whirl figures" in page
+    # the results behind them are the studies' own results (stored, readable)
+    stored = sorted(p.name for p in results.iterdir())
+    assert stored == ["linear-case2.h5", "linear-datum-airspeed.h5"]
+    assert store.read(results / "linear-case2.h5").continuations
+    stamps = {p: p.stat().st_mtime_ns for p in results.iterdir()}
+    again = make_figures([folder], out, results, jobs=2)
+    assert [o.image.name for o in again] == ["fig9_1.png", "fig9_2.png"]
+    assert {p: p.stat().st_mtime_ns for p in results.iterdir()} == stamps  # nothing rerun
+
+
+def test_a_figure_that_cannot_be_drawn_is_reported(tmp_path):
+    copy_studies(tmp_path / "studies", ("linear_datum_airspeed",))
+    folder = tmp_path / "sheets"
+    folder.mkdir()
+    (folder / "good.yaml").write_text(
+        'figure: "9.1"\ncaption: c\npanels:\n'
+        "  - {kind: linear, study: ../studies/linear_datum_airspeed.yaml}\n")
+    (folder / "bad.yaml").write_text(
+        'figure: "9.2"\ncaption: c\npanels:\n'
+        "  - {kind: period, study: ../studies/linear_datum_airspeed.yaml}\n")
+    out = tmp_path / "figures"
+    result = CliRunner().invoke(cli, ["figures", str(folder), "-o", str(out), "--results",
+                                      str(tmp_path / "results"), "-j", "1"])
+    assert result.exit_code == 1
+    assert "figure 9.2: not drawn" in result.output
+    assert "nothing to draw as period: no periodic branch" in result.output
+    assert sorted(p.name for p in out.iterdir()) == ["fig9_1.png", "index.html"]
+    assert "not drawn" in (out / "index.html").read_text()
+
+
+def test_bad_sheet_runs_nothing(tmp_path):
+    folder = tmp_path / "sheets"
+    folder.mkdir()
+    (folder / "bad.yaml").write_text('figure: "9.1"\ncaption: c\npanels:\n'
+                                     "  - {kind: linear, study: nowhere.yaml}\n")
+    result = CliRunner().invoke(cli, ["figures", str(folder), "-o", str(tmp_path / "f"),
+                                      "--results", str(tmp_path / "r")])
+    assert result.exit_code == 1
+    assert "bad.yaml:4: panels[0].study: no study file" in result.output
+    assert not (tmp_path / "f").exists() and not (tmp_path / "r").exists()
+
+
+def test_shipped_sheets_are_valid_and_cover_the_figures_list():
+    shipped = load_sheets([ROOT / "sheets" / "thesis_ch3"])
+    numbers = {s.figure for s in shipped}
+    assert {"3.3", "3.12", "3.14", "3.18", "3.22", "3.28", "3.29", "3.30"} <= numbers
+    for sheet in shipped:
+        for path in sheet.studies():
+            assert path.is_relative_to(ROOT / "studies"), path
+
+
+@pytest.mark.parametrize("name", ["linear-case2.h5"])
+def test_results_of_figures_are_sweep_results(tmp_path, name):
+    """The figures' results folder is a sweep's: `whirl sweep` then finds them up to date."""
+    copy_studies(tmp_path / "studies")
+    make_figures([sheets(tmp_path / "sheets")], tmp_path / "f", tmp_path / "r", jobs=1)
+    with h5py.File(tmp_path / "r" / name) as stored:
+        assert stored.attrs["study_sha256"]
+    result = CliRunner().invoke(cli, ["sweep", str(tmp_path / "studies"), "-o",
+                                      str(tmp_path / "r"), "--no-plots"])
+    assert result.exit_code == 0 and "2 up to date" in result.output

@@ -1,0 +1,178 @@
+"""Sheets (whirl_cli.figures): reading and checking sheet files, drawing any kind onto a given
+Axes, overlays labelled by what differs, a sheet's layout, the index page."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+from matplotlib.colors import to_hex
+
+from tests.unit.test_plots import STATES, branch_lines, continuation, make_sweep  # noqa: F401
+from whirl_cli.errors import StudyError, WhirlError
+from whirl_cli.figures.draw import draw_sheet
+from whirl_cli.figures.index import Entry, index_html
+from whirl_cli.figures.sheet import load_sheet
+from whirl_cli.plots.key import _new_figure
+from whirl_cli.plots.panels import PANEL_KINDS, PanelChoice, differing_labels, draw, draw_overlay
+from whirl_cli.results import ParameterValue, StudyResult
+
+STUDY = "name: s\nmodel: classical\n"
+
+
+def write(folder: Path, name: str, text: str) -> Path:
+    path = folder / name
+    path.write_text(text)
+    return path
+
+
+def result_with(continuation, k2: float, name: str = "study") -> StudyResult:  # noqa: F811
+    parameters = (ParameterValue("K_psi", 0.3, 0.4, "N m/rad"),
+                  ParameterValue("K2_theta", k2, 0.0, "N m/rad^3"))
+    return StudyResult(name, "classical", (continuation,), (make_sweep(),), (),
+                       parameters=parameters)
+
+
+# -- sheet files ---------------------------------------------------------------------------------
+
+def test_sheet_reads_and_resolves_study_paths(tmp_path):
+    (tmp_path / "studies").mkdir()
+    write(tmp_path / "studies", "a.yaml", STUDY)
+    (tmp_path / "sheets").mkdir()
+    path = write(tmp_path / "sheets", "f.yaml",
+                 'figure: "3.14"\ncaption: c\nlayout: [1, 2]\npanels:\n'
+                 "  - {kind: bifurcation, study: ../studies/a.yaml}\n"
+                 "  - kind: bifurcation\n    overlay:\n      - {study: ../studies/a.yaml}\n")
+    sheet = load_sheet(path)
+    assert sheet.stem == "fig3_14"
+    assert sheet.shape == (1, 2)
+    assert sheet.studies() == [tmp_path / "studies" / "a.yaml"]
+
+
+@pytest.mark.parametrize("body, expected", [
+    ("panels:\n  - {kind: bifurcation, study: nowhere.yaml}\n",
+     "f.yaml:4: panels[0].study: no study file"),
+    ("panels:\n  - {kind: bifurcation, study: a.yaml, colour: red}\n",
+     "f.yaml:4: panels[0].colour: unknown key"),
+    ("panels:\n  - {kind: bifurcation}\n",
+     "f.yaml:4: panels[0]: give exactly one of `study` and `overlay`"),
+    ("panels:\n  - {kind: period, overlay: [{study: a.yaml}]}\n",
+     "f.yaml:4: panels[0]: only bifurcation panels can be overlaid"),
+    ("panels:\n  - {kind: contour, study: a.yaml}\n",
+     "f.yaml:4: panels[0].kind: expected one of bifurcation"),
+    ("layout: [1, 1]\npanels:\n  - {kind: bifurcation, study: a.yaml}\n"
+     "  - {kind: period, study: a.yaml}\n",
+     "f.yaml:3: layout: 2 panels do not fit a 1 x 1 layout"),
+    ("panels: []\n", "f.yaml:3: panels: "),
+])
+def test_bad_sheets_name_file_line_key_and_reason(tmp_path, body, expected):
+    write(tmp_path, "a.yaml", STUDY)
+    path = write(tmp_path, "f.yaml", 'figure: "3.1"\ncaption: c\n' + body)
+    with pytest.raises(StudyError) as caught:
+        load_sheet(path)
+    assert expected in str(caught.value)
+
+
+def test_bad_figure_number(tmp_path):
+    path = write(tmp_path, "f.yaml", 'figure: "three"\ncaption: c\npanels: []\n')
+    with pytest.raises(StudyError, match=r"f.yaml:1: figure: expected a figure number"):
+        load_sheet(path)
+
+
+# -- panels --------------------------------------------------------------------------------------
+
+def test_every_panel_kind_draws_or_names_what_is_missing(continuation):  # noqa: F811
+    result = result_with(continuation, 10.0)
+    drawn = {}
+    for kind in PANEL_KINDS:
+        ax = _new_figure().add_subplot()
+        try:
+            drawn[kind] = draw(result, kind, ax)
+        except WhirlError as error:
+            drawn[kind] = str(error)
+    (bifurcation,) = drawn["bifurcation"]
+    assert bifurcation.get_title() == "study"  # no stored study text: the name alone
+    assert len(branch_lines(bifurcation)) >= 2
+    freq, damp = drawn["linear"]  # the linear kind splits its panel in two
+    assert freq.get_ylabel() == "frequency [rad/s]"
+    assert damp.get_ylabel() == "damping ratio [-]"
+    assert len(drawn["projections"]) == len(STATES)
+    assert drawn["root_locus"][0].get_xlabel() == "Re lambda [1/s]"
+    assert drawn["period"][0].get_ylabel() == "period [s]"
+    assert "no stability boundary" in drawn["boundary"]
+    assert "no stability boundary" in drawn["overhang"]
+    assert "freeplay amplitudes" in drawn["amplitude"]
+
+
+def test_panel_choices_are_checked(continuation):  # noqa: F811
+    result = result_with(continuation, 10.0)
+    ax = _new_figure().add_subplot()
+    with pytest.raises(WhirlError, match="no one-parameter continuation 'nope'"):
+        draw(result, "bifurcation", ax, PanelChoice(continuation="nope"))
+    with pytest.raises(WhirlError, match="no linear sweep of 'V'"):
+        draw(result, "linear", ax, PanelChoice(sweep="V"))
+    with pytest.raises(WhirlError, match="unknown panel kind"):
+        draw(result, "contour", ax)
+
+
+def test_overlay_one_colour_per_result_labelled_by_what_differs(continuation):  # noqa: F811
+    results = [result_with(continuation, k2, f"s{k2:g}") for k2 in (5.0, 10.0, 20.0)]
+    assert differing_labels(results) == [f"K2_theta = {k:g} N m/rad^3" for k in (5, 10, 20)]
+    ax = _new_figure().add_subplot()
+    draw_overlay(results, "bifurcation", ax, labels=[None, "datum K2"])
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert legend[:3] == ["K2_theta = 5 N m/rad^3", "datum K2", "K2_theta = 20 N m/rad^3"]
+    assert "Hopf (HB)" in legend and "fold (LP, LPC)" in legend
+    colours = {to_hex(line.get_color()) for line in branch_lines(ax)}
+    assert len(colours) == 3  # one per result; stability by line style
+    styles = {line.get_linestyle() for line in branch_lines(ax)}
+    assert styles == {"-", ":"}
+    assert ax.get_title() == "K_psi = 0.3 N m/rad"  # the parameter they share, not K2
+    with pytest.raises(WhirlError, match="cannot be overlaid"):
+        draw_overlay(results, "period", ax)
+
+
+def test_differing_labels_fall_back_to_study_names(continuation):  # noqa: F811
+    same = [result_with(continuation, 10.0, "a"), result_with(continuation, 10.0, "b")]
+    assert differing_labels(same) == ["a", "b"]
+    old = [replace(same[0], parameters=()), same[1]]
+    assert differing_labels(old) == ["a", "b"]
+
+
+def test_sheet_layout_title_and_first_legend_only(tmp_path, continuation):  # noqa: F811
+    write(tmp_path, "a.yaml", STUDY)
+    path = write(tmp_path, "f.yaml",
+                 'figure: "3.22"\ncaption: grid\nlayout: [2, 2]\nlegends: first\npanels:\n'
+                 + "  - {kind: bifurcation, study: a.yaml}\n" * 3)
+    sheet = load_sheet(path)
+    figure = draw_sheet(sheet, {tmp_path / "a.yaml": result_with(continuation, 10.0)})
+    assert len(figure.axes) == 3
+    assert figure.get_suptitle().startswith("Figure 3.22: grid")
+    assert [ax.get_legend() is not None for ax in figure.axes] == [True, False, False]
+    positions = sorted((round(ax.get_position().x0, 2), -round(ax.get_position().y0, 2))
+                       for ax in figure.axes)
+    assert len({x for x, _ in positions}) == 2 and len({y for _, y in positions}) == 2
+
+
+def test_sheet_panel_errors_name_sheet_and_panel(tmp_path, continuation):  # noqa: F811
+    write(tmp_path, "a.yaml", STUDY)
+    path = write(tmp_path, "f.yaml", 'figure: "3.1"\ncaption: c\npanels:\n'
+                 "  - {kind: boundary, study: a.yaml}\n")
+    with pytest.raises(WhirlError, match=r"f.yaml: panels\[0\] \(boundary\): .*no stability"):
+        draw_sheet(load_sheet(path), {tmp_path / "a.yaml": result_with(continuation, 1.0)})
+
+
+# -- index ---------------------------------------------------------------------------------------
+
+def test_index_lists_figures_in_number_order_escaped():
+    entries = [Entry("3.12", "roots <b>", "", "fig3_12.png", ("s.yaml",), "whirl figures x"),
+               Entry("3.3", "damping", "a note", None, ("t.yaml",), "whirl figures y",
+                     "study failed")]
+    page = index_html(entries, "whirl figures")
+    assert page.index("Figure 3.3") < page.index("Figure 3.12")
+    assert "roots &lt;b&gt;" in page and "<b>" not in page
+    assert '<img src="fig3_12.png"' in page
+    assert "not drawn: study failed" in page and "a note" in page
+    assert np.char.count(page, "<section").item() == 2

@@ -1,0 +1,108 @@
+"""whirl from Python (a notebook, a script): the functions the command line is built on.
+
+Load a study, run it, get the same result dataclasses the CLI stores
+(:class:`~whirl_cli.results.StudyResult`), save and read HDF5 files, get the special points as
+a table (a pandas DataFrame with the optional extra ``whirl[pandas]``) and draw any plot kind
+onto a matplotlib Axes::
+
+    from whirl_cli import api
+    study = api.load("studies/thesis_ch3/linear_case2.yaml")
+    result = api.run(study)
+    api.save(result, "linear-case2.h5", plots=["bifurcation"])
+    table = api.special_points(api.read("linear-case2.h5"))
+    api.draw(result, "bifurcation", ax)
+
+Nothing here prints; progress of the AUTO runs goes to ``on_run`` if given.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from .errors import WhirlError
+from .results import StudyResult
+from .study import Study, load_study
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+    from .output.study_files import Published
+
+__all__ = ["draw", "load", "read", "run", "save", "special_points"]
+
+
+def load(path: str | os.PathLike[str]) -> Study:
+    """The validated study at ``path`` (a StudyError lists every problem)."""
+    return load_study(path)
+
+
+def run(study: Study | str | os.PathLike[str], jobs: int = 1,
+        on_run: Callable[[Any], None] | None = None,
+        keep_runs: str | os.PathLike[str] | None = None) -> StudyResult:
+    """Run every continuation, linear analysis and cross-check of ``study`` (a Study or a
+    path); ``jobs`` AUTO runs at once; ``on_run`` is called with each AUTO run's outcome as it
+    ends. AUTO works in a temporary directory, removed afterwards, or kept under
+    ``keep_runs``."""
+    from .interrupts import held_signals
+    from .pipeline import run_study
+
+    study = study if isinstance(study, Study) else load_study(study)
+    with held_signals():  # the work directory is made and removed whole
+        if keep_runs:
+            Path(keep_runs).mkdir(parents=True, exist_ok=True)
+            workroot = Path(tempfile.mkdtemp(prefix=f"{study.name}-", dir=keep_runs))
+        else:
+            workroot = Path(tempfile.mkdtemp(prefix="whirl-"))
+    try:
+        return run_study(study, workroot, jobs=jobs, on_run=on_run)
+    finally:
+        with held_signals():
+            if not keep_runs:
+                shutil.rmtree(workroot, ignore_errors=True)
+
+
+def save(result: StudyResult, path: str | os.PathLike[str], plots: Sequence[str] = (),
+         overwrite: bool = False, state: str | None = None) -> Published:
+    """Write ``result`` to the HDF5 file ``path`` and its ``plots`` (kinds of
+    :data:`whirl_cli.plots.files.PLOT_KINDS`) next to it, as one unit (all or nothing)."""
+    from .output.study_files import publish_study
+
+    return publish_study(result, Path(path), tuple(plots), overwrite, state=state)
+
+
+def read(path: str | os.PathLike[str]) -> StudyResult:
+    """The result stored in the HDF5 file ``path`` (schema 1 or 2)."""
+    from .output import store
+
+    return store.read(Path(path))
+
+
+def special_points(result: StudyResult, dofs: Sequence[str] | None = None):
+    """The special points of every continuation as a pandas DataFrame, one row per point, the
+    columns of ``whirl summary --format csv`` (parameters and amplitudes with their units in
+    the column names; amplitudes of ``dofs``, None: every dof). Needs pandas
+    (``pip install 'whirl[pandas]'``)."""
+    try:
+        import pandas
+    except ImportError:
+        raise WhirlError("special_points needs pandas: pip install 'whirl[pandas]'") from None
+    from .output.summary import columns, records, summary_rows
+
+    rows = summary_rows(result, dofs)
+    return pandas.DataFrame.from_records(records(rows), columns=columns(rows))
+
+
+def draw(result: StudyResult, kind: str, ax: Axes, **choice) -> list[Axes]:
+    """Draw ``result``'s figure of ``kind`` onto ``ax`` (any kind of
+    :data:`whirl_cli.plots.panels.PANEL_KINDS`); ``choice``: the fields of
+    :class:`~whirl_cli.plots.panels.PanelChoice` (``continuation``, ``state``, ``sweep``,
+    ``slice``, ...). Returns the axes drawn on."""
+    from .plots.panels import PanelChoice
+    from .plots.panels import draw as draw_panel
+
+    return draw_panel(result, kind, ax, PanelChoice(**choice))

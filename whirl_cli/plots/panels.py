@@ -1,0 +1,285 @@
+"""Any plot kind drawn onto a given matplotlib Axes: the panels of a sheet (``whirl figures``)
+and of a notebook.
+
+:func:`draw` draws one result's figure of one kind into an Axes (a kind with several panels
+of its own, ``linear`` and ``projections``, splits that Axes' place in its figure);
+:func:`draw_overlay` draws several results' bifurcation diagrams into one Axes, one colour per
+result, labelled by what differs between them (:func:`differing_labels`). What a kind picks
+from a result (which continuation, branch, sweep, slice) is said by :class:`PanelChoice`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..errors import WhirlError
+from ..results import Branch, ContinuationResult, LinearSweep, StudyResult
+from .captions import Fixed, captions
+from .diagrams import (
+    _checked_branches,
+    _draw_special_points,
+    _label_axes,
+    bifurcation_diagram,
+    period_plot,
+    phase_plane,
+    projections_figure,
+)
+from .freeplay import amplitude_diagram, has_amplitudes
+from .key import PLOT_KEY, _colours, display_unit, stability_segments
+from .linear import linear_sweep_plot, root_locus_plot
+from .maps import _oriented_grid, boundary_plot, overhang_diagram, slice_index
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+PANEL_KINDS = ("bifurcation", "projections", "period", "phase", "linear", "root_locus",
+               "boundary", "overhang", "amplitude")
+"""Kinds :func:`draw` accepts (``overhang``: one slice of a boundary, its unsafe intervals
+shaded)."""
+
+OVERLAY_KINDS = ("bifurcation",)
+"""Kinds :func:`draw_overlay` accepts."""
+
+
+@dataclass(frozen=True)
+class PanelChoice:
+    """What a panel takes from its result; None everywhere: the first that fits.
+
+    ``continuation``: a continuation's name; ``branch``: a periodic branch's name (``phase``);
+    ``state``: the state drawn (``bifurcation``, ``overhang``; a phase plane's y, x being the
+    first state); ``sweep``: a linear sweep's parameter; ``slice``: a boundary slice index
+    from 0 (``overhang``); ``orbits``: AUTO labels of the orbits a phase plane draws;
+    ``hz``: frequencies in Hz; ``title``: replaces the study's title."""
+
+    continuation: str | None = None
+    branch: str | None = None
+    state: str | None = None
+    sweep: str | None = None
+    slice: int | None = None
+    orbits: tuple[int, ...] | None = None
+    hz: bool = False
+    title: str | None = None
+
+
+def draw(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice = PanelChoice()
+         ) -> list[Axes]:
+    """Draw ``result``'s figure of ``kind`` (:data:`PANEL_KINDS`) onto ``ax``; return the
+    axes drawn on (``linear`` and ``projections`` replace ``ax`` by their own panels in its
+    place). Titles name the study and its fixed parameters unless ``choice.title`` is set.
+    A result without what the kind needs is a :class:`WhirlError` saying what is missing."""
+    if kind not in PANEL_KINDS:
+        raise WhirlError(f"unknown panel kind {kind!r}; choose from {', '.join(PANEL_KINDS)}")
+    title = choice.title
+    caption = captions(result)
+    if kind in ("bifurcation", "projections", "period", "amplitude"):
+        continuation = pick_continuation(result, choice.continuation, kind)
+        varied = {n for b in continuation.branches for n in b.parameter_names}
+        title = caption.title(varied) if title is None else title
+        if kind == "bifurcation":
+            bifurcation_diagram(continuation, choice.state, ax=ax, title=title)
+        elif kind == "period":
+            period_plot(continuation, title=title, ax=ax)
+        elif kind == "amplitude":
+            amplitude_diagram(continuation, ax=ax)
+            ax.set_title(title)
+        else:
+            return _replaced(ax, lambda region: projections_figure(
+                continuation, title=title, region=region))
+        return [ax]
+    if kind == "phase":
+        branch = _pick_branch(result, choice)
+        labels = list(choice.orbits) if choice.orbits is not None else None
+        if labels is None:
+            from .files import phase_labels
+
+            labels = phase_labels(branch)
+        phase_plane(branch, labels=labels, y=choice.state, ax=ax,
+                    title=caption.title(branch.parameter_names) if title is None else title)
+        return [ax]
+    if kind in ("linear", "root_locus"):
+        sweep = _pick_sweep(result, choice.sweep)
+        title = caption.title({sweep.parameter}) if title is None else title
+        if kind == "root_locus":
+            root_locus_plot(sweep, title=title, ax=ax)
+            return [ax]
+        return _replaced(ax, lambda region: linear_sweep_plot(
+            sweep, hz=choice.hz, title=title,
+            axes=tuple(region.subgridspec(2, 1).subplots(sharex=True))), share=False)
+    return _draw_map(result, kind, ax, choice, caption)
+
+
+def _draw_map(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice, caption
+              ) -> list[Axes]:
+    """The ``boundary`` and ``overhang`` kinds."""
+    grid = result.linear_grid
+    if not result.boundaries:
+        if kind == "boundary" and grid is not None:
+            boundary_plot(None, grid, ax=ax, title=choice.title or caption.title(
+                {grid.x_parameter, grid.y_parameter}))
+            return [ax]
+        raise WhirlError(f"{result.study_name}: no stability boundary (a two-parameter "
+                         "continuation)" + (" and no linear grid" if kind == "boundary" else ""))
+    names = [b.name for b in result.boundaries]
+    wanted = choice.continuation or names[0]
+    if wanted not in names:
+        raise WhirlError(f"{result.study_name}: no boundary {wanted!r} (boundaries: "
+                         f"{', '.join(names)})")
+    boundary = result.boundaries[names.index(wanted)]
+    if kind == "boundary":
+        matched = None if grid is None else _oriented_grid(grid, boundary.parameter_names)
+        labels = tuple(caption.slice_label(boundary.name, k) for k in range(len(boundary.slices)))
+        boundary_plot(boundary, matched, cases=boundary.slices, case_labels=labels, ax=ax,
+                      title=choice.title or caption.title(boundary.parameter_names))
+        return [ax]
+    k = 0 if choice.slice is None else choice.slice
+    if not 0 <= k < len(boundary.slices):
+        raise WhirlError(f"{result.study_name}: boundary {boundary.name!r} has slices 0 to "
+                         f"{len(boundary.slices) - 1}, not {k}")
+    value = boundary.slices[k]
+    continuation = next((c for c in result.continuations if c.name == boundary.name), None)
+    if continuation is None:
+        raise WhirlError(f"{result.study_name}: no continuation {boundary.name!r} for the "
+                         "overhang diagram")
+    assert slice_index(boundary, value) == k
+    unit = boundary.parameter_units[1]
+    title = choice.title or (
+        f"{caption.title(boundary.parameter_names)}\n{caption.slice_label(boundary.name, k)}: "
+        f"{boundary.parameter_names[1]} = {float(value):g}{' ' + unit if unit else ''}")
+    overhang_diagram(continuation, boundary, value, state=choice.state, ax=ax, title=title)
+    return [ax]
+
+
+def _replaced(ax: Axes, make, share: bool = True) -> list[Axes]:
+    """Remove ``ax`` and let ``make(region)`` draw into its place; the new axes."""
+    figure, region = ax.figure, ax.get_subplotspec()
+    before = set(figure.axes)
+    ax.remove()
+    make(region)
+    return [a for a in figure.axes if a not in before]
+
+
+def pick_continuation(result: StudyResult, name: str | None, kind: str = "bifurcation"
+                      ) -> ContinuationResult:
+    """The one-parameter continuation named ``name`` (None: the first one that has what
+    ``kind`` draws: periodic branches for ``period``, freeplay amplitudes for ``amplitude``)."""
+    one = [c for c in result.continuations if c.kind == "one-parameter"]
+    if name is not None:
+        found = [c for c in one if c.name == name]
+        if not found:
+            raise WhirlError(f"{result.study_name}: no one-parameter continuation {name!r} "
+                             f"(continuations: {', '.join(c.name for c in one) or 'none'})")
+        return found[0]
+    fits = {"period": lambda c: any(b.is_periodic for b in c.branches),
+            "amplitude": has_amplitudes}.get(kind, lambda c: True)
+    found = [c for c in one if fits(c)]
+    if not found:
+        need = {"period": "periodic branch", "amplitude": "freeplay amplitudes"}.get(
+            kind, "one-parameter continuation")
+        raise WhirlError(f"{result.study_name}: nothing to draw as {kind}: no {need}")
+    return found[0]
+
+
+def _pick_branch(result: StudyResult, choice: PanelChoice) -> Branch:
+    """The periodic branch with stored orbits named ``choice.branch`` (None: the first)."""
+    candidates = [b for c in result.continuations
+                  if choice.continuation in (None, c.name) for b in c.branches
+                  if b.is_periodic and b.orbits]
+    if choice.branch is not None:
+        candidates = [b for b in candidates if b.name == choice.branch]
+    if not candidates:
+        raise WhirlError(f"{result.study_name}: no periodic branch with stored orbits"
+                         + (f" named {choice.branch!r}" if choice.branch else ""))
+    return candidates[0]
+
+
+def _pick_sweep(result: StudyResult, parameter: str | None) -> LinearSweep:
+    """The linear sweep of ``parameter`` (None: the first)."""
+    sweeps = [s for s in result.linear_sweeps if parameter in (None, s.parameter)]
+    if not sweeps:
+        have = ", ".join(s.parameter for s in result.linear_sweeps) or "none"
+        raise WhirlError(f"{result.study_name}: no linear sweep"
+                         + (f" of {parameter!r}" if parameter else "") + f" (sweeps: {have})")
+    return sweeps[0]
+
+
+def differing_labels(results: Sequence[StudyResult]) -> list[str]:
+    """One label per result naming the parameters whose values differ between them
+    (``"K2 = 5 N m/rad^3"``; the study's name where nothing differs or a result has no stored
+    parameter set)."""
+    tables = [{p.name: p for p in r.parameters} for r in results]
+    if not all(tables):
+        return [r.study_name for r in results]
+    names = [n for n in tables[0] if all(n in t for t in tables)
+             and len({t[n].value for t in tables}) > 1]
+    if not names:
+        return [r.study_name for r in results]
+    return [", ".join(f"{n} = {t[n].value:g}{' ' + t[n].unit if t[n].unit else ''}"
+                      for n in names) for t in tables]
+
+
+def draw_overlay(results: Sequence[StudyResult], kind: str, ax: Axes,
+                 labels: Sequence[str | None] = (), choice: PanelChoice = PanelChoice(),
+                 title: str | None = None) -> list[Axes]:
+    """Several results' diagrams of ``kind`` (:data:`OVERLAY_KINDS`) on one Axes: each result
+    in its own colour, stable branches solid and unstable dotted, special points with the
+    markers of :data:`PLOT_KEY`; the legend has one entry per result, labelled by
+    ``labels`` (missing or None: :func:`differing_labels`). Title: ``title`` (None: the
+    parameters off their datum that every result shares and the diagram does not vary)."""
+    if kind not in OVERLAY_KINDS:
+        raise WhirlError(f"kind {kind!r} cannot be overlaid; choose from "
+                         f"{', '.join(OVERLAY_KINDS)}")
+    if not results:
+        raise WhirlError("an overlay needs at least one result")
+    auto = differing_labels(results)
+    names = [labels[k] if k < len(labels) and labels[k] else auto[k]
+             for k in range(len(results))]
+    first: dict[str, object] = {}
+    handles = []
+    state = choice.state
+    for result, label, colour in zip(results, names, _colours(), strict=False):
+        continuation = pick_continuation(result, choice.continuation)
+        which, branches, state = _checked_branches(continuation, state, ("max",))
+        handle = None
+        for branch in branches:
+            handle = _draw_coloured(ax, branch, state, colour) or handle
+        if handle is not None:
+            handle.set_label(label)
+            handles.append(handle)
+        _draw_special_points(ax, continuation, branches, state, True, first)
+        if branches and not ax.get_xlabel():
+            _label_axes(ax, continuation, branches, state, which, True)
+    markers = [first[key] for key in PLOT_KEY if key in first]
+    ax.legend(handles + markers,
+              [h.get_label() for h in handles] + [str(PLOT_KEY[k]["label"]) for k in PLOT_KEY
+                                                  if k in first], fontsize="small")
+    if title is None:
+        varied = {n for r in results for c in r.continuations for b in c.branches
+                  for n in b.parameter_names}
+        shared = [p for p in results[0].parameters if p.name not in varied
+                  and p.value != p.datum and all(
+                      any(q.name == p.name and q.value == p.value for q in r.parameters)
+                      for r in results[1:])]
+        kept = [str(Fixed(p.name, p.value, p.unit)) for p in shared]
+        title = ", ".join(kept)
+    ax.set_title(title)
+    return [ax]
+
+
+def _draw_coloured(ax: Axes, branch: Branch, state: str, colour: str):
+    """One branch in ``colour``: stable solid, unstable dotted, periodic drawn by its max;
+    returns a solid line for the legend (None if nothing was drawn)."""
+    factor, _ = display_unit(branch.state_units[branch.state_names.index(state)], True)
+    y = branch.state(state, "max") * factor
+    solid = None
+    for xs, ys, stable in stability_segments(branch.parameters[:, 0], y, branch.stable,
+                                             branch.stability_known):
+        (line,) = ax.plot(xs, ys, color=colour, linestyle="-" if stable else ":",
+                          linewidth=1.4 if branch.is_periodic else 1.0, label="_curve")
+        solid = line if stable and solid is None else solid
+    if solid is None and len(y):
+        (solid,) = ax.plot([], [], color=colour, linestyle="-")
+    return solid if np.size(y) else None
