@@ -53,7 +53,7 @@ MODELS: tuple[type[BaseModel], ...] = (
 )
 KNOWN = (
     "C_l_alpha, C_psi, C_theta, I_x, I_y, K1, K2, K2_psi, K2_theta, K3, K3_psi, K3_theta, "
-    "K_psi, K_theta, N, Omega, R, V, a, c, rho"
+    "K_psi, K_theta, N, Omega, R, V, a, aero_coupling, c, rho"
 )
 
 
