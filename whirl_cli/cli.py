@@ -242,8 +242,8 @@ def _limits(ctx: click.Context, param: click.Parameter, value):
 @cli.command()
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--kind", "kinds", multiple=True,
-              type=click.Choice(["bifurcation", "linear", "root_locus", "projections",
-                                 "period", "phase", "boundary", "amplitude"]),
+              type=click.Choice(["bifurcation", "linear", "root_locus", "damping_multiples",
+                                 "projections", "period", "phase", "boundary", "amplitude"]),
               help="Plot kind (repeatable) [default: every kind the file has the data for]; "
                    "a kind it lacks the data for is an error.")
 @click.option("-o", "--output-dir", type=click.Path(file_okay=False, path_type=Path),

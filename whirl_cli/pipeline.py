@@ -85,8 +85,12 @@ def _run_study(study: Study, workroot: Path, jobs: int,
     sweeps = []
     if study.linear is not None:
         for sweep in study.linear.sweeps:
+            datum = model.parameter(model.canonical(sweep.parameter)).default
             values = np.linspace(sweep.range[0], sweep.range[1], sweep.points)
-            sweeps.append(linear.sweep(model, parameters, sweep.parameter, values))
+            if sweep.multiples:  # the range in multiples of the datum: absolute values
+                values = values * datum
+            found = linear.sweep(model, parameters, sweep.parameter, values)
+            sweeps.append(replace(found, multiples=sweep.multiples))
     grid = None
     if study.linear is not None and study.linear.grid is not None:
         x, y = study.linear.grid.x, study.linear.grid.y

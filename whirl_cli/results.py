@@ -212,6 +212,9 @@ class LinearSweep:
     [rad/s]; ``whirl``: (M, n) str, "FW", "BW" or "--" for real eigenvalues. Modes are ordered by
     frequency per point. ``mode_group``: (M, n) str, the model's mode group holding most of
     each mode's energy (e.g. "nacelle", "gimbal"); None for a model with one group.
+    ``datum``: the parameter's datum [``unit``] (None: not stored, files before it);
+    ``multiples``: the study gave the sweep in multiples of it (``values`` are absolute all
+    the same: ``values / datum`` are the multiples).
     """
 
     parameter: str
@@ -222,6 +225,8 @@ class LinearSweep:
     frequency: np.ndarray
     whirl: np.ndarray
     mode_group: np.ndarray | None = None
+    datum: float | None = None
+    multiples: bool = False
 
 
 @dataclass(frozen=True)

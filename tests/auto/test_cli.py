@@ -61,8 +61,8 @@ def test_store_round_trip(tmp_path):
     plotted = runner.invoke(cli, ["plot", str(copy), "-o", str(tmp_path / "plots")])
     assert plotted.exit_code == 0, plotted.output
     assert sorted(p.name for p in (tmp_path / "plots").iterdir()) == [  # every kind it has
-        "copy_airspeed_bifurcation.png", "copy_airspeed_projections.png", "copy_linear_V.png",
-        "copy_root_locus_V.png"]
+        "copy_airspeed_bifurcation.png", "copy_airspeed_projections.png",
+        "copy_damping_multiples.png", "copy_linear_V.png", "copy_root_locus_V.png"]
 
 
 def test_validate_models_and_doctor():

@@ -344,3 +344,29 @@ def test_two_parameter_range_problems_name_the_key_as_written(tmp_path):
     assert result.output.startswith(
         "b.yaml:13: continuations[0].range.K_theta: expected [lower, upper] with lower < "
         "upper, got [0.5, 0.0]"), result.output
+
+
+def test_bad_multiples_sweeps_are_refused_at_their_keys(tmp_path):
+    """A sweep in multiples of a datum of 0, or with a multiple <= 0, is refused before any
+    run at the key's own line (whirl run, exit 1, no output)."""
+    text = (STUDIES / "linear_multiples_rotor.yaml").read_text()
+    assert "{parameter: R, range: [0.25, 5.0]" in text
+    line = next(k for k, row in enumerate(text.splitlines(), 1) if "parameter: R," in row)
+    cases = {
+        "zero.yaml": (text.replace("model: classical", "model: gimballed").replace(
+            "parameter: R,", "parameter: C_beta,"), f"zero.yaml:{line}: linear.sweeps[2]."
+            "multiples: the datum of C_beta is 0 N m s/rad: it has no multiples"),
+        "negative.yaml": (text.replace("{parameter: R, range: [0.25, 5.0]",
+                                       "{parameter: R, range: [-0.5, 5.0]"),
+                          f"negative.yaml:{line}: linear.sweeps[2].range: with multiples: "
+                          "true the range is in multiples of the datum of R (0.152) and must "
+                          "be > 0, got -0.5"),
+    }
+    for name, (content, expected) in cases.items():
+        path = tmp_path / name
+        path.write_text(content)
+        out = tmp_path / "out" / f"{name}.h5"
+        result = CliRunner().invoke(cli, ["run", str(path), "-o", str(out)])
+        assert result.exit_code == 1, result.output
+        assert result.output.startswith(expected), result.output
+        assert not out.parent.exists()

@@ -53,7 +53,7 @@ MODELS: tuple[type[BaseModel], ...] = (
 )
 KNOWN = (
     "C_l_alpha, C_psi, C_theta, I_x, I_y, K1, K2, K2_psi, K2_theta, K3, K3_psi, K3_theta, "
-    "K_psi, K_theta, N, Omega, R, V, a, c, rho"
+    "K_psi, K_theta, N, Omega, R, V, a, aero_coupling, c, rho"
 )
 
 
@@ -254,8 +254,8 @@ def test_model_validate_fills_the_same_defaults():
         ),
         (
             "plots: [bifurcation, bubble]\n",
-            "s.yaml:3: plots[1]: expected one of bifurcation, linear, root_locus, projections, "
-            "period, phase, boundary, amplitude, got 'bubble'",
+            "s.yaml:3: plots[1]: expected one of bifurcation, linear, root_locus, "
+            "damping_multiples, projections, period, phase, boundary, amplitude, got 'bubble'",
         ),
         (
             "nonlinearity: {type: linear, dof: phi}\n",
@@ -654,6 +654,7 @@ def test_schema_reference_lists_every_key_with_a_description():
                 "nonlinearity[].delta", "nonlinearity[].K_out", "nonlinearity[].K_in",
                 "nonlinearity[].epsilon", "linear.sweeps",
                 "linear.sweeps[].parameter", "linear.sweeps[].range", "linear.sweeps[].points",
+                "linear.sweeps[].multiples",
                 "linear.grid", "linear.grid.x", "linear.grid.y"}
     expected |= {f"linear.grid.{axis}.{k}" for axis in "xy" for k in ("parameter", "range",
                                                                       "points")}

@@ -120,7 +120,8 @@ def analyse(model: Model, params: np.ndarray, equilibrium: np.ndarray | None = N
 
 def sweep(model: Model, overrides: dict[str, float], parameter: str, values: np.ndarray,
           equilibrium: np.ndarray | None = None) -> LinearSweep:
-    """Linear analysis at every value of ``parameter`` (others at datum + ``overrides``)."""
+    """Linear analysis at every value of ``parameter`` (others at datum + ``overrides``);
+    the sweep records the parameter's datum."""
     values = np.asarray(values, dtype=float)
     params = parameter_matrix(model, overrides, parameter, values)
     eigenvalues, whirl, groups = analyse(model, params, equilibrium)
@@ -131,7 +132,8 @@ def sweep(model: Model, overrides: dict[str, float], parameter: str, values: np.
     names = np.array([g[0] for g in model.mode_groups], dtype=object)
     return LinearSweep(name, model.parameter(name).unit, values, eigenvalues, damping,
                        np.abs(eigenvalues.imag), whirl,
-                       names[groups] if len(names) > 1 else None)
+                       names[groups] if len(names) > 1 else None,
+                       datum=float(model.parameter(name).default))
 
 
 def _oscillatory_growth(model: Model, params: np.ndarray) -> np.ndarray:

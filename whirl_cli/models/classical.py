@@ -13,11 +13,19 @@ Equations (thesis/Riso sign convention), dofs q = [theta, psi], M = diag(I_y, I_
     I_y psi''   = -S_psi + k_c theta + k_d psi - I_x Omega theta' - (C_psi + c_a) psi'
 
     S_theta = K_theta theta, S_psi = K_psi psi, or the stiffness law's restoring moment;
-    k_d = Q a A'_1 (direct aerodynamic stiffness), k_c = Q A'_2 (cross aerodynamic stiffness),
+    k_d = Q a A'_1 (direct aerodynamic stiffness), k_c = s_c Q A'_2 (cross aerodynamic stiffness),
     c_a = Q (A_3 + a^2 A_1) / Omega (aerodynamic damping), Q = N rho C_l_alpha R^5 Omega^2 / 4,
     mu = V / (Omega R) and, with c/R constant,
     A_1 = (c/R) mu^2 asinh(1/mu),  A_2 = (c/R) (mu/2) [sqrt(1+mu^2) - mu^2 asinh(1/mu)],
     A_3 = (c/R) [(2 - 3 mu^2) sqrt(1+mu^2) + 3 mu^4 asinh(1/mu)] / 8,  A'_1 = mu A_1, A'_2 = mu A_2.
+
+The aerodynamic-coupling switch s_c = ``aero_coupling`` (dimensionless, in [0, 1], datum 1) is
+a factor on the aerodynamic cross terms: the cross aerodynamic stiffness k_c, which couples
+pitch and yaw (thesis figs. 3.9-3.11: "with and without the aerodynamic coupling"; science.md:
+without it gyroscopics alone cannot destabilise). The quasi-steady theory has no aerodynamic
+cross damping (the damping matrix is diagonal), so nothing else is scaled: the direct stiffness
+k_d and the damping c_a stay. s_c = 1 is the model above; s_c = 0 decouples the aerodynamics,
+leaving only the gyroscopic coupling I_x Omega. It is an ordinary parameter (PAR in AUTO).
 
 Sign conventions: the rotor spins about +x (forward along the shaft); theta is pitch about +y.
 Relative to the strip-theory derivation frame, psi is measured about -z (psi -> -psi), which
@@ -61,6 +69,9 @@ PARAMETERS = (
     Parameter("N", 4.0, "1", "number of blades (>= 3: the azimuth average of the blade "
               "forces is exact)", bounds=Bounds(lower=3.0, integer=True)),
     Parameter("C_l_alpha", 2.0 * math.pi, "1/rad", "blade section lift slope", bounds=POSITIVE),
+    Parameter("aero_coupling", 1.0, "1", "factor on the aerodynamic cross terms (the cross "
+              "stiffness k_c coupling pitch and yaw): 1 = on (the model), 0 = off",
+              bounds=Bounds(lower=0.0, upper=1.0)),
 )
 
 NOTES = (
@@ -89,11 +100,12 @@ def aerodynamic_integrals(p: dict):
 
 def aerodynamic_coefficients(p: dict):
     """(k_d, k_c, c_a): direct and cross aerodynamic stiffness [N m/rad], damping [N m s/rad],
-    as sympy expressions of the parameter symbols ``p`` (by name)."""
+    as sympy expressions of the parameter symbols ``p`` (by name); k_c carries the switch
+    ``aero_coupling`` (k_c = aero_coupling Q A'_2, the models.md value at its datum 1)."""
     q, mu, a1, a2, a3 = aerodynamic_integrals(p)
     Omega = p["Omega"]
     k_d = q * p["a"] * mu * a1
-    k_c = q * mu * a2
+    k_c = p["aero_coupling"] * q * mu * a2
     c_a = q * (a3 + p["a"] ** 2 * a1) / Omega
     return k_d, k_c, c_a
 

@@ -28,6 +28,12 @@ Equations, in the derivation frame (spin about +x, theta about +y, psi and beta_
 
 with Q, mu, A_1, A_2, A_3, A'_1 = mu A_1, A'_2 = mu A_2 the classical model's (models.md 2.2).
 
+The classical aerodynamic-coupling switch ``aero_coupling`` (a parameter of this model too,
+datum 1) multiplies every A'_2 term, the cross aerodynamic stiffness (k_c in the nacelle rows),
+as in the classical model; the a A_2 rate terms (cross damping between nacelle and gimbal rows,
+which cancel in the nacelle rows when beta = 0) are not scaled. With beta = 0 the nacelle rows
+are the classical model's for every value of the switch.
+
 Sign conventions: whirl uses the thesis frame of the classical model, psi -> -psi and
 beta_z -> -beta_z (psi and beta_z measured about -z), which leaves every eigenvalue unchanged;
 with beta = 0 the nacelle rows are the classical model's exactly. In the code the
@@ -95,7 +101,7 @@ def derivation_frame(q: tuple, v: tuple, p: dict):
     dth, dps, dby, dbz = v
     Q, mu, a1, a2, a3 = classical.aerodynamic_integrals(p)
     a, Om = p["a"], p["Omega"]
-    a1p, a2p = mu * a1, mu * a2
+    a1p, a2p = mu * a1, p["aero_coupling"] * mu * a2  # the switch on the cross stiffness
     gyro = p["I_x"] * Om
     aero = sp.Matrix([
         a * a1p * (th + by) + a2p * (ps + bz) - a3 * (dth + dby) / Om - a**2 * a1 * dth / Om

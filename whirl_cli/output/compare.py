@@ -575,7 +575,9 @@ def _compare_cross_checks(path: str, a: ContinuationResult, b: ContinuationResul
 
 # ------------------------------------------------------------------------------ linear sweeps
 def compare_linear_sweep(a: LinearSweep, b: LinearSweep, rtol: float) -> list[Difference]:
-    """Every column of a linear sweep, element by element (relative ``rtol``)."""
+    """Every column of a linear sweep, element by element (relative ``rtol``); the datum
+    where both files store it (files before it do not: that is no drift), and whether the
+    study gave it in multiples of the datum."""
     path = f"/linear/sweeps/{a.parameter}"
     found = []
     for key in ("values", "eigenvalues", "damping_ratio", "frequency"):
@@ -587,6 +589,11 @@ def compare_linear_sweep(a: LinearSweep, b: LinearSweep, rtol: float) -> list[Di
                                 "stored", "absent" if b.mode_group is None else "stored"))
     elif a.mode_group is not None:
         found += _compare_labels(f"{path}/mode_group", a.mode_group, b.mode_group)
+    if a.datum is not None and b.datum is not None:  # older files store no datum: no drift
+        found += _compare_arrays(f"{path}/datum", np.asarray(a.datum, float),
+                                 np.asarray(b.datum, float), rtol)
+    if a.multiples != b.multiples:
+        found.append(Difference(f"{path}/@multiples", str(a.multiples), str(b.multiples)))
     return found
 
 

@@ -33,7 +33,9 @@ Layout (units in a ``units`` attribute on every physical dataset)::
                                     (the exact freeplay law's maximum; NaN where none),
                                     exact (an orbit's max by the exact piecewise law; NaN)
     /linear/sweeps/<parameter>/     values, eigenvalues [1/s], damping_ratio, frequency [rad/s],
-                                    whirl (FW | BW | --)
+                                    whirl (FW | BW | --), datum (scalar, the parameter's
+                                    unit; absent in older files); attrs: parameter, multiples
+                                    (the study gave the range in multiples of the datum)
     /linear/grid/                   x, y, max_real (Ny, Nx) [1/s], oscillatory (Ny, Nx),
                                     flutter/line_<k>, divergence/line_<k> (K, 2): zero contour
     /boundaries/<name>/             attrs: parameters, units, method (loci | slices), slices
@@ -174,6 +176,8 @@ LINEAR_SWEEP = (
     Field("values", unit_field="unit"), Field("eigenvalues", units="1/s"),
     Field("damping_ratio", units="1"), Field("frequency", units="rad/s"),
     Field("whirl", kind="text"), Field("mode_group", kind="text", default=None),
+    Field("datum", kind="float", unit_field="unit", default=None),  # older files: none
+    Field("multiples", "attribute", "bool", default=False),
 )
 #: A :class:`LinearGrid` in ``linear/grid`` (its contour lines: collections of their own).
 LINEAR_GRID = (

@@ -23,17 +23,21 @@ class Fixed:
     unit: str
 
     def __str__(self) -> str:
-        return f"{self.name} = {self.value:g}{' ' + self.unit if self.unit else ''}"
+        dimensioned = self.unit not in ("", "1")  # "a = 0.3", not "a = 0.3 1"
+        return f"{self.name} = {self.value:g}{' ' + self.unit if dimensioned else ''}"
 
 
 @dataclass(frozen=True)
 class Captions:
-    """The study's name, the parameters it overrides (in the order written) and, per
-    two-parameter continuation, one label per slice (empty: none given)."""
+    """The study's name, the parameters it overrides (in the order written), per
+    two-parameter continuation one label per slice (empty: none given), and the datum of
+    every parameter of its model (canonical names, SI; empty if the study does not
+    validate): what a file without a parameter set (schema 1) divides sweeps by."""
 
     study: str
     fixed: tuple[Fixed, ...] = ()
     slice_labels: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    datums: dict[str, float] = field(default_factory=dict)
 
     def title(self, varied: Iterable[str] = ()) -> str:
         """``"<study>: <name> = <value> <unit>, ..."`` over the fixed parameters that are
@@ -64,4 +68,4 @@ def captions(result: StudyResult) -> Captions:
                   for key, value in study.parameters.items())
     labels = {c.name: tuple(c.slice_labels) for c in study.continuations
               if c.type == "two-parameter"}
-    return Captions(study.name, fixed, labels)
+    return Captions(study.name, fixed, labels, dict(names.defaults()))

@@ -20,14 +20,14 @@ from .captions import Captions, captions
 from .diagrams import bifurcation_diagram, period_plot, phase_plane, projections_figure
 from .freeplay import amplitude_diagram, has_amplitudes
 from .key import _PLOTTED_KINDS
-from .linear import linear_sweep_plot, root_locus_plot
+from .linear import damping_multiples_plot, linear_sweep_plot, root_locus_plot, sweep_datum
 from .maps import _oriented_grid, boundary_plot, overhang_diagram, slice_continuation
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-PLOT_KINDS = ("bifurcation", "linear", "root_locus", "projections", "period", "phase",
-              "boundary", "amplitude")
+PLOT_KINDS = ("bifurcation", "linear", "root_locus", "damping_multiples", "projections",
+              "period", "phase", "boundary", "amplitude")
 """Kinds accepted by :func:`save_study_plots`."""
 
 PHASE_ORBITS = 12
@@ -58,14 +58,32 @@ def missing_data(result: StudyResult, kind: str) -> str:
     if kind == "phase" and not any(b.is_periodic and b.orbits and len(b.state_names) >= 2
                                    for c in result.continuations for b in c.branches):
         return "no stored orbits on a periodic branch (periodic: true; orbits_at stores more)"
-    if kind in ("linear", "root_locus") and not result.linear_sweeps:
+    if kind in ("linear", "root_locus", "damping_multiples") and not result.linear_sweeps:
         return "no linear sweep (linear.sweeps)"
+    if kind == "damping_multiples" and not _multiple_sweeps(result):
+        return "no linear sweep of a parameter with a non-zero datum (linear.sweeps)"
     if kind == "boundary" and not result.boundaries and result.linear_grid is None:
         return "no stability boundary (a two-parameter continuation) and no linear grid " \
                "(linear.grid)"
     if kind == "amplitude" and not any(has_amplitudes(c) for c in result.continuations):
         return "no freeplay amplitudes (a periodic branch of a model with a freeplay law)"
     return ""
+
+
+def _datums(result: StudyResult) -> dict[str, float]:
+    """The datum of every parameter, for files whose sweeps do not store theirs: from the
+    file's parameter set, else (schema 1 files) from the model of the study stored with it."""
+    if result.parameters:
+        return {p.name: p.datum for p in result.parameters}
+    if not result.linear_sweeps:
+        return {}
+    return captions(result).datums
+
+
+def _multiple_sweeps(result: StudyResult) -> list:
+    """The linear sweeps that can be drawn against parameter / datum (a non-zero datum)."""
+    datums = _datums(result)
+    return [s for s in result.linear_sweeps if sweep_datum(s, datums) is not None]
 
 
 def available_kinds(result: StudyResult) -> tuple[str, ...]:
@@ -94,6 +112,10 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
     * "linear" -> ``<stem>_linear_<parameter>.png`` per linear sweep;
     * "root_locus" -> ``<stem>_root_locus_<parameter>.png`` per linear sweep
       (:func:`~whirl_cli.plots.linear.root_locus_plot`);
+    * "damping_multiples" -> ``<stem>_damping_multiples.png``, one for all the linear sweeps
+      of a parameter with a non-zero datum, given in multiples or not
+      (:func:`~whirl_cli.plots.linear.damping_multiples_plot`: the least-damped mode against
+      parameter / datum);
     * "amplitude" -> ``<stem>_<continuation>_amplitude.png`` per continuation with freeplay
       amplitudes (:func:`~whirl_cli.plots.freeplay.amplitude_diagram`: A/delta, the
       describing-function estimate dashed);
@@ -227,6 +249,13 @@ def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str,
             jobs.append((f"{stem}_root_locus_{sweep.parameter}.png",
                          lambda s=sweep: root_locus_plot(s, title=caption().title(
                              {s.parameter}))))
+    if "damping_multiples" in kinds:
+        chosen = _multiple_sweeps(result)
+        if chosen:
+            jobs.append((f"{stem}_damping_multiples.png",
+                         lambda c=tuple(chosen): damping_multiples_plot(
+                             c, _datums(result), hz=view.hz, title=caption().title(
+                                 {s.parameter for s in c}))))
     if "boundary" in kinds:
         jobs += _boundary_jobs(result, stem, state, caption, view)
     if "amplitude" in kinds:

@@ -1,9 +1,11 @@
 """Figures of linear sweeps: frequency and damping ratio of each mode against the parameter;
-the root locus (eigenvalues in the complex plane, coloured by the parameter).
+the root locus (eigenvalues in the complex plane, coloured by the parameter); the damping and
+frequency of the least-damped mode of several sweeps against parameter / datum.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -83,6 +85,92 @@ def root_locus_plot(sweep: LinearSweep, title: str | None = None, ax: Axes | Non
     ax.set_xlabel(axis_label("Re lambda", "1/s"))
     ax.set_ylabel(axis_label("Im lambda", "rad/s"))
     ax.set_title(f"root locus vs {sweep.parameter}" if title is None else title)
+    return figure
+
+
+def sweep_datum(sweep: LinearSweep, datums: Mapping[str, float] | None = None
+                ) -> float | None:
+    """The datum ``sweep`` is drawn in multiples of: the one it stores, else
+    ``datums[parameter]`` (older files: the file's parameter set); None if neither has it
+    or it is 0."""
+    datum = sweep.datum if sweep.datum is not None else (datums or {}).get(sweep.parameter)
+    return float(datum) if datum is not None and float(datum) != 0.0 else None
+
+
+def least_damped(sweep: LinearSweep) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(damping ratio, frequency [rad/s], whirl label) per point of the oscillatory mode with
+    the smallest damping ratio there (modes with Im(lambda) > 0; the label has the mode group
+    first for models with several, "nacelle BW"); NaN and "" where no mode oscillates.
+    Damping ratios equal to 1e-9 (FW and BW have equal ones without the aerodynamic
+    coupling, ``aero_coupling = 0``) go to the lowest-frequency mode, so the curve does not
+    hop between them."""
+    upper = np.asarray(sweep.eigenvalues).imag > 0
+    damping = np.where(upper, sweep.damping_ratio, np.inf)
+    lowest = np.min(damping, axis=1, keepdims=True)
+    tied = damping <= lowest + 1e-9 * np.where(np.isfinite(lowest), np.abs(lowest), 0.0) + 1e-15
+    column = np.argmax(tied, axis=1)[:, None]  # the first (lowest-frequency) of equal ones
+    some = upper.any(axis=1)
+    zeta = np.where(some, np.take_along_axis(damping, column, axis=1)[:, 0], np.nan)
+    freq = np.where(some, np.take_along_axis(np.asarray(sweep.frequency), column,
+                                             axis=1)[:, 0], np.nan)
+    labels = np.take_along_axis(np.asarray(sweep.whirl).astype(str), column, axis=1)[:, 0]
+    if sweep.mode_group is not None:
+        groups = np.take_along_axis(np.asarray(sweep.mode_group).astype(str), column,
+                                    axis=1)[:, 0]
+        labels = np.char.add(np.char.add(groups, " "), labels)
+    return zeta, freq, np.where(some, labels, "")
+
+
+def damping_multiples_plot(sweeps: Sequence[LinearSweep],
+                           datums: Mapping[str, float] | None = None, hz: bool = False,
+                           title: str | None = None,
+                           axes: tuple[Axes, Axes] | None = None) -> Figure:
+    """Damping ratio [-] (top) and frequency [rad/s, or Hz if ``hz``] (bottom) of the
+    least-damped mode (:func:`least_damped`) of each sweep against parameter / datum (thesis
+    figs. 3.9-3.11): one line per sweep in each panel, labelled by its parameter and the whirl
+    direction(s) of that mode in the order they appear along the sweep ("I_x (BW)",
+    "R (BW, FW)"; the mode group first for models with several); a dot marks each point
+    where the least-damped mode changes direction. The datum is the sweep's own
+    (:func:`sweep_datum`, else ``datums``); sweeps without a non-zero datum are left out.
+    A zero line on the damping panel, the datum (x = 1) dotted on both.
+
+    ``axes``: (damping axes, frequency axes) to draw into (None: a new figure). Title:
+    ``title`` (None: ``"least-damped mode vs parameter multiples"``).
+    """
+    if axes is None:
+        figure = _new_figure(figsize=(6.4, 6.4))
+        ax_damp, ax_freq = figure.subplots(2, 1, sharex=True)
+    else:
+        ax_damp, ax_freq = axes
+        figure = ax_damp.figure
+    scale = HZ_PER_RAD_S if hz else 1.0
+    colours = _colours()
+    drawn = 0
+    for sweep in sweeps:
+        datum = sweep_datum(sweep, datums)
+        if datum is None:
+            continue
+        zeta, freq, whirl = least_damped(sweep)
+        shown = [w for w in dict.fromkeys(whirl) if w]
+        label = f"{sweep.parameter} ({', '.join(shown)})" if shown else sweep.parameter
+        changes = [k for k in range(1, len(whirl)) if whirl[k] and whirl[k - 1]
+                   and whirl[k] != whirl[k - 1]]
+        x = np.asarray(sweep.values, dtype=float) / datum
+        style = {"color": next(colours), "label": label}
+        if changes:
+            style.update(marker="o", markersize=4, markevery=changes)
+        ax_damp.plot(x, zeta, **style)
+        ax_freq.plot(x, freq * scale, **style)
+        drawn += 1
+    ax_damp.axhline(0.0, color="black", linewidth=0.8, label="_zero")
+    for ax in (ax_damp, ax_freq):
+        ax.axvline(1.0, color="grey", linewidth=0.8, linestyle=":", label="_datum")
+    ax_damp.set_ylabel(axis_label("damping ratio", ""))
+    ax_freq.set_ylabel(axis_label("frequency", "Hz" if hz else "rad/s"))
+    ax_freq.set_xlabel("parameter / datum")
+    if drawn:
+        ax_damp.legend(fontsize="small")
+    ax_damp.set_title("least-damped mode vs parameter multiples" if title is None else title)
     return figure
 
 

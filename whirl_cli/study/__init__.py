@@ -57,6 +57,7 @@ from .reference import schema_reference
 from .schema import (
     AutoSettings,
     Linear,
+    LinearAxisSpec,
     LinearSpec,
     LinearSweepSpec,
     OneParameterContinuation,
@@ -71,6 +72,7 @@ __all__ = [
     "AutoSettings",
     "Linear",
     "LinearSpec",
+    "LinearAxisSpec",
     "LinearSweepSpec",
     "OneParameterContinuation",
     "Polynomial",

@@ -62,7 +62,9 @@ def _meaning_problems(data: dict) -> list[Problem]:
     for axis in ("x", "y"):
         spec = grid.get(axis) if isinstance(grid, dict) else None
         if isinstance(spec, dict):
-            problems += _sweep_problems(("linear", "grid", axis), spec, names, family, values)
+            axis_spec = {k: v for k, v in spec.items() if k != "multiples"}  # sweeps only
+            problems += _sweep_problems(("linear", "grid", axis), axis_spec, names, family,
+                                        values)
     return problems
 
 
@@ -140,9 +142,32 @@ def _sweep_problems(loc: Loc, spec: dict, names: Names, family: str,
     if found or not isinstance(name, str):
         return found
     canonical = names.canonical(name)
-    return _range_problems(loc + ("range",), canonical, spec.get("range"), names, "swept") \
-        or _range_constraint_problems(loc + ("range",), canonical, spec.get("range"), family,
-                                      values)
+    bounds = spec.get("range")
+    if spec.get("multiples") is True:
+        found = _multiples_problems(loc, canonical, bounds, names)
+        if found:
+            return found
+        datum = names.parameter(canonical).default
+        bounds = [b * datum for b in bounds] if isinstance(bounds, list) and len(bounds) == 2 \
+            and all(_finite(b) is not None for b in bounds) else bounds
+    return _range_problems(loc + ("range",), canonical, bounds, names, "swept") \
+        or _range_constraint_problems(loc + ("range",), canonical, bounds, family, values)
+
+
+def _multiples_problems(loc: Loc, canonical: str, bounds: Any, names: Names) -> list[Problem]:
+    """A sweep in multiples of its parameter's datum: a non-zero datum, multiples > 0."""
+    parameter = names.parameter(canonical)
+    if parameter.default == 0.0:
+        unit = f" {parameter.unit}" if parameter.unit not in ("", "1") else ""
+        return [(loc + ("multiples",), f"the datum of {canonical} is 0{unit}: it has no "
+                 f"multiples; give the range in {canonical}'s unit (multiples: false)")]
+    ends = [_finite(b) for b in bounds] if isinstance(bounds, list) and len(bounds) == 2 else []
+    bad = [e for e in ends if e is not None and not e > 0]
+    if bad:
+        return [(loc + ("range",), f"with multiples: true the range is in multiples of the "
+                 f"datum of {canonical} ({parameter.default:g}) and must be > 0, got "
+                 f"{bad[0]!r}")]
+    return []
 
 
 def _dict_items(items: Any) -> Iterator[tuple[int, dict]]:

@@ -98,11 +98,12 @@ def names_of(family: str, laws: list[tuple[str, Any]]) -> Names | None:
     a dof is unknown, named twice or a law type unknown."""
     declared = FAMILIES[family]
     dofs = [dof for dof, _ in laws]
-    if not set(dofs) <= set(declared.dof_names) or len(set(dofs)) != len(dofs):
+    if not all(isinstance(d, str) for d in dofs) or not set(dofs) <= set(declared.dof_names) \
+            or len(set(dofs)) != len(dofs):
         return None
     types = {dof: _get(block, "type") for dof, block in laws}
-    if not set(types.values()) <= set(LAW_TYPES):
-        return None
+    if not all(isinstance(t, str) and t in LAW_TYPES for t in types.values()):
+        return None  # (a type of the wrong type, e.g. a list, is a structural problem)
     per_dof = tuple("polynomial" if types.get(d, "linear") == "linear" else types[d]
                     for d in declared.dof_names)
     model = get_model(family, per_dof)

@@ -355,14 +355,14 @@ class TwoParameterContinuation(_Strict):
         return tuple(s.label for s in self.slices)
 
 
-PlotKind = Literal["bifurcation", "linear", "root_locus", "projections", "period", "phase",
-                   "boundary", "amplitude"]
+PlotKind = Literal["bifurcation", "linear", "root_locus", "damping_multiples", "projections",
+                   "period", "phase", "boundary", "amplitude"]
 Continuation = Annotated[OneParameterContinuation | TwoParameterContinuation,
                         Field(discriminator="type")]
 
 
-class LinearSweepSpec(_Strict):
-    """Eigenvalues along one parameter, on an even grid."""
+class LinearAxisSpec(_Strict):
+    """One parameter on an even grid of values: a grid axis."""
 
     parameter: Text = Field(
         description="Swept parameter, by name or alias (stored as the canonical name)."
@@ -373,11 +373,23 @@ class LinearSweepSpec(_Strict):
     )
 
 
+class LinearSweepSpec(LinearAxisSpec):
+    """Eigenvalues along one parameter, on an even grid (of its values, or of multiples of
+    its datum)."""
+
+    range: Range = Field(description="[lower, upper] of the sweep, in the parameter's unit "
+                         "(with `multiples: true`, in multiples of its datum, both > 0).")
+    multiples: Boolean = Field(
+        False, description="`range` is in multiples of the parameter's datum (the model's "
+        "value, `whirl models`), e.g. [0.25, 4]; the sweep is stored in absolute values with "
+        "the datum beside them. The datum must be non-zero.")
+
+
 class LinearGridSpec(_Strict):
     """Linear stability over a grid of two parameters."""
 
-    x: LinearSweepSpec = Field(description="First grid axis: parameter, range, points.")
-    y: LinearSweepSpec = Field(description="Second grid axis: parameter, range, points.")
+    x: LinearAxisSpec = Field(description="First grid axis: parameter, range, points.")
+    y: LinearAxisSpec = Field(description="Second grid axis: parameter, range, points.")
 
 
 class LinearSpec(_Strict):
