@@ -412,7 +412,9 @@ def figures(paths: tuple[Path, ...], out_dir: Path, results_dir: Path, jobs: int
     for outcome in outcomes:
         if outcome.image is None:
             click.echo(f"figure {outcome.sheet.figure}: not drawn: {outcome.problem}", err=True)
-    click.echo(f"{len(drawn)} of {len(outcomes)} figures -> {out_dir / 'index.html'}")
+    reused = sum(o.reused for o in outcomes)
+    click.echo(f"{len(drawn)} of {len(outcomes)} figures ({reused} up to date, not redrawn) -> "
+               f"{out_dir / 'index.html'}")
     if len(drawn) < len(outcomes):
         raise WhirlError(f"{len(outcomes) - len(drawn)} of {len(outcomes)} figures not drawn")
 

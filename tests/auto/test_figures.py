@@ -50,10 +50,16 @@ def test_figures_run_draw_index_and_reuse(tmp_path):
     stored = sorted(p.name for p in results.iterdir())
     assert stored == ["linear-case2.h5", "linear-datum-airspeed.h5"]
     assert store.read(results / "linear-case2.h5").continuations
-    stamps = {p: p.stat().st_mtime_ns for p in results.iterdir()}
+    stamps = {p: p.stat().st_mtime_ns for p in [*results.iterdir(), *out.glob("*.png")]}
     again = make_figures([folder], out, results, jobs=2)
-    assert [o.image.name for o in again] == ["fig9_1.png", "fig9_2.png"]
-    assert {p: p.stat().st_mtime_ns for p in results.iterdir()} == stamps  # nothing rerun
+    assert [(o.image.name, o.reused) for o in again] == [("fig9_1.png", True),
+                                                         ("fig9_2.png", True)]
+    # nothing rerun, nothing redrawn
+    assert {p: p.stat().st_mtime_ns for p in [*results.iterdir(), *out.glob("*.png")]} == stamps
+    sheet = folder / "fig9_2.yaml"
+    sheet.write_text(sheet.read_text().replace("two results", "2 results"))
+    changed = make_figures([folder], out, results, jobs=2)
+    assert [o.reused for o in changed] == [True, False]  # only the edited sheet is redrawn
 
 
 def test_a_figure_that_cannot_be_drawn_is_reported(tmp_path):

@@ -59,7 +59,7 @@ def test_sheet_reads_and_resolves_study_paths(tmp_path):
     ("panels:\n  - {kind: bifurcation}\n",
      "f.yaml:4: panels[0]: give exactly one of `study` and `overlay`"),
     ("panels:\n  - {kind: period, overlay: [{study: a.yaml}]}\n",
-     "f.yaml:4: panels[0]: only bifurcation panels can be overlaid"),
+     "f.yaml:4: panels[0]: only bifurcation and damping_multiples panels can be overlaid"),
     ("panels:\n  - {kind: contour, study: a.yaml}\n",
      "f.yaml:4: panels[0].kind: expected one of bifurcation"),
     ("layout: [1, 1]\npanels:\n  - {kind: bifurcation, study: a.yaml}\n"
@@ -176,3 +176,18 @@ def test_index_lists_figures_in_number_order_escaped():
     assert '<img src="fig3_12.png"' in page
     assert "not drawn: study failed" in page and "a note" in page
     assert np.char.count(page, "<section").item() == 2
+
+
+def test_damping_multiples_overlay_style_per_result_colour_per_parameter(continuation):  # noqa: F811
+    sweep = replace(make_sweep(), datum=0.25)
+    results = [replace(result_with(continuation, k2), linear_sweeps=(sweep,))
+               for k2 in (5.0, 10.0)]
+    ax = _new_figure().add_subplot()
+    damping, frequency = draw_overlay(results, "damping_multiples", ax, ["on", "off"])
+    for panel in (damping, frequency):
+        lines = [line for line in panel.lines if not line.get_label().startswith("_")]
+        assert [line.get_label() for line in lines] == ["on: K1 (BW)", "off: K1 (BW)"]
+        assert [line.get_linestyle() for line in lines] == ["-", "--"]
+        assert to_hex(lines[0].get_color()) == to_hex(lines[1].get_color())
+        np.testing.assert_allclose(lines[0].get_xdata(), sweep.values / 0.25)
+    assert frequency.get_xlabel() == "parameter / datum"

@@ -349,11 +349,12 @@ def _unique(path: Path, taken: list[Path]) -> Path:
     return candidate
 
 
-def _png(figure: Figure, dpi: int) -> bytes:
-    """``figure`` rendered as PNG bytes (the figure is cleared afterwards)."""
+def _png(figure: Figure, dpi: int, metadata: dict[str, str] | None = None) -> bytes:
+    """``figure`` rendered as PNG bytes, with ``metadata`` as PNG text chunks (the figure is
+    cleared afterwards)."""
     buffer = io.BytesIO()
     try:
-        figure.savefig(buffer, format="png", dpi=dpi)
+        figure.savefig(buffer, format="png", dpi=dpi, metadata=metadata)
     finally:
         figure.clear()
     return buffer.getvalue()

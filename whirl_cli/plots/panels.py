@@ -30,18 +30,18 @@ from .diagrams import (
 )
 from .freeplay import amplitude_diagram, has_amplitudes
 from .key import PLOT_KEY, _colours, display_unit, stability_segments
-from .linear import linear_sweep_plot, root_locus_plot
+from .linear import damping_multiples_plot, linear_sweep_plot, root_locus_plot
 from .maps import _oriented_grid, boundary_plot, overhang_diagram, slice_index
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
 PANEL_KINDS = ("bifurcation", "projections", "period", "phase", "linear", "root_locus",
-               "boundary", "overhang", "amplitude")
+               "damping_multiples", "boundary", "overhang", "amplitude")
 """Kinds :func:`draw` accepts (``overhang``: one slice of a boundary, its unsafe intervals
 shaded)."""
 
-OVERLAY_KINDS = ("bifurcation",)
+OVERLAY_KINDS = ("bifurcation", "damping_multiples")
 """Kinds :func:`draw_overlay` accepts."""
 
 
@@ -100,6 +100,8 @@ def draw(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice = PanelCh
         phase_plane(branch, labels=labels, y=choice.state, ax=ax,
                     title=caption.title(branch.parameter_names) if title is None else title)
         return [ax]
+    if kind == "damping_multiples":
+        return _replaced(ax, lambda region: _draw_multiples(result, region, choice, caption))
     if kind in ("linear", "root_locus"):
         sweep = _pick_sweep(result, choice.sweep)
         title = caption.title({sweep.parameter}) if title is None else title
@@ -110,6 +112,22 @@ def draw(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice = PanelCh
             sweep, hz=choice.hz, title=title,
             axes=tuple(region.subgridspec(2, 1).subplots(sharex=True))), share=False)
     return _draw_map(result, kind, ax, choice, caption)
+
+
+def _draw_multiples(result: StudyResult, region, choice: PanelChoice, caption,
+                    axes=None) -> None:
+    """The ``damping_multiples`` kind (every sweep with a non-zero datum, or ``choice.sweep``)
+    into ``region`` (or onto ``axes``, damping and frequency)."""
+    from .files import _datums, _multiple_sweeps
+
+    sweeps = [s for s in _multiple_sweeps(result) if choice.sweep in (None, s.parameter)]
+    if not sweeps:
+        raise WhirlError(f"{result.study_name}: no linear sweep with a non-zero datum"
+                         + (f" of {choice.sweep!r}" if choice.sweep else ""))
+    if axes is None:
+        axes = tuple(region.subgridspec(2, 1).subplots(sharex=True))
+    title = choice.title or caption.title({s.parameter for s in sweeps})
+    damping_multiples_plot(sweeps, _datums(result), hz=choice.hz, title=title, axes=axes)
 
 
 def _draw_map(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice, caption
@@ -224,9 +242,11 @@ def differing_labels(results: Sequence[StudyResult]) -> list[str]:
 def draw_overlay(results: Sequence[StudyResult], kind: str, ax: Axes,
                  labels: Sequence[str | None] = (), choice: PanelChoice = PanelChoice(),
                  title: str | None = None) -> list[Axes]:
-    """Several results' diagrams of ``kind`` (:data:`OVERLAY_KINDS`) on one Axes: each result
-    in its own colour, stable branches solid and unstable dotted, special points with the
-    markers of :data:`PLOT_KEY`; the legend has one entry per result, labelled by
+    """Several results' diagrams of ``kind`` (:data:`OVERLAY_KINDS`) on one Axes: for
+    ``bifurcation`` each result in its own colour, stable branches solid and unstable dotted,
+    special points with the markers of :data:`PLOT_KEY`; for ``damping_multiples`` each
+    parameter in its own colour, each result in its own line style (the Axes split in
+    damping and frequency). The legend names each result by
     ``labels`` (missing or None: :func:`differing_labels`). Title: ``title`` (None: the
     parameters off their datum that every result shares and the diagram does not vary)."""
     if kind not in OVERLAY_KINDS:
@@ -237,6 +257,9 @@ def draw_overlay(results: Sequence[StudyResult], kind: str, ax: Axes,
     auto = differing_labels(results)
     names = [labels[k] if k < len(labels) and labels[k] else auto[k]
              for k in range(len(results))]
+    if kind == "damping_multiples":
+        return _replaced(ax, lambda region: _overlay_multiples(results, names, region, choice,
+                                                               title))
     first: dict[str, object] = {}
     handles = []
     state = choice.state
@@ -267,6 +290,25 @@ def draw_overlay(results: Sequence[StudyResult], kind: str, ax: Axes,
         title = ", ".join(kept)
     ax.set_title(title)
     return [ax]
+
+
+def _overlay_multiples(results: Sequence[StudyResult], names: Sequence[str], region,
+                       choice: PanelChoice, title: str | None) -> None:
+    """Every result's ``damping_multiples`` on one pair of axes: a colour per parameter (in
+    the order of each result's sweeps), a line style per result, its lines labelled
+    ``"<name>: <parameter> (<whirl>)"``."""
+    axes = tuple(region.subgridspec(2, 1).subplots(sharex=True))
+    styles = ("-", "--", "-.", ":")
+    for k, (result, name) in enumerate(zip(results, names, strict=True)):
+        before = [len(a.lines) for a in axes]
+        _draw_multiples(result, None, choice, captions(result), axes=axes)
+        for ax, start in zip(axes, before, strict=True):  # colours: by parameter already
+            for line in ax.lines[start:]:
+                if not line.get_label().startswith("_"):
+                    line.set_linestyle(styles[k % len(styles)])
+                    line.set_label(f"{name}: {line.get_label()}")
+    axes[0].legend(fontsize="small")
+    axes[0].set_title(title if title is not None else "")
 
 
 def _draw_coloured(ax: Axes, branch: Branch, state: str, colour: str):
