@@ -60,7 +60,9 @@ def lorenz_motion():
 
 def test_lorenz_largest_lyapunov_exponent(lorenz_motion):
     assert lorenz_motion.lyapunov == pytest.approx(LORENZ_EXPONENT, rel=0.02)
-    assert lorenz_motion.lyapunov_error < 0.02 * LORENZ_EXPONENT
+    # the confidence: small, and honest (the literature value within three standard errors)
+    assert 0 < lorenz_motion.lyapunov_error < 0.05 * LORENZ_EXPONENT
+    assert abs(lorenz_motion.lyapunov - LORENZ_EXPONENT) < 3 * lorenz_motion.lyapunov_error
 
 
 def test_lorenz_is_chaotic(lorenz_motion):
