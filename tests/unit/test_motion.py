@@ -87,6 +87,16 @@ def test_hopf_cycle_is_periodic_at_its_closed_form_frequency():
     assert np.abs(motion.section[:, 1] + np.sqrt(mu - level**2)).max() < 1e-4
 
 
+def test_a_cycle_not_yet_reached_is_periodic_and_said_unsettled():
+    # attraction at -2 mu = -0.1 1/s: after 10 s the radius is still 0.16 of the cycle's 0.224
+    field, jacobian = hopf(0.05, 2 * np.pi, 0.0)
+    motion = classify(field, jacobian, [0.05, 0.0], transient=10.0, duration=30.0, dt=0.025,
+                      section_state=0)
+    assert motion.kind == "periodic", motion.evidence
+    assert "not settled" in motion.evidence
+    assert motion.frequencies[0] == pytest.approx(1.0, rel=1e-4)  # omega / 2 pi at any radius
+
+
 def test_two_incommensurate_oscillators_are_quasi_periodic_with_both_frequencies():
     first = hopf(1.0, 2 * np.pi, 0.5)
     second = hopf(0.5, 2 * np.pi * np.sqrt(2.0), 0.0)

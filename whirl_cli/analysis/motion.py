@@ -34,9 +34,11 @@ The class (:class:`MotionClass`), in this order:
    largest exponent (on any other bounded orbit the flow direction gives lambda >= 0);
 3. ``chaotic``: lambda > threshold + 3 error;
 4. otherwise lambda is zero within its confidence, and the section decides: points repeating
-   with a lag k -> ``periodic`` (period-k; ``multiplicity`` k); points on a curve (D2 < 1.5) or a
-   spectrum of two base frequencies -> ``quasi-periodic``; a cloud with a broadband spectrum
-   -> ``chaotic`` (weakly: lambda not resolved from zero; the evidence says so).
+   with a lag k, or whose lag-k distances shrink steadily (a period-k orbit not yet reached,
+   said in the evidence) -> ``periodic`` (period-k; ``multiplicity`` k); points on a curve
+   (D2 < 1.5) or a spectrum of two base frequencies -> ``quasi-periodic``; a cloud with a
+   broadband spectrum -> ``chaotic`` (weakly: lambda not resolved from zero; the evidence
+   says so).
 
 threshold = ``lyapunov_tolerance`` (1/s), by default 0.01 x 2 pi f_dom (an e-fold in 16
 periods of the dominant frequency f_dom of the spectrum). Frequencies (Hz) reported: the
@@ -125,14 +127,18 @@ def _lagrange_slope(s: np.ndarray) -> np.ndarray:
 
 
 def section_geometry(points: np.ndarray, scale: np.ndarray,
-                     tolerance: float = 1e-2) -> tuple[int, float, float]:
-    """(k, D2, spread) of section ``points`` (m, n) in units of ``scale`` (n,): k the smallest
-    lag <= :data:`MAX_MULTIPLICITY` with max |p_i+k - p_i| <= ``tolerance`` over the last half
-    of the points (0 if none), spread that largest distance for k (or for k = 1), D2 the
-    correlation dimension (NaN below 10 points)."""
+                     tolerance: float = 1e-2) -> tuple[int, float, float, int, float]:
+    """(k, D2, spread, k_c, rate) of section ``points`` (m, n) in units of ``scale`` (n,): k the
+    smallest lag <= :data:`MAX_MULTIPLICITY` with max |p_i+k - p_i| <= ``tolerance`` over the
+    last half of the points (0 if none), spread that largest distance for k (or for k = 1), D2
+    the correlation dimension (NaN below 10 points); k_c the smallest lag whose distances s_i =
+    max |p_i+k - p_i| shrink steadily over the last half of the points (correlation of ln s_i
+    with i below -0.9, at least 8 of them: a period-k orbit not yet reached, where a torus's
+    distances only fluctuate; 0 if none) and rate the factor by which they shrink per return (a
+    fit of ln s_i)."""
     m = len(points)
     if m < 3:
-        return 0, np.nan, np.nan
+        return 0, np.nan, np.nan, 0, np.nan
     unit = points / scale
     late = unit[m // 2:]
     spreads = [np.max(np.abs(late[k:] - late[:-k])) for k in range(1, MAX_MULTIPLICITY + 1)
@@ -146,7 +152,18 @@ def section_geometry(points: np.ndarray, scale: np.ndarray,
         pairs = distances[np.triu_indices(m, 1)]
         low, high = np.percentile(pairs, [5.0, 30.0])
         dimension = float(np.log(6.0) / np.log(high / low)) if low > 0 else 0.0
-    return multiplicity, dimension, spread
+    converging, rate = 0, np.nan
+    for k in range(1, MAX_MULTIPLICITY + 1):
+        lags = np.max(np.abs(unit[k:] - unit[:-k]), axis=1)
+        lags = lags[len(lags) // 2:]  # the approach is steady only near the orbit
+        if len(lags) < 8 or np.any(lags <= 0):
+            continue
+        logs = np.log(lags)
+        order = np.arange(len(logs))
+        if np.corrcoef(order, logs)[0, 1] < -0.9:
+            converging, rate = k, float(np.exp(np.polyfit(order, logs, 1)[0]))
+            break
+    return multiplicity, dimension, spread, converging, rate
 
 
 # ------------------------------------------------------------------------------ (c) spectrum
@@ -263,7 +280,8 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
     # (a) section geometry in units of each state's spread (states that hardly move: the
     # largest spread, so they count as fixed)
     units = np.where(spread > 1e-9 * spread.max(), spread, spread.max())
-    multiplicity, dimension, drift = section_geometry(section, units, section_tolerance)
+    multiplicity, dimension, drift, converging, rate = section_geometry(section, units,
+                                                                         section_tolerance)
     # (c) spectrum
     frequency, power = spectrum(time, states, scale)
     peaks, _, broadband = spectral_peaks(frequency, power)
@@ -291,6 +309,11 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
         kind, found = "chaotic", strongest
     elif multiplicity:
         kind, found = "periodic", (1.0 / (multiplicity * returns),)
+    elif converging:
+        multiplicity = converging
+        kind, found = "periodic", (1.0 / (multiplicity * returns),)
+        evidence.append(f"not settled: the section's lag-{converging} distances shrink by "
+                        f"{rate:.3g} per return, towards a period-{converging} orbit")
     elif (np.isfinite(dimension) and dimension < CURVE_DIMENSION) or len(bases) == 2:
         others = [p for p in peaks if abs(p * returns - round(p * returns)) > 1.5 * bins
                   * returns]
