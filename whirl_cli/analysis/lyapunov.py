@@ -181,7 +181,9 @@ def exponent_between(time: np.ndarray, growth: np.ndarray, marks: np.ndarray | N
     at least ``blocks`` + 1 of them in the window) a and b and the block ends are crossings,
     so that a bounded oscillation of |v| along a cycle cancels; else equal-length blocks.
     The error is the standard deviation of the ``blocks`` block exponents over
-    sqrt(blocks) (blocks treated as independent)."""
+    sqrt(blocks) (blocks treated as independent). Fewer than two samples: (NaN, inf)."""
+    if len(time) < 2:
+        return np.nan, np.inf
     start = time[0] + discard * (time[-1] - time[0])
     ends = None
     if marks is not None:

@@ -36,10 +36,11 @@ The class (:class:`MotionClass`), in this order:
 3. ``chaotic``: lambda > threshold + 3 error;
 4. otherwise lambda is zero within its confidence, and the section decides: points repeating
    with a lag k, or whose lag-k distances shrink steadily (a period-k orbit not yet reached,
-   said in the evidence) -> ``periodic`` (period-k; ``multiplicity`` k); points on a curve
-   (D2 < 1.5) or a spectrum of two base frequencies -> ``quasi-periodic``; a cloud with a
-   broadband spectrum -> ``chaotic`` (weakly: lambda not resolved from zero; the evidence
-   says so).
+   said in the evidence) -> ``periodic`` (period-k; ``multiplicity`` k); else a spectrum of
+   one fundamental and its harmonics (under 1 % broadband) -> ``periodic`` (the evidence says
+   the section did not repeat); else points on a curve (D2 < 1.5) or a spectrum of two base
+   frequencies -> ``quasi-periodic``; else (a cloud, a broadband spectrum) -> ``chaotic``
+   (weakly: lambda not resolved from zero; the evidence says so).
 
 threshold = ``lyapunov_tolerance`` (1/s), by default 0.01 x 2 pi f_dom (an e-fold in 16
 periods of the dominant frequency f_dom of the spectrum). Frequencies (Hz) reported: the
@@ -320,6 +321,10 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
         kind, found = "periodic", (1.0 / (multiplicity * returns),)
         evidence.append(f"not settled: the section's lag-{converging} distances shrink by "
                         f"{rate:.3g} per return, towards a period-{converging} orbit")
+    elif len(bases) == 1 and broadband < 0.01:
+        kind, found = "periodic", bases
+        evidence.append("the spectrum is one fundamental and its harmonics, though the section "
+                        f"did not repeat within {section_tolerance:g}")
     elif (np.isfinite(dimension) and dimension < CURVE_DIMENSION) or len(bases) == 2:
         others = [p for p in peaks if abs(p * returns - round(p * returns)) > 1.5 * bins
                   * returns]
