@@ -11,6 +11,11 @@ imported inside functions.
   family: homoclinic or heteroclinic approach, bracketed;
 * :mod:`~whirl_cli.analysis.simulate` -- time simulation (scipy), the cross-check of what
   continuation claims;
+* :mod:`~whirl_cli.analysis.lyapunov` -- the largest Lyapunov exponent of any ODE by the
+  variational equations (Benettin), with its standard error;
+* :mod:`~whirl_cli.analysis.motion` -- what a simulation settles to where AUTO cannot
+  continue: equilibrium, periodic, quasi-periodic, chaotic or diverged, from a Poincaré
+  section, the Lyapunov exponent and the spectrum;
 * :mod:`~whirl_cli.analysis.boundaries` -- stability boundaries in two parameters and the
   unsafe (overhang) region.
 """
