@@ -255,7 +255,7 @@ def test_model_validate_fills_the_same_defaults():
         (
             "plots: [bifurcation, bubble]\n",
             "s.yaml:3: plots[1]: expected one of bifurcation, linear, root_locus, projections, "
-            "period, phase, boundary, amplitude, got 'bubble'",
+            "period, phase, boundary, amplitude, time_history, hub_path, got 'bubble'",
         ),
         (
             "nonlinearity: {type: linear, dof: phi}\n",
@@ -278,7 +278,8 @@ def test_model_validate_fills_the_same_defaults():
         (
             "grid: {x: 1}\n",
             "s.yaml:3: grid: unknown key (allowed: name, description, model, parameters, "
-            "nonlinearity, continuations, linear, plots, plot_state, cross_check, auto)",
+            "nonlinearity, continuations, linear, simulations, plots, plot_state, cross_check, "
+            "auto)",
         ),
         ("linear: {grid: 1}\n", "s.yaml:3: linear.grid: expected a mapping, got 1"),
         ("linear: {table: 1}\n",
@@ -661,6 +662,8 @@ def test_schema_reference_lists_every_key_with_a_description():
     expected |= {f"continuations[].{k}" for k in TwoParameterContinuation.model_fields}
     expected |= {f"auto.{k}" for k in AutoSettings.model_fields}
     expected |= {"continuations[].slices[].value", "continuations[].slices[].label"}
+    expected |= {"simulations"} | {f"simulations[].{k}" for k in (
+        "name", "parameters", "initial", "duration", "samples", "law")}
     assert set(rows) == expected
     for line in lines[2:]:
         cells = [c.strip() for c in line.strip("|").split(" | ")]

@@ -174,6 +174,7 @@ def _with_derived_defaults(block: Any) -> Any:
 def _resolved(data: dict) -> dict:
     """``data`` with dof, law defaults, canonical parameter names and start values filled
     where possible."""
+    data = _named_simulations(data)
     names = _names_of_data(data)
     if names is None:
         return data
@@ -202,6 +203,16 @@ def _resolved(data: dict) -> dict:
         grid = {k: _resolved_item(v, names, None) for k, v in linear["grid"].items()}
         data["linear"] = {**linear, "grid": grid}
     return data
+
+
+def _named_simulations(data: dict) -> dict:
+    """``data`` with every simulation mapping named (``sim_<k>``, k its position from 1)."""
+    items = data.get("simulations")
+    if not isinstance(items, list | tuple):
+        return data
+    return {**data, "simulations": [
+        {**item, "name": f"sim_{k}"} if isinstance(item, dict) and item.get("name") is None
+        else item for k, item in enumerate(items, 1)]}
 
 
 def _resolved_pair(item: dict, names: Names, values: dict[str, float] | None) -> dict:
