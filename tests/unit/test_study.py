@@ -826,7 +826,15 @@ def test_a_labelled_slice_is_checked_like_a_number():
         "K_psi"]
     found = problems(HEAD + PAIR + "    slices: [{label: x}, {value: 0.1, name: y}, ten]\n")
     assert len(found) == 3
-    assert found[2] == ("s.yaml:8: continuations[0].slices[2]: expected a number or a mapping "
-                        "{value, label}, got 'ten'")
+    assert found[2] == ("s.yaml:8: continuations[0].slices[2]: expected a finite number or a "
+                        "mapping {value, label}, got 'ten'")
+    assert problems(HEAD + PAIR + "    slices: [.nan]\n") == [
+        "s.yaml:8: continuations[0].slices[0]: expected a finite number or a mapping {value, "
+        "label}, got .nan"]
     assert found[0].startswith("s.yaml:8: continuations[0].slices[0].value: ")
     assert found[1].startswith("s.yaml:8: continuations[0].slices[1].name: ")
+
+
+def test_a_law_type_of_the_wrong_type_is_a_message_not_a_crash():
+    assert problems(HEAD + "nonlinearity: {type: [1, 2]}\n") == [
+        "s.yaml:3: nonlinearity.type: expected one of linear, polynomial, freeplay, got a list"]

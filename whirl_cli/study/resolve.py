@@ -101,8 +101,8 @@ def names_of(family: str, laws: list[tuple[str, Any]]) -> Names | None:
     if not set(dofs) <= set(declared.dof_names) or len(set(dofs)) != len(dofs):
         return None
     types = {dof: _get(block, "type") for dof, block in laws}
-    if not set(types.values()) <= set(LAW_TYPES):
-        return None
+    if not all(isinstance(t, str) and t in LAW_TYPES for t in types.values()):
+        return None  # an unknown or malformed type (e.g. a list): reported by the schema
     per_dof = tuple("polynomial" if types.get(d, "linear") == "linear" else types[d]
                     for d in declared.dof_names)
     model = get_model(family, per_dof)

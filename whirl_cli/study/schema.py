@@ -293,8 +293,8 @@ def _as_slice(value: Any) -> Any:
     """A slice given as a bare number is ``{value: number}``."""
     if isinstance(value, dict):
         return value
-    if not _is_number(value):
-        _fail("expected a number or a mapping {{value, label}}, got {got}")
+    if _finite(value) is None:
+        _fail("expected a finite number or a mapping {{value, label}}, got {got}")
     return {"value": value}
 
 
