@@ -6,9 +6,10 @@ study may use (:class:`~whirl_cli.study.resolve.Names`), law coefficients only u
 of a list naming its dof), a parameter given once, values and ranges inside the physical
 bounds, the family's constraints on several parameters at once (e.g. I_d < I_y, for the
 study's values and at each end of a range), unique continuation names, ``start``,
-``slices`` and ``orbits_at`` inside ``range``, ``plot_state`` and seed keys states of the
-model, and what a law requires of its coefficients together (freeplay: epsilon < delta,
-K_out > K_in).
+``slices`` and ``orbits_at`` inside ``range``, ``plot_state``, seed keys and the initial states
+of ``simulations`` states of the model, unique simulation names, their overrides checked like
+the study's, ``law: exact`` only with a piecewise law, and what a law requires of its
+coefficients together (freeplay: epsilon < delta, K_out > K_in).
 """
 
 from __future__ import annotations
