@@ -105,6 +105,12 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     if checks:
         console.print(f"cross-checks by time simulation: {sum(x.passed for x in checks)} of "
                       f"{len(checks)} passed")
+    for sim in result.simulations:
+        state = "ok" if sim.status == 0 else ("stopped" if sim.status > 0 else "FAILED")
+        console.print(f"simulation {sim.name}: {len(sim.time)} samples to "
+                      f"{sim.time[-1] if len(sim.time) else 0:.6g} s, {state}"
+                      + ("" if sim.status == 0 else f": {sim.message}"), soft_wrap=True,
+                      markup=False)
     if found.problems:
         raise WhirlError(f"{len(found.problems)} problem(s); the results are stored with "
                          "their status: " + "; ".join(found.problems))
@@ -243,7 +249,8 @@ def _limits(ctx: click.Context, param: click.Parameter, value):
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--kind", "kinds", multiple=True,
               type=click.Choice(["bifurcation", "linear", "root_locus", "damping_multiples",
-                                 "projections", "period", "phase", "boundary", "amplitude"]),
+                                 "projections", "period", "phase", "boundary", "amplitude",
+                                 "time_history", "hub_path"]),
               help="Plot kind (repeatable) [default: every kind the file has the data for]; "
                    "a kind it lacks the data for is an error.")
 @click.option("-o", "--output-dir", type=click.Path(file_okay=False, path_type=Path),
@@ -277,7 +284,7 @@ def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None,
     kinds = kinds or available_kinds(result)
     if not kinds:
         raise WhirlError(f"{result_file.name}: nothing to plot (no continuation, linear "
-                         "sweep, boundary or linear grid)")
+                         "sweep, boundary, linear grid or simulation)")
     output_dir = output_dir or result_file.parent
     try:
         output_dir.mkdir(parents=True, exist_ok=True)

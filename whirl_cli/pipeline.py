@@ -1,4 +1,5 @@
-"""A whole study, end to end: Study -> model -> AUTO runs + linear analysis -> StudyResult.
+"""A whole study, end to end: Study -> model -> AUTO runs + linear analysis + simulations ->
+StudyResult.
 
 ``run_study`` is what ``whirl run`` calls; it does not write files other than AUTO's working
 directories under ``workroot`` (the caller stores the result with :mod:`whirl_cli.output.store`).
@@ -25,6 +26,7 @@ from .results import (
     ContinuationResult,
     ParameterValue,
     SeedOutcome,
+    Simulation,
     StudyResult,
 )
 from .study import Study
@@ -32,7 +34,8 @@ from .study import Study
 
 def run_study(study: Study, workroot: Path, jobs: int = 1,
               on_run: Callable[[RunOutcome], None] | None = None) -> StudyResult:
-    """Run every continuation and linear sweep of ``study``; AUTO works under ``workroot``.
+    """Run every continuation, linear sweep and simulation of ``study``; AUTO works under
+    ``workroot`` (a study without continuations needs no AUTO).
 
     In the main thread, SIGINT and SIGTERM kill the running AUTO processes at once and raise
     :class:`whirl_cli.interrupts.Interrupted` (a KeyboardInterrupt), see
@@ -100,7 +103,17 @@ def _run_study(study: Study, workroot: Path, jobs: int,
         study_name=study.name, model=model.name, continuations=tuple(continuations),
         linear_sweeps=tuple(sweeps), runs=engine.records() if engine else (),
         attributes=provenance(study), boundaries=tuple(found_boundaries), linear_grid=grid,
-        parameters=resolved_parameters(model, parameters))
+        parameters=resolved_parameters(model, parameters),
+        simulations=tuple(simulations(study, model)))
+
+
+def simulations(study: Study, model) -> list[Simulation]:
+    """The study's ``simulations:``, each from its initial state (degrees -> SI) with its
+    overrides on top of the study's parameters (scipy; a failure is in the result)."""
+    return [simulate.simulation(
+        model, model.parameter_vector(study.simulation_values(spec)),
+        seeds.seed_state(model, spec.initial), spec.duration, spec.samples, spec.law,
+        str(spec.name), study.simulation_overrides(spec)) for spec in study.simulations]
 
 
 def seeded_orbits(model, overrides: dict[str, float], spec

@@ -390,6 +390,42 @@ class ParameterValue:
 
 
 @dataclass(frozen=True)
+class Simulation:
+    """A time simulation from a stated initial state (a study's ``simulations:`` entry,
+    :func:`whirl_cli.analysis.simulate.simulation`).
+
+    ``parameter_names``/``parameter_units``/``parameter_values`` (P,): the simulation's own
+    overrides (canonical names, SI), applied on top of the study's parameter set;
+    ``initial`` (n,): the initial state (SI); ``time`` (K,) s and ``states`` (K, n) SI: the
+    samples (fewer than asked if the simulation stopped early); ``hub`` (K, 2): the hub
+    displacement (y, z) normal to the spin axis as the model declares it (``Model.hub_matrix``
+    @ state, classical: (-psi, -theta), i.e. up to the factor a R) in ``hub_unit``; ``law``:
+    "smoothed" (the law AUTO continues) or "exact" (the unsmoothed piecewise law);
+    ``status``/``message``: as scipy's ``solve_ivp`` (0: the whole duration; 1: stopped by an
+    event, e.g. a dof beyond the divergence bound; -1: the integration failed)."""
+
+    name: str
+    law: str
+    parameter_names: tuple[str, ...]
+    parameter_units: tuple[str, ...]
+    parameter_values: np.ndarray
+    state_names: tuple[str, ...]
+    state_units: tuple[str, ...]
+    initial: np.ndarray
+    time: np.ndarray
+    states: np.ndarray
+    hub: np.ndarray
+    hub_unit: str
+    status: int
+    message: str
+
+    @property
+    def dof_names(self) -> tuple[str, ...]:
+        """The degrees of freedom: the first half of the states (the rest are their rates)."""
+        return self.state_names[: len(self.state_names) // 2]
+
+
+@dataclass(frozen=True)
 class StudyResult:
     """A whole study's results, as written to one HDF5 file."""
 
@@ -402,3 +438,4 @@ class StudyResult:
     boundaries: tuple[Boundary, ...] = ()
     linear_grid: LinearGrid | None = None
     parameters: tuple[ParameterValue, ...] = ()  # the resolved set; () in schema-1 files
+    simulations: tuple[Simulation, ...] = ()  # the study's ``simulations:``; () in older files

@@ -7,6 +7,8 @@ A study has *problems* (``whirl run`` exits 1, a sweep counts it failed) when
   status is then "ok") and a locus ending in MX, which has mostly reached a degenerate point
   (a cusp of folds of cycles, a Bogdanov-Takens point) and is reported as a *note*;
 * a time-simulation cross-check failed;
+* a study simulation's integration failed (status -1; one stopped at the divergence bound,
+  status 1, is a result, not a failure);
 * its plots could not be drawn.
 
 Either way the results are stored, with each branch's and run's status and message.
@@ -49,5 +51,7 @@ def verdict(result: StudyResult, plot_error: str = "") -> Verdict:
                 if is_problem(b.kind, b.status)]
     problems += [f"cross-check failed on {x.branch} at {x.parameter:.6g}"
                  for c in result.continuations for x in c.cross_checks if not x.passed]
+    problems += [f"simulation {s.name} failed: {s.message}" for s in result.simulations
+                 if s.status < 0]
     problems += [plot_error] if plot_error else []
     return Verdict(tuple(problems), notes)

@@ -25,6 +25,7 @@ STRUCTURAL = {
     results.RunRecord: {"name"},
     results.FreeplayAmplitudes: {"branch"},
     results.SeedOutcome: set(),
+    results.Simulation: {"name"},
 }
 DECLARATIONS = {
     results.Branch: store.BRANCH, results.Orbit: store.ORBIT,
@@ -32,7 +33,7 @@ DECLARATIONS = {
     results.LinearSweep: store.LINEAR_SWEEP, results.LinearGrid: store.LINEAR_GRID,
     results.Boundary: store.BOUNDARY, results.UnsafeInterval: store.UNSAFE_INTERVAL,
     results.RunRecord: store.RUN, results.FreeplayAmplitudes: store.FREEPLAY,
-    results.SeedOutcome: store.SEED,
+    results.SeedOutcome: store.SEED, results.Simulation: store.SIMULATION,
 }
 
 

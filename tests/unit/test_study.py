@@ -255,7 +255,8 @@ def test_model_validate_fills_the_same_defaults():
         (
             "plots: [bifurcation, bubble]\n",
             "s.yaml:3: plots[1]: expected one of bifurcation, linear, root_locus, "
-            "damping_multiples, projections, period, phase, boundary, amplitude, got 'bubble'",
+            "damping_multiples, projections, period, phase, boundary, amplitude, "
+            "time_history, hub_path, got 'bubble'",
         ),
         (
             "nonlinearity: {type: linear, dof: phi}\n",
@@ -278,7 +279,8 @@ def test_model_validate_fills_the_same_defaults():
         (
             "grid: {x: 1}\n",
             "s.yaml:3: grid: unknown key (allowed: name, description, model, parameters, "
-            "nonlinearity, continuations, linear, plots, plot_state, cross_check, auto)",
+            "nonlinearity, continuations, linear, simulations, plots, plot_state, cross_check, "
+            "auto)",
         ),
         ("linear: {grid: 1}\n", "s.yaml:3: linear.grid: expected a mapping, got 1"),
         ("linear: {table: 1}\n",
@@ -662,6 +664,8 @@ def test_schema_reference_lists_every_key_with_a_description():
     expected |= {f"continuations[].{k}" for k in TwoParameterContinuation.model_fields}
     expected |= {f"auto.{k}" for k in AutoSettings.model_fields}
     expected |= {"continuations[].slices[].value", "continuations[].slices[].label"}
+    expected |= {"simulations"} | {f"simulations[].{k}" for k in (
+        "name", "parameters", "initial", "duration", "samples", "law")}
     assert set(rows) == expected
     for line in lines[2:]:
         cells = [c.strip() for c in line.strip("|").split(" | ")]
@@ -824,7 +828,15 @@ def test_a_labelled_slice_is_checked_like_a_number():
         "K_psi"]
     found = problems(HEAD + PAIR + "    slices: [{label: x}, {value: 0.1, name: y}, ten]\n")
     assert len(found) == 3
-    assert found[2] == ("s.yaml:8: continuations[0].slices[2]: expected a number or a mapping "
-                        "{value, label}, got 'ten'")
+    assert found[2] == ("s.yaml:8: continuations[0].slices[2]: expected a finite number or a "
+                        "mapping {value, label}, got 'ten'")
+    assert problems(HEAD + PAIR + "    slices: [.nan]\n") == [
+        "s.yaml:8: continuations[0].slices[0]: expected a finite number or a mapping {value, "
+        "label}, got .nan"]
     assert found[0].startswith("s.yaml:8: continuations[0].slices[0].value: ")
     assert found[1].startswith("s.yaml:8: continuations[0].slices[1].name: ")
+
+
+def test_a_law_type_of_the_wrong_type_is_a_message_not_a_crash():
+    assert problems(HEAD + "nonlinearity: {type: [1, 2]}\n") == [
+        "s.yaml:3: nonlinearity.type: expected one of linear, polynomial, freeplay, got a list"]

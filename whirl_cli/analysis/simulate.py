@@ -7,6 +7,9 @@ model: the independent check of what continuation claims.
   law is simulated too (:func:`integrate_exact`) and must stay on it as well.
 * A stable equilibrium: a small perturbation of every dof must decay.
 
+:func:`simulation` is the free simulation a study states (``simulations:``): from an initial
+state, with the smoothed or the exact law, its failure reported in the result.
+
 Time in seconds, states in SI units (the classical model's rad, rad/s), as everywhere outside
 AUTO; perturbations and deviations of equilibria in units of the dofs' typical amplitudes.
 """
@@ -21,7 +24,7 @@ import numpy as np
 
 from ..interrupts import end_processes, forking, quiet_worker
 from ..models import Model
-from ..results import Branch, BranchKind, CrossCheck, Orbit, PointType
+from ..results import Branch, BranchKind, CrossCheck, Orbit, PointType, Simulation
 from .global_bifurcations import BLOWUP_FACTOR
 
 #: Relative tolerance on the amplitude for "the simulation stays on the orbit".
@@ -140,6 +143,73 @@ def integrate_exact(model: Model, params: np.ndarray, y0: np.ndarray, duration: 
     return ExactTrajectory(time[keep], np.concatenate(states)[keep], np.array(event_time),
                            np.array(event_state).reshape(-1, model.n_states),
                            np.array(event_dof, dtype=int))
+
+
+#: A free simulation stops (status 1) when a dof leaves this many typical amplitudes.
+DIVERGENCE_LIMIT = 100.0
+
+
+def simulation(model: Model, params: np.ndarray, initial: np.ndarray, duration: float,
+               samples: int = 2001, law: str = "smoothed", name: str = "",
+               overrides: dict[str, float] | None = None, rtol: float = 1e-9,
+               limit: float = DIVERGENCE_LIMIT) -> Simulation:
+    """The trajectory from ``initial`` (SI) over ``duration`` s at ``params``, sampled at
+    ``samples`` equally spaced times, as a :class:`~whirl_cli.results.Simulation` named
+    ``name`` (``overrides``: the parameters it sets beyond the study's, kept with it).
+
+    ``law`` "smoothed": the model's right-hand side (the law AUTO continues), scipy
+    ``solve_ivp`` LSODA with the analytic Jacobian, rtol ``rtol``, atol ``rtol`` x 1e-3
+    typical amplitudes; it stops (status 1) where a dof leaves ``limit`` typical amplitudes.
+    "exact": the unsmoothed piecewise law (:func:`integrate_exact`; the model needs one).
+    A failed integration is not raised: the samples up to the failure are kept, with
+    status -1 and scipy's message."""
+    from scipy.integrate import solve_ivp
+
+    y0 = np.asarray(initial, dtype=float)
+    grid = np.linspace(0.0, duration, samples)
+    status, message = 0, "The solver successfully reached the end of the integration interval."
+    if law == "exact":
+        try:
+            run = integrate_exact(model, params, y0, duration, samples, rtol=rtol)
+            time, states = run.time, run.states
+        except (RuntimeError, ArithmeticError, ValueError) as error:
+            time, states, status, message = grid[:1], y0[None, :], -1, str(error)
+    elif law == "smoothed":
+        field, jacobian = model.field_at(params)
+        scale = np.asarray(model.state_scale, dtype=float)
+        amplitudes = scale[: len(model.dofs)]
+
+        def diverged(_t, y):
+            return float(np.max(np.abs(y[: len(amplitudes)]) / amplitudes)) - limit
+
+        diverged.terminal = True
+        diverged.direction = 1.0
+        try:
+            with np.errstate(over="ignore", invalid="ignore"):
+                solved = solve_ivp(lambda _t, y: field(y), (0.0, duration), y0,
+                                   method="LSODA", jac=lambda _t, y: jacobian(y), t_eval=grid,
+                                   rtol=rtol, atol=rtol * 1e-3 * scale, events=[diverged])
+            time, states, status = solved.t, solved.y.T, int(solved.status)
+            message = str(solved.message)
+            if status == 1:
+                message = (f"a dof beyond {limit:g} typical amplitudes at t = "
+                           f"{solved.t_events[0][0]:.6g} s")
+        except (ArithmeticError, ValueError, RuntimeError) as error:
+            time, states, status, message = grid[:1], y0[None, :], -1, str(error)
+    else:
+        raise ValueError(f"unknown law {law!r} (smoothed | exact)")
+    overrides = dict(overrides or {})
+    matrix = model.hub_matrix
+    used = {model.states[k].unit for k in np.flatnonzero(np.abs(matrix).sum(axis=0))}
+    return Simulation(
+        name=name, law=law, parameter_names=tuple(overrides),
+        parameter_units=tuple(model.parameter(n).unit for n in overrides),
+        parameter_values=np.array(list(overrides.values()), dtype=float),
+        state_names=model.state_names, state_units=tuple(s.unit for s in model.states),
+        initial=y0, time=np.asarray(time, dtype=float),
+        states=np.asarray(states, dtype=float).reshape(-1, model.n_states),
+        hub=np.asarray(states, dtype=float).reshape(-1, model.n_states) @ matrix.T,
+        hub_unit=used.pop() if len(used) == 1 else "1", status=status, message=message)
 
 
 def _crossing(dof: int, value: float, direction: float):

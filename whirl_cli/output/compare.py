@@ -22,6 +22,9 @@ on other machines. Point indices, step counts and provenance are not compared; i
 * **linear sweeps** directly (relative ``linear``);
 * **boundaries** (``/boundaries``, curves in two parameters), when present, by the distance of
   every point of one curve to the polyline of the other, in axes scaled by their span;
+* **simulations** (``/simulations``) by law, status and samples, their states within
+  ``simulation`` of each state's largest magnitude (a phase error near a zero crossing is
+  not drift beyond that);
 * **runs** by status, **cross-checks** by their pass/fail outcome.
 
 Files are read with :func:`whirl_cli.output.store.read`; ``/boundaries`` (not part of
@@ -36,7 +39,15 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from ..results import Branch, ContinuationResult, LinearSweep, PointType, SpecialPoint, StudyResult
+from ..results import (
+    Branch,
+    ContinuationResult,
+    LinearSweep,
+    PointType,
+    Simulation,
+    SpecialPoint,
+    StudyResult,
+)
 from . import store
 
 #: Root attributes that change from run to run without any physical meaning.
@@ -56,7 +67,8 @@ class Tolerances:
     period: relative, special-point periods [-]; branch_state: interpolated
         state_max/state_min of branches [rad, rad/s]; linear: relative, linear sweeps [-];
     boundary: boundary curves, fraction of each axis' span [-]; lyapunov: relative, first
-    Lyapunov coefficients of Hopf points [-].
+    Lyapunov coefficients of Hopf points [-]; simulation: simulated states, fraction of each
+    state's largest magnitude over the simulation [-].
     """
 
     parameter: float = 1e-6
@@ -66,6 +78,7 @@ class Tolerances:
     linear: float = 1e-9
     boundary: float = 1e-5
     lyapunov: float = 1e-4
+    simulation: float = 1e-6
 
     @classmethod
     def from_options(cls, rtol: float | None = None, atol: float | None = None) -> Tolerances:
@@ -135,6 +148,10 @@ def compare_results(a: StudyResult, b: StudyResult, tolerances: Tolerances | Non
         "/linear/sweeps", {s.parameter: s for s in a.linear_sweeps},
         {s.parameter: s for s in b.linear_sweeps},
         lambda name, x, y: compare_linear_sweep(x, y, tolerances.linear))
+    found += _compare_named(
+        "/simulations", {s.name: s for s in a.simulations},
+        {s.name: s for s in b.simulations},
+        lambda name, x, y: compare_simulation(x, y, tolerances.simulation))
     found += _compare_named(
         "/runs", {r.name: r for r in a.runs}, {r.name: r for r in b.runs},
         lambda name, x, y: [] if x.status == y.status else
@@ -595,6 +612,32 @@ def compare_linear_sweep(a: LinearSweep, b: LinearSweep, rtol: float) -> list[Di
     if a.multiples != b.multiples:
         found.append(Difference(f"{path}/@multiples", str(a.multiples), str(b.multiples)))
     return found
+
+
+def compare_simulation(a: Simulation, b: Simulation, rtol: float) -> list[Difference]:
+    """Law, status, parameters, initial state and sample times exactly as stored (they
+    come from the study), the states within ``rtol`` of each state's largest magnitude."""
+    path = f"/simulations/{a.name}"
+    found = [Difference(f"{path}/@{key}", str(getattr(a, key)), str(getattr(b, key)))
+             for key in ("law", "status", "parameter_names", "state_names")
+             if getattr(a, key) != getattr(b, key)]
+    for key in ("parameter_values", "initial", "time"):
+        found += _compare_arrays(f"{path}/{key}", np.asarray(getattr(a, key), float),
+                                 np.asarray(getattr(b, key), float), 1e-12)
+    x, y = np.asarray(a.states, float), np.asarray(b.states, float)
+    if found or x.shape != y.shape:
+        return found + ([Difference(f"{path}/states", f"shape {x.shape}", f"shape {y.shape}")]
+                        if x.shape != y.shape else [])
+    if not x.size:
+        return []
+    scale = np.maximum(np.abs(x).max(axis=0), np.abs(y).max(axis=0))
+    delta = np.abs(x - y) / np.where(scale > 0, scale, 1.0)
+    if not (delta > rtol).any():
+        return []
+    at = np.unravel_index(int(np.argmax(delta)), x.shape)
+    return [Difference(f"{path}/states{[int(i) for i in at]}", f"{x[at]:.12g}", f"{y[at]:.12g}",
+                       f"{int((delta > rtol).sum())} element(s) beyond {rtol:.3g} of the "
+                       f"state's largest magnitude")]
 
 
 def _compare_labels(path: str, a: np.ndarray, b: np.ndarray) -> list[Difference]:

@@ -43,12 +43,16 @@ Layout (units in a ``units`` attribute on every physical dataset)::
         unsafe/polygon_<k>          (K, 2) closed outline of the unsafe region
         unsafe_intervals/           slice_value, lower, upper, cause (flutter | divergence)
     /parameters/                    columns: name, value, datum, unit (the resolved set)
+    /simulations/<name>/            (study `simulations`) attrs: law, status, message;
+                                    parameters (P,) the simulation's overrides (attrs names,
+                                    units), initial (n,), time (K,) [s], states (K, n) (attrs
+                                    names, units), hub (K, 2) (attr units)
     /runs/<run>                     attrs: status, message, constants, returncode,
                                            wall_seconds, n_points
 
 The groups holding collections (continuations, branches, orbits, sweeps, boundaries, loci,
-polygons, contour lines, runs) track the creation order of their members, so a round trip
-keeps the order of the study and its results; older files list (and read) by name.
+polygons, contour lines, simulations, runs) track the creation order of their members, so a
+round trip keeps the order of the study and its results; older files list (and read) by name.
 
 Every dataclass field's place in that layout is declared once, below (:data:`BRANCH`,
 :data:`SPECIAL_POINT`, ...), and both :func:`write` and :func:`read` go by those declarations
@@ -86,6 +90,7 @@ from ..results import (
     ParameterValue,
     RunRecord,
     SeedOutcome,
+    Simulation,
     SpecialPoint,
     StudyResult,
     UnsafeInterval,
@@ -195,6 +200,16 @@ BOUNDARY = (
 UNSAFE_INTERVAL = (
     Field("slice_value", kind="float"), Field("lower", kind="float"),
     Field("upper", kind="float"), Field("cause", kind="text"),
+)
+#: A :class:`Simulation` in ``simulations/<name>`` (its name is the group's).
+SIMULATION = (
+    Field("law", "attribute", "text"), Field("status", "attribute", "int"),
+    Field("message", "attribute", "text"),
+    Field("parameter_values", key="parameters", columns=("parameter_names", "parameter_units")),
+    Field("initial", columns=("state_names", "state_units")),
+    Field("time", units="s"),
+    Field("states", columns=("state_names", "state_units")),
+    Field("hub", unit_field="hub_unit"),
 )
 #: A :class:`RunRecord` in ``runs/<name>``.
 RUN = (
@@ -346,6 +361,9 @@ def _image(result: StudyResult) -> bytes:
         units = [p.unit for p in result.parameters]
         write_table(handle.create_group("parameters"), result.parameters, PARAMETER,
                     attributes={"value": {"units": units}, "datum": {"units": units}})
+        for found in result.simulations:
+            write_record(_collection(handle, "simulations").create_group(found.name), found,
+                         SIMULATION)
         runs = _collection(handle, "runs")
         for record in result.runs:
             write_record(runs.create_group(record.name), record, RUN)
@@ -476,6 +494,8 @@ def read(path: Path) -> StudyResult:
                       for k, v in handle.attrs.items() if k not in skip}
         parameters = read_table(handle["parameters"], ParameterValue, PARAMETER) \
             if "parameters" in handle else ()
+        simulations = tuple(Simulation(name=name, **read_record(group, SIMULATION))
+                            for name, group in handle.get("simulations", {}).items())
         return StudyResult(text(handle.attrs["study_name"]), text(handle.attrs["model"]),
                            continuations, sweeps, runs, attributes, boundaries, grid,
-                           parameters)
+                           parameters, simulations)

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
-from ..results import StudyResult
+from ..results import Simulation, StudyResult
 
 
 @dataclass(frozen=True)
@@ -45,6 +45,18 @@ class Captions:
         varied = set(varied)
         shown = [str(f) for f in self.fixed if f.name not in varied]
         return f"{self.study}: {', '.join(shown)}" if shown else self.study
+
+    def simulation_title(self, simulation: Simulation) -> str:
+        """``"<study>: <fixed>, <the simulation's overrides>\n<simulation name>"``: the
+        study's fixed parameters with the simulation's own on top (by canonical name with
+        their units), then its name (and ``exact law`` where it simulated the exact law)."""
+        own = [str(Fixed(name, float(value), unit)) for name, value, unit in zip(
+            simulation.parameter_names, simulation.parameter_values,
+            simulation.parameter_units, strict=True)]
+        base = self.title(simulation.parameter_names)
+        shown = base + (": " if base == self.study else ", ") + ", ".join(own) if own else base
+        law = " (exact law)" if simulation.law == "exact" else ""
+        return f"{shown}\n{simulation.name}{law}"
 
     def slice_label(self, continuation: str, k: int) -> str:
         """The label of slice ``k`` (from 0) of ``continuation``: the study's ``label``, else

@@ -22,12 +22,13 @@ from .freeplay import amplitude_diagram, has_amplitudes
 from .key import _PLOTTED_KINDS
 from .linear import damping_multiples_plot, linear_sweep_plot, root_locus_plot, sweep_datum
 from .maps import _oriented_grid, boundary_plot, overhang_diagram, slice_continuation
+from .simulations import hub_path, time_history
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 PLOT_KINDS = ("bifurcation", "linear", "root_locus", "damping_multiples", "projections",
-              "period", "phase", "boundary", "amplitude")
+              "period", "phase", "boundary", "amplitude", "time_history", "hub_path")
 """Kinds accepted by :func:`save_study_plots`."""
 
 PHASE_ORBITS = 12
@@ -67,6 +68,8 @@ def missing_data(result: StudyResult, kind: str) -> str:
                "(linear.grid)"
     if kind == "amplitude" and not any(has_amplitudes(c) for c in result.continuations):
         return "no freeplay amplitudes (a periodic branch of a model with a freeplay law)"
+    if kind in ("time_history", "hub_path") and not result.simulations:
+        return "no simulation (simulations:)"
     return ""
 
 
@@ -119,6 +122,10 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
     * "amplitude" -> ``<stem>_<continuation>_amplitude.png`` per continuation with freeplay
       amplitudes (:func:`~whirl_cli.plots.freeplay.amplitude_diagram`: A/delta, the
       describing-function estimate dashed);
+    * "time_history" -> ``<stem>_<simulation>_time_history.png`` per simulation
+      (:func:`~whirl_cli.plots.simulations.time_history`: every dof against time);
+    * "hub_path" -> ``<stem>_<simulation>_hub_path.png`` per simulation
+      (:func:`~whirl_cli.plots.simulations.hub_path`);
     * "boundary" -> per boundary of ``result.boundaries``: ``<stem>_<boundary>_boundary.png``
       (:func:`boundary_plot` with ``result.linear_grid`` if it is over the same parameters, the
       slices as cases) and ``<stem>_<boundary>_slice_<k>_overhang.png`` per slice k
@@ -263,6 +270,12 @@ def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str,
             if has_amplitudes(continuation):
                 jobs.append((f"{stem}_{continuation.name}_amplitude.png",
                              lambda c=continuation: amplitude_diagram(c)))
+    for kind, draw in (("time_history", time_history), ("hub_path", hub_path)):
+        if kind in kinds:
+            for found in result.simulations:
+                jobs.append((f"{stem}_{found.name}_{kind}.png",
+                             lambda s=found, draw=draw: draw(
+                                 s, title=caption().simulation_title(s))))
     return jobs
 
 

@@ -19,8 +19,8 @@ How a file is read:
    (:mod:`~whirl_cli.study.messages`);
 5. meaning, on the raw data so that it adds to the structural problems: parameter names known
    to the model variant, ``K2``/``K3`` only under ``nonlinearity``, ``dof`` a degree of freedom
-   of the model, unique continuation names, ``start`` inside ``range``
-   (:mod:`~whirl_cli.study.checks`).
+   of the model, unique continuation names, ``start`` inside ``range``, simulations' initial
+   states and overrides (:mod:`~whirl_cli.study.checks`).
 
 Validation also fills the model-dependent defaults (:mod:`~whirl_cli.study.resolve`):
 ``nonlinearity.dof`` (the family's default), ``continuations[].parameter`` and

@@ -6,9 +6,10 @@ study may use (:class:`~whirl_cli.study.resolve.Names`), law coefficients only u
 of a list naming its dof), a parameter given once, values and ranges inside the physical
 bounds, the family's constraints on several parameters at once (e.g. I_d < I_y, for the
 study's values and at each end of a range), unique continuation names, ``start``,
-``slices`` and ``orbits_at`` inside ``range``, ``plot_state`` and seed keys states of the
-model, and what a law requires of its coefficients together (freeplay: epsilon < delta,
-K_out > K_in).
+``slices`` and ``orbits_at`` inside ``range``, ``plot_state``, seed keys and the initial states
+of ``simulations`` states of the model, unique simulation names, their overrides checked like
+the study's, ``law: exact`` only with a piecewise law, and what a law requires of its
+coefficients together (freeplay: epsilon < delta, K_out > K_in).
 """
 
 from __future__ import annotations
@@ -65,6 +66,41 @@ def _meaning_problems(data: dict) -> list[Problem]:
             axis_spec = {k: v for k, v in spec.items() if k != "multiples"}  # sweeps only
             problems += _sweep_problems(("linear", "grid", axis), axis_spec, names, family,
                                         values)
+    problems += _simulation_problems(data.get("simulations"), names, family, values)
+    return problems
+
+
+def _simulation_problems(items: Any, names: Names, family: str,
+                         values: dict[str, float]) -> list[Problem]:
+    """Each simulation: a unique name (given, or ``sim_<k>``), its overrides (as the study's,
+    and the constraints with them on top of the study's values), initial-state keys states
+    of the model, and ``law: exact`` only with a piecewise law (freeplay)."""
+    dofs = FAMILIES[family].dofs
+    states = [d.name for d in dofs] + [d.rate for d in dofs]
+    problems: list[Problem] = []
+    taken: set[str] = set()
+    for i, item in _dict_items(items):
+        loc = ("simulations", i)
+        name = item.get("name", f"sim_{i + 1}")
+        if isinstance(name, str) and name in taken:
+            problems.append((loc + ("name",), f"duplicate simulation name {name!r}"))
+        if isinstance(name, str):
+            taken.add(name)
+        parameters = item.get("parameters")
+        found = _override_problems(parameters, names, family, loc + ("parameters",))
+        if not found and isinstance(parameters, dict):
+            mine = {names.canonical(k): float(v) for k, v in parameters.items()
+                    if _finite(v) is not None}
+            found = _constraint_problems(parameters, names, family, {**values, **mine},
+                                         loc + ("parameters",))
+        problems += found
+        initial = item.get("initial")
+        if isinstance(initial, dict):
+            problems += [(loc + ("initial", key), _choice_reason(states, repr(key)))
+                         for key in initial if isinstance(key, str) and key not in states]
+        if item.get("law") == "exact" and not names.model.piecewise_dofs:
+            problems.append((loc + ("law",), "the exact law needs a piecewise stiffness law "
+                             "(type: freeplay) on a dof; this study has none (use smoothed)"))
     return problems
 
 
@@ -183,11 +219,14 @@ def _parameter_problems(loc: Loc, name: Any, names: Names, family: str) -> list[
     return [(loc, f"unknown parameter {name!r} for model {family} (known: {known})")]
 
 
-def _override_problems(parameters: Any, names: Names, family: str) -> list[Problem]:
+def _override_problems(parameters: Any, names: Names, family: str,
+                       prefix: Loc = ("parameters",)) -> list[Problem]:
+    """Overrides (the study's ``parameters``, or a simulation's at ``prefix``): known
+    names, no law coefficient, each parameter once, inside its bounds."""
     problems: list[Problem] = []
     spelled: dict[str, str] = {}  # canonical name -> the key that gave it first
     for name, value in parameters.items() if isinstance(parameters, dict) else ():
-        loc = ("parameters", name)
+        loc = prefix + (name,)
         found = _parameter_problems(loc, name, names, family)
         if not found and names.canonical(name) in names.model.law_parameter_names():
             found = [(loc, _law_coefficient_reason(name, names))]
@@ -207,15 +246,17 @@ def _broken(family: str, values: dict[str, float]) -> list:
 
 
 def _constraint_problems(parameters: Any, names: Names, family: str,
-                         values: dict[str, float]) -> list[Problem]:
+                         values: dict[str, float], prefix: Loc = ("parameters",)
+                         ) -> list[Problem]:
     """Constraints the study's values break, reported at the first of their parameters the
-    study sets under ``parameters`` (at ``parameters`` if it sets none of them)."""
+    study sets under ``parameters`` (at ``parameters`` if it sets none of them); ``prefix``:
+    where those overrides are (a simulation's ``parameters``)."""
     given = {names.canonical(k): k for k in parameters if isinstance(k, str)
              and k in names.known_parameter_names()} if isinstance(parameters, dict) else {}
     problems: list[Problem] = []
     for constraint in _broken(family, values):
         keys = [given[n] for n in constraint.names if n in given]
-        loc = ("parameters", keys[0]) if keys else ("parameters",)
+        loc = prefix + (keys[0],) if keys else prefix
         shown = ", ".join(f"{n} = {values[n]:g}" for n in constraint.names)
         problems.append((loc, f"{constraint.reason}, got {shown}"))
     return problems

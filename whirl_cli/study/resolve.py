@@ -103,7 +103,7 @@ def names_of(family: str, laws: list[tuple[str, Any]]) -> Names | None:
         return None
     types = {dof: _get(block, "type") for dof, block in laws}
     if not all(isinstance(t, str) and t in LAW_TYPES for t in types.values()):
-        return None  # (a type of the wrong type, e.g. a list, is a structural problem)
+        return None  # an unknown or malformed type (e.g. a list): reported by the schema
     per_dof = tuple("polynomial" if types.get(d, "linear") == "linear" else types[d]
                     for d in declared.dof_names)
     model = get_model(family, per_dof)
@@ -175,6 +175,7 @@ def _with_derived_defaults(block: Any) -> Any:
 def _resolved(data: dict) -> dict:
     """``data`` with dof, law defaults, canonical parameter names and start values filled
     where possible."""
+    data = _named_simulations(data)
     names = _names_of_data(data)
     if names is None:
         return data
@@ -203,6 +204,16 @@ def _resolved(data: dict) -> dict:
         grid = {k: _resolved_item(v, names, None) for k, v in linear["grid"].items()}
         data["linear"] = {**linear, "grid": grid}
     return data
+
+
+def _named_simulations(data: dict) -> dict:
+    """``data`` with every simulation mapping named (``sim_<k>``, k its position from 1)."""
+    items = data.get("simulations")
+    if not isinstance(items, list | tuple):
+        return data
+    return {**data, "simulations": [
+        {**item, "name": f"sim_{k}"} if isinstance(item, dict) and item.get("name") is None
+        else item for k, item in enumerate(items, 1)]}
 
 
 def _resolved_pair(item: dict, names: Names, values: dict[str, float] | None) -> dict:

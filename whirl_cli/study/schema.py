@@ -90,16 +90,27 @@ def _as_range(value: Any) -> tuple[float, float]:
     return lower, upper
 
 
+def _is_state(value: Any) -> bool:
+    """True for a mapping state name -> finite number (a seed, an initial state)."""
+    return isinstance(value, dict) and all(isinstance(k, str) and _finite(v) is not None
+                                           for k, v in value.items())
+
+
 def _as_seeds(value: Any) -> str | tuple[dict[str, float], ...]:
     """``auto``, or a list of mappings state name -> finite number."""
     if value == "auto":
         return value
-    if not isinstance(value, list) or not all(
-            isinstance(seed, dict) and all(isinstance(k, str) and _finite(v) is not None
-                                           for k, v in seed.items()) for seed in value):
+    if not isinstance(value, list) or not all(_is_state(seed) for seed in value):
         _fail("expected `auto` or a list of mappings state -> number, e.g. [{{theta: 4}}], "
               "got {got}")
     return tuple({k: float(v) for k, v in seed.items()} for seed in value)
+
+
+def _as_state(value: Any) -> dict[str, float]:
+    """A mapping state name -> finite number (the names are checked against the model)."""
+    if not _is_state(value):
+        _fail("expected a mapping state -> number, e.g. {{theta: 2}}, got {got}")
+    return {k: float(v) for k, v in value.items()}
 
 
 def _at_most_orbits(values: tuple) -> tuple:
@@ -282,8 +293,8 @@ def _as_slice(value: Any) -> Any:
     """A slice given as a bare number is ``{value: number}``."""
     if isinstance(value, dict):
         return value
-    if not _is_number(value):
-        _fail("expected a number or a mapping {{value, label}}, got {got}")
+    if _finite(value) is None:
+        _fail("expected a finite number or a mapping {{value, label}}, got {got}")
     return {"value": value}
 
 
@@ -356,7 +367,7 @@ class TwoParameterContinuation(_Strict):
 
 
 PlotKind = Literal["bifurcation", "linear", "root_locus", "damping_multiples", "projections",
-                   "period", "phase", "boundary", "amplitude"]
+                   "period", "phase", "boundary", "amplitude", "time_history", "hub_path"]
 Continuation = Annotated[OneParameterContinuation | TwoParameterContinuation,
                         Field(discriminator="type")]
 
@@ -403,6 +414,36 @@ class LinearSpec(_Strict):
         description="Max real part of the eigenvalues of y = 0 over a grid, with its zero "
         "contour split into flutter and divergence parts; unset: none.",
     )
+
+
+#: Most samples a simulation stores (8 states: 64 MB).
+SAMPLES_MAX = 1_000_000
+
+
+class SimulationSpec(_Strict):
+    """A time simulation from a stated initial state (scipy, without AUTO).
+
+    After validation ``name`` is filled (``sim_<k>``, its position from 1)."""
+
+    name: Name | None = Field(
+        None, description="Simulation name, unique within the study (same characters as the "
+        "study name). Unset: `sim_<k>`, its position from 1.")
+    parameters: dict[str, Number] = Field(
+        default_factory=dict,
+        description="Overrides for this simulation, by name or alias, in SI units, applied "
+        "on top of the study's `parameters` (same rules: law coefficients go under "
+        "`nonlinearity`).")
+    initial: Annotated[dict[str, float], BeforeValidator(_as_state)] = Field(
+        description="Initial state, state name -> value (angles in deg, rates in deg/s, other "
+        "states in their unit; unnamed states 0), as the `seeds` of a continuation.")
+    duration: Positive = Field(description="Simulated time, s, > 0.")
+    samples: Annotated[Integer, _bound(">=", 2), _bound("<=", SAMPLES_MAX)] = Field(
+        2001, description=f"Output points, equally spaced from 0 to `duration`, 2 to "
+        f"{SAMPLES_MAX}.")
+    law: Literal["smoothed", "exact"] = Field(
+        "smoothed", description="`smoothed`: the model as AUTO continues it (scipy LSODA); "
+        "`exact`: the unsmoothed piecewise law, integrated piece by piece (only with a "
+        "freeplay law).")
 
 
 class AutoSettings(_Strict):
@@ -469,6 +510,10 @@ class Study(_Strict):
     linear: LinearSpec | None = Field(
         None, description="Linear (eigenvalue) analysis without AUTO; unset: none."
     )
+    simulations: tuple[SimulationSpec, ...] = Field(
+        (), description="Time simulations from stated initial states (scipy, no AUTO: a study "
+        "may hold only these), for the `time_history` and `hub_path` plots."
+    )
     plots: tuple[PlotKind, ...] = Field(
         ("bifurcation",), description="Figures drawn after the runs."
     )
@@ -527,6 +572,16 @@ class Study(_Strict):
         """The model variant: the polynomial law on every dof (linear is K2 = K3 = 0) unless a
         study names another law."""
         return self.names().model
+
+    def simulation_values(self, spec: SimulationSpec) -> dict[str, float]:
+        """Canonical name -> value: the study's (:meth:`parameter_values`) with the
+        simulation's own overrides on top."""
+        return {**self.parameter_values(), **self.simulation_overrides(spec)}
+
+    def simulation_overrides(self, spec: SimulationSpec) -> dict[str, float]:
+        """The simulation's own overrides, by canonical name."""
+        names = self.names()
+        return {names.canonical(k): float(v) for k, v in spec.parameters.items()}
 
     def parameter_values(self) -> dict[str, float]:
         """Canonical name -> value for every override and every law coefficient."""
