@@ -191,3 +191,23 @@ def test_damping_multiples_overlay_style_per_result_colour_per_parameter(continu
         assert to_hex(lines[0].get_color()) == to_hex(lines[1].get_color())
         np.testing.assert_allclose(lines[0].get_xdata(), sweep.values / 0.25)
     assert frequency.get_xlabel() == "parameter / datum"
+
+
+def test_simulation_panels_one_axes_per_dof_and_a_hub_path(continuation):  # noqa: F811
+    from whirl_cli.results import Simulation
+
+    time = np.linspace(0.0, 2.0, 201)
+    states = np.column_stack([0.01 * np.cos(5 * time), 0.01 * np.sin(5 * time),
+                              -0.05 * np.sin(5 * time), 0.05 * np.cos(5 * time)])
+    simulation = Simulation("kick", "smoothed", (), (), np.array([]), STATES,
+                            ("rad", "rad", "rad/s", "rad/s"), states[0], time, states,
+                            -states[:, [1, 0]], "rad", 0, "ok")
+    result = replace(result_with(continuation, 10.0), simulations=(simulation,))
+    history = draw(result, "time_history", _new_figure().add_subplot(),
+                   PanelChoice(simulation="kick"))
+    assert [ax.get_ylabel() for ax in history] == ["theta [deg]", "psi [deg]"]
+    np.testing.assert_allclose(history[0].lines[0].get_ydata(), np.degrees(states[:, 0]))
+    (hub,) = draw(result, "hub_path", _new_figure().add_subplot())
+    assert hub.get_xlabel() == "hub y [deg]"
+    with pytest.raises(WhirlError, match="no simulation 'other' \\(simulations: kick\\)"):
+        draw(result, "hub_path", _new_figure().add_subplot(), PanelChoice(simulation="other"))

@@ -37,7 +37,8 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
 PANEL_KINDS = ("bifurcation", "projections", "period", "phase", "linear", "root_locus",
-               "damping_multiples", "boundary", "overhang", "amplitude")
+               "damping_multiples", "boundary", "overhang", "amplitude", "time_history",
+               "hub_path")
 """Kinds :func:`draw` accepts (``overhang``: one slice of a boundary, its unsafe intervals
 shaded)."""
 
@@ -53,7 +54,8 @@ class PanelChoice:
     ``state``: the state drawn (``bifurcation``, ``overhang``; a phase plane's y, x being the
     first state); ``sweep``: a linear sweep's parameter; ``slice``: a boundary slice index
     from 0 (``overhang``); ``orbits``: AUTO labels of the orbits a phase plane draws;
-    ``hz``: frequencies in Hz; ``title``: replaces the study's title."""
+    ``simulation``: a simulation's name (``time_history``, ``hub_path``); ``hz``:
+    frequencies in Hz; ``title``: replaces the study's title."""
 
     continuation: str | None = None
     branch: str | None = None
@@ -61,6 +63,7 @@ class PanelChoice:
     sweep: str | None = None
     slice: int | None = None
     orbits: tuple[int, ...] | None = None
+    simulation: str | None = None
     hz: bool = False
     title: str | None = None
 
@@ -100,6 +103,8 @@ def draw(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice = PanelCh
         phase_plane(branch, labels=labels, y=choice.state, ax=ax,
                     title=caption.title(branch.parameter_names) if title is None else title)
         return [ax]
+    if kind in ("time_history", "hub_path"):
+        return _draw_simulation(result, kind, ax, choice, caption)
     if kind == "damping_multiples":
         return _replaced(ax, lambda region: _draw_multiples(result, region, choice, caption))
     if kind in ("linear", "root_locus"):
@@ -112,6 +117,29 @@ def draw(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice = PanelCh
             sweep, hz=choice.hz, title=title,
             axes=tuple(region.subgridspec(2, 1).subplots(sharex=True))), share=False)
     return _draw_map(result, kind, ax, choice, caption)
+
+
+def _draw_simulation(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice, caption
+                     ) -> list[Axes]:
+    """The ``time_history`` (one panel per dof, in ``ax``'s place) and ``hub_path`` kinds of
+    the simulation ``choice.simulation`` (None: the first)."""
+    from .simulations import hub_path, time_history
+
+    found = [s for s in result.simulations if choice.simulation in (None, s.name)]
+    if not found:
+        have = ", ".join(s.name for s in result.simulations) or "none"
+        raise WhirlError(f"{result.study_name}: no simulation"
+                         + (f" {choice.simulation!r}" if choice.simulation else "")
+                         + f" (simulations: {have})")
+    simulation = found[0]
+    title = choice.title or caption.simulation_title(simulation)
+    if kind == "hub_path":
+        hub_path(simulation, ax=ax, title=title)
+        return [ax]
+    dofs = len(simulation.dof_names)
+    return _replaced(ax, lambda region: time_history(
+        simulation, axes=list(region.subgridspec(dofs, 1).subplots(sharex=True, squeeze=False)
+                              [:, 0]), title=title))
 
 
 def _draw_multiples(result: StudyResult, region, choice: PanelChoice, caption,
