@@ -97,3 +97,4 @@ def test_files_from_before_read_in_name_order():
     for branch in old.continuations[0].branches:
         labels = [o.label for o in branch.orbits]
         assert labels == sorted(labels)  # by number, as before (not "12" before "3")
+

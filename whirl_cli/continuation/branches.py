@@ -60,8 +60,41 @@ def special_points(branch: Branch, skip_first: bool = False) -> list[SpecialPoin
             parameter_names=branch.parameter_names, parameters=branch.parameters[index].copy(),
             parameter_units=branch.parameter_units,
             state=branch.state_max[index].copy(), period=float(branch.period[index]),
-            stable=bool(branch.stable[index]), label=int(branch.label[index])))
+            stable=bool(branch.stable[index]), label=int(branch.label[index]),
+            **(_torus(branch, index) if kind == PointType.TR and branch.is_periodic else {})))
     return found
+
+
+#: How far from the unit circle (in modulus) the multiplier pair of a torus point may be.
+TORUS_TOLERANCE = 0.05
+
+
+def neimark_sacker_angle(multipliers: np.ndarray) -> float:
+    """The angle in (0, pi) rad of the complex conjugate pair of Floquet ``multipliers`` on
+    the unit circle, exp(+-i angle), at a torus (Neimark-Sacker) point; NaN if no complex
+    pair lies within :data:`TORUS_TOLERANCE` of it (or the multipliers are unknown). A second
+    frequency of the torus is angle / (2 pi T) for a cycle of period T."""
+    values = np.asarray(multipliers, dtype=complex)
+    upper = values[np.isfinite(values) & (values.imag > 1e-9 * np.maximum(1, abs(values)))]
+    if not upper.size:
+        return float("nan")
+    nearest = upper[np.argmin(np.abs(np.abs(upper) - 1.0))]
+    if abs(abs(nearest) - 1.0) > TORUS_TOLERANCE:
+        return float("nan")
+    return float(np.angle(nearest))
+
+
+def _torus(branch: Branch, index: int) -> dict:
+    """A TR point's ``torus_angle``, and a ``note`` if its multipliers (known) have no pair
+    on the unit circle."""
+    multipliers = branch.eigenvalues[index]
+    angle = neimark_sacker_angle(multipliers)
+    if not np.isfinite(multipliers).any() or np.isfinite(angle):
+        return {"torus_angle": angle}
+    return {"torus_angle": angle,
+            "note": "no complex pair of Floquet multipliers on the unit circle: AUTO's torus "
+                    "test function changed sign without a Neimark-Sacker pair (not a torus "
+                    "bifurcation)"}
 
 
 def typical_amplitudes(model: Model) -> np.ndarray:

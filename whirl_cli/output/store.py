@@ -143,6 +143,7 @@ SPECIAL_POINT = (
     Field("lyapunov", kind="float", default=float("nan")),  # units: see _lyapunov_unit
     Field("refined", width=2, default=lambda: np.full(2, np.nan)),  # units: the bracket's
     Field("artefact", kind="bool", default=False),
+    Field("torus_angle", kind="float", units="rad", default=float("nan")),
 )
 #: The resolved :class:`ParameterValue` table of a study (``parameters/``; schema 2).
 PARAMETER = (
