@@ -256,7 +256,7 @@ def test_model_validate_fills_the_same_defaults():
             "plots: [bifurcation, bubble]\n",
             "s.yaml:3: plots[1]: expected one of bifurcation, linear, root_locus, "
             "damping_multiples, projections, period, phase, boundary, amplitude, "
-            "time_history, hub_path, got 'bubble'",
+            "time_history, hub_path, law, got 'bubble'",
         ),
         (
             "nonlinearity: {type: linear, dof: phi}\n",

@@ -20,6 +20,7 @@ from .captions import Captions, captions
 from .diagrams import bifurcation_diagram, period_plot, phase_plane, projections_figure
 from .freeplay import amplitude_diagram, has_amplitudes
 from .key import _PLOTTED_KINDS
+from .laws import law_plot, nonlinear_laws
 from .linear import damping_multiples_plot, linear_sweep_plot, root_locus_plot, sweep_datum
 from .maps import _oriented_grid, boundary_plot, overhang_diagram, slice_continuation
 from .simulations import hub_path, time_history
@@ -28,7 +29,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 PLOT_KINDS = ("bifurcation", "linear", "root_locus", "damping_multiples", "projections",
-              "period", "phase", "boundary", "amplitude", "time_history", "hub_path")
+              "period", "phase", "boundary", "amplitude", "time_history", "hub_path", "law")
 """Kinds accepted by :func:`save_study_plots`."""
 
 PHASE_ORBITS = 12
@@ -68,6 +69,8 @@ def missing_data(result: StudyResult, kind: str) -> str:
                "(linear.grid)"
     if kind == "amplitude" and not any(has_amplitudes(c) for c in result.continuations):
         return "no freeplay amplitudes (a periodic branch of a model with a freeplay law)"
+    if kind == "law" and not nonlinear_laws(result):
+        return "no nonlinear stiffness law (nonlinearity) in the stored study"
     if kind in ("time_history", "hub_path") and not result.simulations:
         return "no simulation (simulations:)"
     return ""
@@ -126,6 +129,8 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
       (:func:`~whirl_cli.plots.simulations.time_history`: every dof against time);
     * "hub_path" -> ``<stem>_<simulation>_hub_path.png`` per simulation
       (:func:`~whirl_cli.plots.simulations.hub_path`);
+    * "law" -> ``<stem>_law_<dof>.png`` per dof with a nonlinear law
+      (:func:`~whirl_cli.plots.laws.law_plot`: the law as continued, exact, and K x);
     * "boundary" -> per boundary of ``result.boundaries``: ``<stem>_<boundary>_boundary.png``
       (:func:`boundary_plot` with ``result.linear_grid`` if it is over the same parameters, the
       slices as cases) and ``<stem>_<boundary>_slice_<k>_overhang.png`` per slice k
@@ -270,6 +275,10 @@ def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str,
             if has_amplitudes(continuation):
                 jobs.append((f"{stem}_{continuation.name}_amplitude.png",
                              lambda c=continuation: amplitude_diagram(c)))
+    if "law" in kinds:
+        for model, values, dof in nonlinear_laws(result):
+            jobs.append((f"{stem}_law_{dof}.png",
+                         lambda m=model, v=values, d=dof: law_plot(m, v, d)))
     for kind, draw in (("time_history", time_history), ("hub_path", hub_path)):
         if kind in kinds:
             for found in result.simulations:

@@ -38,7 +38,7 @@ if TYPE_CHECKING:
 
 PANEL_KINDS = ("bifurcation", "projections", "period", "phase", "linear", "root_locus",
                "damping_multiples", "boundary", "overhang", "amplitude", "time_history",
-               "hub_path")
+               "hub_path", "law")
 """Kinds :func:`draw` accepts (``overhang``: one slice of a boundary, its unsafe intervals
 shaded)."""
 
@@ -105,6 +105,8 @@ def draw(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice = PanelCh
         return [ax]
     if kind in ("time_history", "hub_path"):
         return _draw_simulation(result, kind, ax, choice, caption)
+    if kind == "law":
+        return _draw_law(result, ax, choice)
     if kind == "damping_multiples":
         return _replaced(ax, lambda region: _draw_multiples(result, region, choice, caption))
     if kind in ("linear", "root_locus"):
@@ -117,6 +119,19 @@ def draw(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice = PanelCh
             sweep, hz=choice.hz, title=title,
             axes=tuple(region.subgridspec(2, 1).subplots(sharex=True))), share=False)
     return _draw_map(result, kind, ax, choice, caption)
+
+
+def _draw_law(result: StudyResult, ax: Axes, choice: PanelChoice) -> list[Axes]:
+    """The ``law`` kind: the nonlinear law on the dof ``choice.state`` (None: the first)."""
+    from .laws import law_plot, nonlinear_laws
+
+    found = [(m, v, d) for m, v, d in nonlinear_laws(result) if choice.state in (None, d)]
+    if not found:
+        raise WhirlError(f"{result.study_name}: no nonlinear stiffness law"
+                         + (f" on {choice.state!r}" if choice.state else ""))
+    model, values, dof = found[0]
+    law_plot(model, values, dof, ax=ax, title=choice.title)
+    return [ax]
 
 
 def _draw_simulation(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice, caption

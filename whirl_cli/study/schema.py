@@ -367,7 +367,8 @@ class TwoParameterContinuation(_Strict):
 
 
 PlotKind = Literal["bifurcation", "linear", "root_locus", "damping_multiples", "projections",
-                   "period", "phase", "boundary", "amplitude", "time_history", "hub_path"]
+                   "period", "phase", "boundary", "amplitude", "time_history", "hub_path",
+                   "law"]
 Continuation = Annotated[OneParameterContinuation | TwoParameterContinuation,
                         Field(discriminator="type")]
 

@@ -59,6 +59,10 @@ class Law:
     breakpoints j - 1 and j), smooth on each piece. ``exact`` None: the law is exact as it is.
     ``smoothing_key``: the coefficient that sets the smoothing (the exact law returns as it
     goes to 0; freeplay's epsilon), for the persistence check of special points.
+
+    ``numeric(x, k, c)``: the same restoring force on numpy arrays and floats (to draw the
+    law), where ``moment`` needs sympy-only functions; None: ``moment`` itself takes arrays.
+    :meth:`force` and :meth:`exact_force` evaluate the law and its exact form numerically.
     """
 
     name: str
@@ -73,6 +77,23 @@ class Law:
     exact: Callable[..., object] | None = None
     breakpoints: Callable[[Mapping[str, float]], tuple[float, ...]] | None = None
     smoothing_key: str | None = None
+    numeric: Callable[..., object] | None = None
+
+    def force(self, x, k: float, c: Mapping[str, float]):
+        """The restoring force at ``x`` (array, the dof's unit) for stiffness ``k`` and
+        coefficients ``c`` (by key), in the stiffness's unit times the dof's."""
+        return (self.numeric or self.moment)(x, k, c)
+
+    def exact_force(self, x, k: float, c: Mapping[str, float]):
+        """The exact (unsmoothed) restoring force at ``x``, piece by piece; :meth:`force` if
+        the law is exact as it is."""
+        if self.exact is None or self.breakpoints is None:
+            return self.force(x, k, c)
+        import numpy as np
+
+        x = np.asarray(x, dtype=float)
+        piece = np.searchsorted(np.asarray(self.breakpoints(c), dtype=float), x)
+        return self.exact(x, k, c, piece)
 
     def parameter_name(self, key: str, dof: str) -> str:
         """The model parameter a study's ``key`` of a law on ``dof`` becomes: K2 -> K2_theta."""

@@ -84,6 +84,20 @@ def _moment(x, k, c):
     return k_in * x + (k - k_in) * (x - gap)
 
 
+def _moment_numeric(x, k, c):
+    """M_eps(x) on numpy arrays, in the same overflow-free ln cosh form."""
+    import numpy as np
+
+    def lc(z):
+        z = np.abs(z)
+        return z + np.log1p(np.exp(-2.0 * z)) - math.log(2.0)
+
+    delta, k_in, epsilon = c["delta"], c["K_in"], c["epsilon"]
+    x = np.asarray(x, dtype=float)
+    gap = epsilon / 2 * (lc((x + delta) / epsilon) - lc((x - delta) / epsilon))
+    return k_in * x + (k - k_in) * (x - gap)
+
+
 def _exact(x, k, c, piece):
     """M_fp(x) on piece 0 (x <= -delta), 1 (inside the gap) or 2 (x >= delta)."""
     side = piece - 1
@@ -146,4 +160,5 @@ FREEPLAY = Law(
     exact=_exact,
     breakpoints=_breakpoints,
     smoothing_key="epsilon",
+    numeric=_moment_numeric,
 )

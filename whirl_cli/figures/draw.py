@@ -1,0 +1,62 @@
+"""A sheet drawn from study results: one matplotlib Figure, panels on a grid
+(:func:`draw_sheet`), each panel :func:`whirl_cli.plots.panels.draw` or
+:func:`~whirl_cli.plots.panels.draw_overlay`.
+"""
+
+from __future__ import annotations
+
+import textwrap
+from collections.abc import Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from ..errors import WhirlError
+from ..plots.key import _new_figure
+from ..plots.panels import PanelChoice, draw, draw_overlay
+from ..results import StudyResult
+from .sheet import PanelSpec, Sheet
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+PANEL_SIZE = (5.2, 4.2)
+"""Default width and height of one panel, inches."""
+
+
+def draw_sheet(sheet: Sheet, results: Mapping[Path, StudyResult]) -> Figure:
+    """The figure of ``sheet`` from ``results`` (keyed by :meth:`Sheet.resolve` paths):
+    panels row by row on the sheet's layout, titled "Figure <number>: <caption>" (legends
+    on the first panel only if the sheet says ``legends: first``).
+    A panel that cannot be drawn is a :class:`WhirlError` naming the sheet and the panel."""
+    rows, columns = sheet.shape
+    size = sheet.size or (PANEL_SIZE[0] * columns, PANEL_SIZE[1] * rows)
+    figure = _new_figure(figsize=size)
+    grid = figure.add_gridspec(rows, columns)
+    for k, panel in enumerate(sheet.panels):
+        ax = figure.add_subplot(grid[k // columns, k % columns])
+        try:
+            _draw_panel(sheet, panel, results, ax)
+        except WhirlError as error:
+            raise WhirlError(f"{sheet.path}: panels[{k}] ({panel.kind}): {error}") from None
+    if sheet.legends == "first":
+        for ax in figure.axes[1:]:
+            if ax.get_legend() is not None:
+                ax.get_legend().remove()
+    width = max(40, int(size[0] * 14))
+    figure.suptitle(textwrap.fill(f"Figure {sheet.figure}: {sheet.caption}", width),
+                    fontsize="medium")
+    return figure
+
+
+def _draw_panel(sheet: Sheet, panel: PanelSpec, results: Mapping[Path, StudyResult], ax
+                ) -> None:
+    choice = PanelChoice(continuation=panel.continuation, branch=panel.branch,
+                         state=panel.state, sweep=panel.sweep, slice=panel.slice,
+                         orbits=panel.orbits, simulation=panel.simulation, hz=panel.hz,
+                         title=panel.title)
+    if panel.overlay:
+        members = [results[sheet.resolve(m.study)] for m in panel.overlay]
+        draw_overlay(members, panel.kind, ax, [m.label for m in panel.overlay], choice,
+                     title=panel.title)
+    else:
+        draw(results[sheet.resolve(panel.study)], panel.kind, ax, choice)

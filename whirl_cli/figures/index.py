@@ -1,0 +1,61 @@
+"""``index.html`` of a figures folder: every figure with its number, caption, the studies and
+the commands that made it (pure: text in, text out)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from html import escape
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One figure of the index: its number, caption, note, image file name (None: not
+    drawn), the study files behind it, the command that redraws it and, if it was not
+    drawn, why."""
+
+    figure: str
+    caption: str
+    note: str
+    image: str | None
+    studies: tuple[str, ...]
+    command: str
+    problem: str = ""
+
+
+def index_html(entries: list[Entry], title: str) -> str:
+    """The page: a heading, then one section per entry in figure-number order."""
+    sections = "\n".join(_section(e) for e in sorted(entries, key=_number))
+    return f"""<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<title>{escape(title)}</title>
+<style>
+body {{ font-family: sans-serif; max-width: 72em; margin: 2em auto; padding: 0 1em; }}
+section {{ border-top: 1px solid #ccc; padding: 1em 0; }}
+img {{ max-width: 100%; }}
+code {{ background: #f4f4f4; padding: 0 0.3em; }}
+.problem {{ color: #b00; }}
+</style>
+</head>
+<body>
+<h1>{escape(title)}</h1>
+{sections}
+</body>
+</html>
+"""
+
+
+def _number(entry: Entry) -> tuple:
+    return tuple(int(p) if p.isdigit() else p for p in entry.figure.replace("_", ".").split("."))
+
+
+def _section(entry: Entry) -> str:
+    studies = ", ".join(f"<code>{escape(s)}</code>" for s in entry.studies)
+    body = (f'<img src="{escape(entry.image)}" alt="figure {escape(entry.figure)}">'
+            if entry.image else f'<p class="problem">not drawn: {escape(entry.problem)}</p>')
+    note = f"<p><em>{escape(entry.note)}</em></p>" if entry.note else ""
+    return (f'<section id="fig{escape(entry.figure)}">\n<h2>Figure {escape(entry.figure)}</h2>\n'
+            f"<p>{escape(entry.caption)}</p>\n{note}\n{body}\n"
+            f"<p>Studies: {studies}<br>Redraw: <code>{escape(entry.command)}</code></p>\n"
+            "</section>")
