@@ -250,7 +250,8 @@ def _limits(ctx: click.Context, param: click.Parameter, value):
 @click.option("--kind", "kinds", multiple=True,
               type=click.Choice(["bifurcation", "linear", "root_locus", "damping_multiples",
                                  "projections", "period", "phase", "boundary", "amplitude",
-                                 "time_history", "hub_path"]),
+                                 "time_history", "hub_path", "poincare", "spectrum",
+                                 "orbit_diagram"]),
               help="Plot kind (repeatable) [default: every kind the file has the data for]; "
                    "a kind it lacks the data for is an error.")
 @click.option("-o", "--output-dir", type=click.Path(file_okay=False, path_type=Path),
