@@ -124,11 +124,13 @@ def explorations(model, overrides: dict[str, float], spec) -> tuple[Exploration,
     """The settled motion at each ``explore`` value of a one-parameter continuation, by
     simulation (:func:`whirl_cli.analysis.motion.classify_model`) at the study's parameters
     with the continuation parameter at that value, from ``explore_initial`` (default: the
-    first dof at :data:`whirl_cli.study.schema.EXPLORE_OFFSET`, deg for an angle).
+    first dof at :data:`whirl_cli.study.schema.EXPLORE_OFFSET`, deg for an angle), after
+    ``explore_transient`` whirl periods, on the section where ``explore_section`` (default:
+    the first dof's rate, i.e. at that dof's minima) crosses its mean upwards.
 
     One value after another (the integration is CPU-bound Python: threads would not run
-    them side by side; about 0.3 s per value for the classical model, 1.4-2.7 s for the
-    gimballed one). A failure is the result ``diverged`` with its message, never raised."""
+    them side by side; a few seconds per value for the gimballed model). A failure is the
+    result ``diverged`` with its message, never raised."""
     from .study.schema import EXPLORE_OFFSET
 
     parameter = model.parameter(model.canonical(spec.parameter))
@@ -137,11 +139,14 @@ def explorations(model, overrides: dict[str, float], spec) -> tuple[Exploration,
     y0 = seeds.seed_state(model, given)
     names = tuple(s.name for s in model.states)
     units = tuple(s.unit for s in model.states)
+    section = names.index(spec.explore_section if spec.explore_section is not None
+                          else model.dofs[0].rate)
     found = []
     for value in spec.explore:
         try:
             motion_class = motion.classify_model(
-                model, {**overrides, parameter.name: float(value)}, y0)
+                model, {**overrides, parameter.name: float(value)}, y0,
+                transient_periods=spec.explore_transient, section_state=section)
         except Exception as error:  # noqa: BLE001 - reported in the result, never raised
             motion_class = motion.MotionClass(
                 "diverged", np.nan, np.nan, (), np.zeros((0, len(names))), np.nan, 0, (),

@@ -115,8 +115,9 @@ def orbit_diagram(continuation: ContinuationResult, state: str | None = None,
     last section point (the decaying oscillation's, nearest the equilibrium), a value without
     section points (an equilibrium that does not oscillate, a divergence) by a triangle on the
     parameter axis. With ``branches`` and branches to draw, over the continuation's bifurcation
-    diagram (:func:`~whirl_cli.plots.diagrams.bifurcation_diagram` of the same state: a stable
-    cycle's dots lie between its max and min). Draws on ``ax`` if given, else on a new figure;
+    diagram (:func:`~whirl_cli.plots.diagrams.bifurcation_diagram` of the same state, max and
+    min: on the study's default section, at the first dof's minima, a stable cycle's dots lie
+    on its min curve). Draws on ``ax`` if given, else on a new figure;
     returns the figure. Title ``title`` (None: the continuation's name)."""
     found = _explorations(continuation)
     if ax is None:

@@ -351,6 +351,9 @@ def _continuation_problems(
             found += _seed_problems(loc, item.get("seeds"), family)
             found += _initial_problems(loc + ("explore_initial",),
                                        item.get("explore_initial"), family)
+            section = item.get("explore_section")
+            if isinstance(section, str):
+                found += _state_problems(loc + ("explore_section",), section, family)
         problems += found
     return problems
 
@@ -374,6 +377,13 @@ def _initial_problems(loc: Loc, initial: Any, family: str) -> list[Problem]:
         return []
     return [(loc + (name,), _choice_reason(states, repr(name)))
             for name in initial if isinstance(name, str) and name not in states]
+
+
+def _state_problems(loc: Loc, name: str, family: str) -> list[Problem]:
+    """A state name (``explore_section``) the model lacks."""
+    dofs = FAMILIES[family].dofs
+    states = [d.name for d in dofs] + [d.rate for d in dofs]
+    return [] if name in states else [(loc, _choice_reason(states, repr(name)))]
 
 
 def _orbits_problems(loc: Loc, item: dict, key: str = "orbits_at") -> list[Problem]:
