@@ -147,7 +147,7 @@ def orbit_diagram(continuation: ContinuationResult, state: str | None = None,
         handle = None
         if dots:
             (handle,) = ax.plot(*np.array(dots).T, linestyle="none", marker="o",
-                                markersize=3, color=colour, zorder=4)
+                                markersize=5, color=colour, zorder=4)
         if bare:
             (marker,) = ax.plot(bare, np.zeros(len(bare)), linestyle="none", marker="^",
                                 markersize=7, color=colour, zorder=4,
