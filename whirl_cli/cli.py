@@ -105,6 +105,14 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     if checks:
         console.print(f"cross-checks by time simulation: {sum(x.passed for x in checks)} of "
                       f"{len(checks)} passed")
+    for continuation in result.continuations:
+        for explored in continuation.explorations:
+            frequencies = ", ".join(f"{f:.4g}" for f in explored.frequencies)
+            console.print(
+                f"{continuation.name} explore {explored.parameter} = {explored.value:g}: "
+                f"{explored.kind}" + (f" at {frequencies} Hz" if frequencies else "")
+                + f", lambda = {explored.lyapunov:.3g} +- {explored.lyapunov_error:.2g} 1/s",
+                soft_wrap=True, markup=False)
     for sim in result.simulations:
         state = "ok" if sim.status == 0 else ("stopped" if sim.status > 0 else "FAILED")
         console.print(f"simulation {sim.name}: {len(sim.time)} samples to "
