@@ -105,6 +105,14 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     if checks:
         console.print(f"cross-checks by time simulation: {sum(x.passed for x in checks)} of "
                       f"{len(checks)} passed")
+    for continuation in result.continuations:
+        for explored in continuation.explorations:
+            frequencies = ", ".join(f"{f:.4g}" for f in explored.frequencies)
+            console.print(
+                f"{continuation.name} explore {explored.parameter} = {explored.value:g}: "
+                f"{explored.kind}" + (f" at {frequencies} Hz" if frequencies else "")
+                + f", lambda = {explored.lyapunov:.3g} +- {explored.lyapunov_error:.2g} 1/s",
+                soft_wrap=True, markup=False)
     for sim in result.simulations:
         state = "ok" if sim.status == 0 else ("stopped" if sim.status > 0 else "FAILED")
         console.print(f"simulation {sim.name}: {len(sim.time)} samples to "
@@ -250,7 +258,8 @@ def _limits(ctx: click.Context, param: click.Parameter, value):
 @click.option("--kind", "kinds", multiple=True,
               type=click.Choice(["bifurcation", "linear", "root_locus", "damping_multiples",
                                  "projections", "period", "phase", "boundary", "amplitude",
-                                 "time_history", "hub_path", "law"]),
+                                 "time_history", "hub_path", "law", "poincare", "spectrum",
+                                 "orbit_diagram"]),
               help="Plot kind (repeatable) [default: every kind the file has the data for]; "
                    "a kind it lacks the data for is an error.")
 @click.option("-o", "--output-dir", type=click.Path(file_okay=False, path_type=Path),

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .analysis import boundaries, freeplay, linear, seeds, simulate
+from .analysis import boundaries, freeplay, linear, motion, seeds, simulate
 from .auto.runner import RunOutcome, interruptible
 from .continuation import persistence
 from .continuation.engine import Engine, Numerics
@@ -24,6 +24,7 @@ from .output.provenance import provenance
 from .results import (
     Boundary,
     ContinuationResult,
+    Exploration,
     ParameterValue,
     SeedOutcome,
     Simulation,
@@ -81,6 +82,9 @@ def _run_study(study: Study, workroot: Path, jobs: int,
         if freeplay.freeplay_dofs(model):  # amplitudes / delta, describing function
             continuation = replace(continuation, freeplay=freeplay.freeplay_amplitudes(
                 model, parameters, continuation, tuple(spec.range)))
+        if spec.explore:
+            continuation = replace(continuation, explorations=explorations(
+                model, parameters, spec))
         continuations.append(continuation)
     if study.cross_check:
         continuations = [replace(c, cross_checks=simulate.cross_check(
@@ -114,6 +118,50 @@ def simulations(study: Study, model) -> list[Simulation]:
         model, model.parameter_vector(study.simulation_values(spec)),
         seeds.seed_state(model, spec.initial), spec.duration, spec.samples, spec.law,
         str(spec.name), study.simulation_overrides(spec)) for spec in study.simulations]
+
+
+def explorations(model, overrides: dict[str, float], spec) -> tuple[Exploration, ...]:
+    """The settled motion at each ``explore`` value of a one-parameter continuation, by
+    simulation (:func:`whirl_cli.analysis.motion.classify_model`) at the study's parameters
+    with the continuation parameter at that value, from ``explore_initial`` (default: the
+    first dof at :data:`whirl_cli.study.schema.EXPLORE_OFFSET`, deg for an angle), after
+    ``explore_transient`` whirl periods, on the section where ``explore_section`` (default:
+    the first dof's rate, i.e. at that dof's minima) crosses its mean upwards.
+
+    One value after another (the integration is CPU-bound Python: threads would not run
+    them side by side; a few seconds per value for the gimballed model). A failure is the
+    result ``diverged`` with its message, never raised."""
+    from .study.schema import EXPLORE_OFFSET
+
+    parameter = model.parameter(model.canonical(spec.parameter))
+    given = spec.explore_initial if spec.explore_initial is not None else {
+        model.dofs[0].name: EXPLORE_OFFSET}
+    y0 = seeds.seed_state(model, given)
+    names = tuple(s.name for s in model.states)
+    units = tuple(s.unit for s in model.states)
+    section = names.index(spec.explore_section if spec.explore_section is not None
+                          else model.dofs[0].rate)
+    found = []
+    for value in spec.explore:
+        try:
+            motion_class = motion.classify_model(
+                model, {**overrides, parameter.name: float(value)}, y0,
+                transient_periods=spec.explore_transient, section_state=section)
+        except Exception as error:  # noqa: BLE001 - reported in the result, never raised
+            motion_class = motion.MotionClass(
+                "diverged", np.nan, np.nan, (), np.zeros((0, len(names))), np.nan, 0, (),
+                np.nan, f"diverged: the classification failed ({type(error).__name__}: "
+                f"{error})")
+        found.append(Exploration(
+            float(value), parameter.name, parameter.unit, names, units, y0.copy(),
+            motion_class.kind, float(motion_class.lyapunov),
+            float(motion_class.lyapunov_error),
+            np.asarray(motion_class.frequencies, dtype=float),
+            np.asarray(motion_class.section, dtype=float).reshape(-1, len(names)),
+            float(motion_class.section_dimension), int(motion_class.multiplicity),
+            np.asarray(motion_class.peaks, dtype=float), float(motion_class.broadband),
+            motion_class.evidence))
+    return tuple(found)
 
 
 def seeded_orbits(model, overrides: dict[str, float], spec

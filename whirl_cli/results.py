@@ -367,10 +367,48 @@ class SeedOutcome:
 
 
 @dataclass(frozen=True)
+class Exploration:
+    """The settled motion at one ``explore:`` value of a one-parameter continuation, classified
+    by simulation (:func:`whirl_cli.analysis.motion.classify_model`; the fields after
+    ``initial`` are those of :class:`whirl_cli.analysis.motion.MotionClass`).
+
+    ``value``: the continuation parameter ``parameter`` [``unit``] the study's parameters
+    are simulated at; ``initial`` (n,): the initial state (SI); ``state_names``,
+    ``state_units``: the model's states (of ``initial`` and the ``section`` columns);
+    ``kind``: equilibrium | periodic | quasi-periodic | chaotic | diverged; ``lyapunov``,
+    ``lyapunov_error``: the largest Lyapunov exponent and its standard error [1/s] (NaN if
+    diverged); ``frequencies`` [Hz]: the fundamental of a periodic orbit, the two bases of a
+    torus, the strongest peaks otherwise; ``section`` (m, n): Poincaré section points (SI
+    states); ``section_dimension``: its correlation dimension (NaN: fewer than 10 points);
+    ``multiplicity``: k of a period-k orbit (0 otherwise); ``peaks`` [Hz]: the spectral
+    peaks, strongest first; ``broadband``: the fraction of the spectral power away from the
+    peaks; ``evidence``: the readings in words (a failure of the simulation says so, with
+    kind ``diverged``)."""
+
+    value: float
+    parameter: str
+    unit: str
+    state_names: tuple[str, ...]
+    state_units: tuple[str, ...]
+    initial: np.ndarray
+    kind: str
+    lyapunov: float
+    lyapunov_error: float
+    frequencies: np.ndarray
+    section: np.ndarray
+    section_dimension: float
+    multiplicity: int
+    peaks: np.ndarray
+    broadband: float
+    evidence: str
+
+
+@dataclass(frozen=True)
 class ContinuationResult:
     """Everything one continuation of a study produced. ``freeplay``: its periodic branches
     in the units of each freeplay law, with the describing-function estimate (one-parameter
-    continuations of models with freeplay). ``seeds``: what its seeds settled on."""
+    continuations of models with freeplay). ``seeds``: what its seeds settled on.
+    ``explorations``: the motion classified by simulation at each ``explore:`` value."""
 
     name: str
     kind: str  # "one-parameter" | "two-parameter"
@@ -379,6 +417,7 @@ class ContinuationResult:
     cross_checks: tuple[CrossCheck, ...] = ()
     freeplay: tuple[FreeplayAmplitudes, ...] = ()
     seeds: tuple[SeedOutcome, ...] = ()
+    explorations: tuple[Exploration, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -149,6 +149,8 @@ def mutate(kind: str, data: dict, draw) -> tuple[bytes, tuple]:
                             [[-1e308, 1e308], [-1.7e308, 1.7e308]]))
             if "parameter" in item:
                 choices.append((("continuations", i, "orbits_at"), [[0.1] * 65, [0.0] * 500]))
+                choices.append((("continuations", i, "explore"), [[0.1] * 65]))
+                choices.append((("continuations", i, "explore_transient"), [0, -1.0]))
         path, values = draw(st.sampled_from(choices))
         put(data, path, draw(st.sampled_from(values)))
         return dump(data), ("path", path)

@@ -145,7 +145,8 @@ def test_plot_without_kind_draws_every_kind_the_file_has(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
         f"hardening_case2_{name}" for name in (
             "k1_bifurcation.png", "k1_projections.png", "k1_period.png",
-            "k1_periodic_1_phase.png", "k1_periodic_3_phase.png", "k1_periodic_5_phase.png"))
+            "k1_periodic_1_phase.png", "k1_periodic_3_phase.png", "k1_periodic_5_phase.png",
+            "law_theta.png"))
 
 
 @pytest.mark.parametrize("kind, missing", [

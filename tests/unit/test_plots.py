@@ -343,7 +343,8 @@ def test_save_study_plots_rejects_unknown_kind(tmp_path, continuation):
 def test_plot_kinds():
     assert PLOT_KINDS == ("bifurcation", "linear", "root_locus", "damping_multiples",
                           "projections", "period", "phase", "boundary", "amplitude",
-                          "time_history", "hub_path", "law")
+                          "time_history", "hub_path", "law", "poincare", "spectrum",
+                          "orbit_diagram")
 
 
 # -- projections_figure --------------------------------------------------------------------------

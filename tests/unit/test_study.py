@@ -256,7 +256,7 @@ def test_model_validate_fills_the_same_defaults():
             "plots: [bifurcation, bubble]\n",
             "s.yaml:3: plots[1]: expected one of bifurcation, linear, root_locus, "
             "damping_multiples, projections, period, phase, boundary, amplitude, "
-            "time_history, hub_path, law, got 'bubble'",
+            "time_history, hub_path, law, poincare, spectrum, orbit_diagram, got 'bubble'",
         ),
         (
             "nonlinearity: {type: linear, dof: phi}\n",
@@ -394,7 +394,8 @@ RUN = "continuations:\n  - name: k1\n    type: one-parameter\n    parameter: K1\
         (
             "    range: [0, 1]\n    loci: [hopf]\n",
             "s.yaml:8: continuations[0].loci: unknown key (allowed: name, type, parameter, "
-            "start, range, periodic, branch_points, orbits_at, seeds)",
+            "start, range, periodic, branch_points, orbits_at, seeds, explore, explore_initial, "
+            "explore_transient, explore_section)",
         ),
         ("", "s.yaml:4: continuations[0].range: required key is missing"),
     ],

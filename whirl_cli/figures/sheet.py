@@ -29,7 +29,7 @@ from ..study.source import _compose, _read_text, _Tree
 
 PanelKind = Literal["bifurcation", "projections", "period", "phase", "linear", "root_locus",
                     "damping_multiples", "boundary", "overhang", "amplitude", "time_history",
-                    "hub_path", "law"]
+                    "hub_path", "law", "poincare", "spectrum", "orbit_diagram"]
 _FIGURE_RE = re.compile(r"\d+(\.\d+)*[a-z]?")
 _MAX_PANELS = 64
 

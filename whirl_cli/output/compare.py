@@ -25,6 +25,9 @@ on other machines. Point indices, step counts and provenance are not compared; i
 * **simulations** (``/simulations``) by law, status and samples, their states within
   ``simulation`` of each state's largest magnitude (a phase error near a zero crossing is
   not drift beyond that);
+* **explorations** (``explore:``) by position: value and class exact, Lyapunov exponents and
+  frequencies within ``exploration`` (relative; an exponent relative to its size plus three
+  standard errors);
 * **runs** by status, **cross-checks** by their pass/fail outcome.
 
 Files are read with :func:`whirl_cli.output.store.read`; ``/boundaries`` (not part of
@@ -68,7 +71,9 @@ class Tolerances:
         state_max/state_min of branches [rad, rad/s]; linear: relative, linear sweeps [-];
     boundary: boundary curves, fraction of each axis' span [-]; lyapunov: relative, first
     Lyapunov coefficients of Hopf points [-]; simulation: simulated states, fraction of each
-    state's largest magnitude over the simulation [-].
+    state's largest magnitude over the simulation [-]; exploration: relative, the
+    frequencies and Lyapunov exponents of ``explore`` classifications (simulations at
+    rtol 1e-6) [-].
     """
 
     parameter: float = 1e-6
@@ -79,6 +84,7 @@ class Tolerances:
     boundary: float = 1e-5
     lyapunov: float = 1e-4
     simulation: float = 1e-6
+    exploration: float = 1e-3
 
     @classmethod
     def from_options(cls, rtol: float | None = None, atol: float | None = None) -> Tolerances:
@@ -221,6 +227,42 @@ def compare_continuation(a: ContinuationResult, b: ContinuationResult,
         lambda name, x, y: compare_branch(f"{path}/branches/{name}", x, y, spans[0],
                                           tolerances))
     found += _compare_cross_checks(path, a, b)
+    found += compare_explorations(path, a, b, tolerances.exploration)
+    return found
+
+
+def compare_explorations(path: str, a: ContinuationResult, b: ContinuationResult,
+                         rtol: float) -> list[Difference]:
+    """The ``explore`` classifications, by position: value and kind exact, the largest
+    Lyapunov exponent within ``rtol`` x (|exponent| + 3 x its standard error) of the larger
+    (an exponent near zero is known only to its error), frequencies relative ``rtol``
+    (their number exact)."""
+    found = []
+    if len(a.explorations) != len(b.explorations):
+        return [Difference(f"{path}/explorations", f"{len(a.explorations)} values",
+                           f"{len(b.explorations)} values", "explored values")]
+    for k, (x, y) in enumerate(zip(a.explorations, b.explorations, strict=True)):
+        where = f"{path}/explorations/{k}"
+        if x.value != y.value:
+            found.append(Difference(f"{where}/value", f"{x.value:.6g}", f"{y.value:.6g}"))
+            continue
+        if x.kind != y.kind:
+            found.append(Difference(f"{where}/@kind", x.kind, y.kind,
+                                    f"class at {x.parameter} = {x.value:g}"))
+            continue
+        limit = rtol * max(abs(x.lyapunov) + 3 * x.lyapunov_error,
+                           abs(y.lyapunov) + 3 * y.lyapunov_error)
+        both_nan = np.isnan(x.lyapunov) and np.isnan(y.lyapunov)
+        if not both_nan and not abs(x.lyapunov - y.lyapunov) <= limit:
+            found.append(Difference(f"{where}/lyapunov", f"{x.lyapunov:.6g}",
+                                    f"{y.lyapunov:.6g}", f"1/s, beyond {limit:.3g}"))
+        fx, fy = np.asarray(x.frequencies, float), np.asarray(y.frequencies, float)
+        if fx.shape != fy.shape:
+            found.append(Difference(f"{where}/frequencies", f"{len(fx)} values",
+                                    f"{len(fy)} values"))
+        elif len(fx) and not np.allclose(fx, fy, rtol=rtol, atol=0.0):
+            found.append(Difference(f"{where}/frequencies", _short(np.round(fx, 6).tolist()),
+                                    _short(np.round(fy, 6).tolist()), f"Hz, relative {rtol:g}"))
     return found
 
 

@@ -27,6 +27,14 @@ Layout (units in a ``units`` attribute on every physical dataset)::
                                     refined (K, 2), artefact (persistence as epsilon shrinks)
         seeds/                      (continuation `seeds`) columns: index, seed (K, n), kind,
                                     period, branch, message
+        explorations/<k>/           (continuation `explore`, k from 0 in its order) attrs:
+                                    parameter, kind (equilibrium | periodic | quasi-periodic
+                                    | chaotic | diverged), multiplicity, evidence; value
+                                    (scalar, the parameter's unit), initial (n,) (attrs
+                                    names, units), lyapunov, lyapunov_error [1/s],
+                                    frequencies [Hz], section (m, n) Poincare points (attrs
+                                    names, units), section_dimension [1], peaks [Hz],
+                                    broadband [1]
         cross_checks/               (study `cross_check: true`) columns: branch, index, kind
                                     (orbit | equilibrium), parameter, expected, simulated,
                                     passed, state (the dof an orbit check compares), exact
@@ -50,9 +58,10 @@ Layout (units in a ``units`` attribute on every physical dataset)::
     /runs/<run>                     attrs: status, message, constants, returncode,
                                            wall_seconds, n_points
 
-The groups holding collections (continuations, branches, orbits, sweeps, boundaries, loci,
-polygons, contour lines, simulations, runs) track the creation order of their members, so a
-round trip keeps the order of the study and its results; older files list (and read) by name.
+The groups holding collections (continuations, branches, orbits, explorations, sweeps,
+boundaries, loci, polygons, contour lines, simulations, runs) track the creation order of their
+members, so a round trip keeps the order of the study and its results; older files list (and
+read) by name.
 
 Every dataclass field's place in that layout is declared once, below (:data:`BRANCH`,
 :data:`SPECIAL_POINT`, ...), and both :func:`write` and :func:`read` go by those declarations
@@ -83,6 +92,7 @@ from ..results import (
     BranchKind,
     ContinuationResult,
     CrossCheck,
+    Exploration,
     FreeplayAmplitudes,
     LinearGrid,
     LinearSweep,
@@ -163,6 +173,21 @@ SEED = (
     Field("index", kind="int"), Field("seed", width="states"), Field("kind", kind="text"),
     Field("period", kind="float", units="s"), Field("branch", kind="text"),
     Field("message", kind="text"),
+)
+#: An :class:`Exploration` of a continuation, in ``explorations/<k>`` (k from 0, in the
+#: order of the study's ``explore``).
+EXPLORATION = (
+    Field("parameter", "attribute", "text"), Field("kind", "attribute", "text"),
+    Field("multiplicity", "attribute", "int"), Field("evidence", "attribute", "text"),
+    Field("value", kind="float", unit_field="unit"),
+    Field("initial", columns=("state_names", "state_units")),
+    Field("lyapunov", kind="float", units="1/s"),
+    Field("lyapunov_error", kind="float", units="1/s"),
+    Field("frequencies", units="Hz"),
+    Field("section", columns=("state_names", "state_units")),
+    Field("section_dimension", kind="float", units="1"),
+    Field("peaks", units="Hz"),
+    Field("broadband", kind="float", units="1"),
 )
 #: The :class:`FreeplayAmplitudes` of a periodic branch, in ``<branch>/freeplay_<dof>``.
 FREEPLAY = (
@@ -260,6 +285,9 @@ def _write_continuation(group: h5py.Group, continuation: ContinuationResult) -> 
     if continuation.seeds:
         write_table(group.create_group("seeds"), continuation.seeds, SEED,
                     {"states": len(first.state_names) if first else 0}, {"seed": states})
+    for k, found in enumerate(continuation.explorations):
+        write_record(_collection(group, "explorations").create_group(str(k)), found,
+                     EXPLORATION)
     if continuation.cross_checks and first is not None:
         write_table(group.create_group("cross_checks"), continuation.cross_checks,
                     CROSS_CHECK, attributes=_cross_check_units(continuation.cross_checks, first))
@@ -403,7 +431,19 @@ def _read_continuation(name: str, group: h5py.Group) -> ContinuationResult:
         read_table(group["cross_checks"], CrossCheck, CROSS_CHECK)
         if "cross_checks" in group else (),
         tuple(f for b, g in branches.items() for f in _read_freeplay(b, g)),
-        read_table(group["seeds"], SeedOutcome, SEED) if "seeds" in group else ())
+        read_table(group["seeds"], SeedOutcome, SEED) if "seeds" in group else (),
+        _read_explorations(group.get("explorations", {})))
+
+
+def _read_explorations(group) -> tuple[Exploration, ...]:
+    """The explorations of a continuation, in their order (none in older files)."""
+    found = []
+    for key in _members(group, int):
+        values = read_record(group[key], EXPLORATION)
+        for name in ("value", "lyapunov", "lyapunov_error", "section_dimension", "broadband"):
+            values[name] = float(values[name])
+        found.append(Exploration(**values))
+    return tuple(found)
 
 
 def _read_boundary(name: str, group: h5py.Group) -> Boundary:

@@ -1,7 +1,7 @@
 """Figures of study results (matplotlib, Agg): bifurcation diagrams, state projections, period
 plots, phase planes of stored orbits, linear sweeps, two-parameter stability maps with the
 unsafe (overhang) region and the bifurcation diagrams of their slices, time histories and hub
-paths of simulations.
+paths of simulations, Poincaré sections and orbit diagrams of explored values.
 
 The only package that imports matplotlib, and only inside functions (the CLI starts without
 it). Figures are built with the object-oriented API on an Agg canvas, never through pyplot, so
@@ -27,6 +27,8 @@ Modules, lowest first:
 * :mod:`~whirl_cli.plots.linear` -- linear sweeps;
 * :mod:`~whirl_cli.plots.maps` -- stability maps in two parameters and overhang diagrams;
 * :mod:`~whirl_cli.plots.simulations` -- time histories and hub paths of simulations;
+* :mod:`~whirl_cli.plots.motion` -- Poincaré sections, frequencies and orbit diagrams of the
+  motion classified by simulation at a continuation's ``explore:`` values;
 * :mod:`~whirl_cli.plots.files` -- a study's figures as named PNG files (axis limits, Hz, the
   kinds a result has the data for).
 """

@@ -23,14 +23,19 @@ from .key import _PLOTTED_KINDS
 from .laws import law_plot, nonlinear_laws
 from .linear import damping_multiples_plot, linear_sweep_plot, root_locus_plot, sweep_datum
 from .maps import _oriented_grid, boundary_plot, overhang_diagram, slice_continuation
+from .motion import orbit_diagram, poincare_plot, spectrum_plot
 from .simulations import hub_path, time_history
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 PLOT_KINDS = ("bifurcation", "linear", "root_locus", "damping_multiples", "projections",
-              "period", "phase", "boundary", "amplitude", "time_history", "hub_path", "law")
+              "period", "phase", "boundary", "amplitude", "time_history", "hub_path", "law",
+              "poincare", "spectrum", "orbit_diagram")
 """Kinds accepted by :func:`save_study_plots`."""
+
+MOTION_KINDS = ("poincare", "spectrum", "orbit_diagram")
+"""Kinds drawn from a continuation's ``explore:`` classifications."""
 
 PHASE_ORBITS = 12
 """Most orbits a study's phase-plane figure draws (a long family stores one every 20 steps)."""
@@ -73,6 +78,8 @@ def missing_data(result: StudyResult, kind: str) -> str:
         return "no nonlinear stiffness law (nonlinearity) in the stored study"
     if kind in ("time_history", "hub_path") and not result.simulations:
         return "no simulation (simulations:)"
+    if kind in MOTION_KINDS and not any(c.explorations for c in result.continuations):
+        return "no explored values (a one-parameter continuation with explore:)"
     return ""
 
 
@@ -131,6 +138,11 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
       (:func:`~whirl_cli.plots.simulations.hub_path`);
     * "law" -> ``<stem>_law_<dof>.png`` per dof with a nonlinear law
       (:func:`~whirl_cli.plots.laws.law_plot`: the law as continued, exact, and K x);
+    * "poincare", "spectrum", "orbit_diagram" -> ``<stem>_<continuation>_<kind>.png`` per
+      continuation with ``explore:`` classifications (:mod:`~whirl_cli.plots.motion`: the
+      Poincaré sections of the first two states, the frequencies found against the
+      parameter, the section's values of ``state`` (else the first dof) over the bifurcation
+      diagram);
     * "boundary" -> per boundary of ``result.boundaries``: ``<stem>_<boundary>_boundary.png``
       (:func:`boundary_plot` with ``result.linear_grid`` if it is over the same parameters, the
       slices as cases) and ``<stem>_<boundary>_slice_<k>_overhang.png`` per slice k
@@ -285,7 +297,25 @@ def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str,
                 jobs.append((f"{stem}_{found.name}_{kind}.png",
                              lambda s=found, draw=draw: draw(
                                  s, title=caption().simulation_title(s))))
+    for kind in (k for k in MOTION_KINDS if k in kinds):
+        for continuation in result.continuations:
+            if continuation.explorations:
+                jobs.append((f"{stem}_{continuation.name}_{kind}.png",
+                             lambda c=continuation, kind=kind: _motion_figure(
+                                 kind, c, state, _title(caption, c))))
     return jobs
+
+
+def _motion_figure(kind: str, continuation: ContinuationResult, state: str | None,
+                   title: str) -> Figure:
+    """The figure of a :data:`MOTION_KINDS` kind (``state``: the orbit diagram's, if the
+    explorations have it)."""
+    if kind == "poincare":
+        return poincare_plot(continuation, title=title)
+    if kind == "spectrum":
+        return spectrum_plot(continuation, title=title)
+    names = continuation.explorations[0].state_names
+    return orbit_diagram(continuation, state if state in names else None, title=title)
 
 
 def _title(caption: Callable[[], Captions], continuation: ContinuationResult) -> str:

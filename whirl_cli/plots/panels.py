@@ -38,7 +38,7 @@ if TYPE_CHECKING:
 
 PANEL_KINDS = ("bifurcation", "projections", "period", "phase", "linear", "root_locus",
                "damping_multiples", "boundary", "overhang", "amplitude", "time_history",
-               "hub_path", "law")
+               "hub_path", "law", "poincare", "spectrum", "orbit_diagram")
 """Kinds :func:`draw` accepts (``overhang``: one slice of a boundary, its unsafe intervals
 shaded)."""
 
@@ -78,6 +78,14 @@ def draw(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice = PanelCh
         raise WhirlError(f"unknown panel kind {kind!r}; choose from {', '.join(PANEL_KINDS)}")
     title = choice.title
     caption = captions(result)
+    if kind in ("poincare", "spectrum", "orbit_diagram"):
+        continuation = pick_continuation(result, choice.continuation, kind)
+        varied = {n for b in continuation.branches for n in b.parameter_names}
+        if continuation.explorations:
+            varied.add(continuation.explorations[0].parameter)
+        _motion_panel(kind, continuation, ax, choice.state,
+                      caption.title(varied) if title is None else title)
+        return [ax]
     if kind in ("bifurcation", "projections", "period", "amplitude"):
         continuation = pick_continuation(result, choice.continuation, kind)
         varied = {n for b in continuation.branches for n in b.parameter_names}
@@ -132,6 +140,19 @@ def _draw_law(result: StudyResult, ax: Axes, choice: PanelChoice) -> list[Axes]:
     model, values, dof = found[0]
     law_plot(model, values, dof, ax=ax, title=choice.title)
     return [ax]
+
+
+def _motion_panel(kind: str, continuation, ax: Axes, state: str | None, title: str) -> None:
+    """The ``poincare``, ``spectrum`` and ``orbit_diagram`` kinds on ``ax`` (``state``: the
+    orbit diagram's)."""
+    from .motion import orbit_diagram, poincare_plot, spectrum_plot
+
+    if kind == "poincare":
+        poincare_plot(continuation, ax=ax, title=title)
+    elif kind == "spectrum":
+        spectrum_plot(continuation, ax=ax, title=title)
+    else:
+        orbit_diagram(continuation, state, ax=ax, title=title)
 
 
 def _draw_simulation(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice, caption
@@ -234,11 +255,15 @@ def pick_continuation(result: StudyResult, name: str | None, kind: str = "bifurc
             raise WhirlError(f"{result.study_name}: no one-parameter continuation {name!r} "
                              f"(continuations: {', '.join(c.name for c in one) or 'none'})")
         return found[0]
+    explored = lambda c: bool(c.explorations)  # noqa: E731
     fits = {"period": lambda c: any(b.is_periodic for b in c.branches),
-            "amplitude": has_amplitudes}.get(kind, lambda c: True)
+            "amplitude": has_amplitudes, "poincare": explored, "spectrum": explored,
+            "orbit_diagram": explored}.get(kind, lambda c: True)
     found = [c for c in one if fits(c)]
     if not found:
-        need = {"period": "periodic branch", "amplitude": "freeplay amplitudes"}.get(
+        need = {"period": "periodic branch", "amplitude": "freeplay amplitudes",
+                "poincare": "explored values", "spectrum": "explored values",
+                "orbit_diagram": "explored values"}.get(
             kind, "one-parameter continuation")
         raise WhirlError(f"{result.study_name}: nothing to draw as {kind}: no {need}")
     return found[0]

@@ -5,11 +5,11 @@ study may use (:class:`~whirl_cli.study.resolve.Names`), law coefficients only u
 ``nonlinearity``, each law on a dof of the model and each dof with at most one law (every law
 of a list naming its dof), a parameter given once, values and ranges inside the physical
 bounds, the family's constraints on several parameters at once (e.g. I_d < I_y, for the
-study's values and at each end of a range), unique continuation names, ``start``,
-``slices`` and ``orbits_at`` inside ``range``, ``plot_state``, seed keys and the initial states
-of ``simulations`` states of the model, unique simulation names, their overrides checked like
-the study's, ``law: exact`` only with a piecewise law, and what a law requires of its
-coefficients together (freeplay: epsilon < delta, K_out > K_in).
+study's values and at each end of a range), unique continuation names, ``start``, ``slices``,
+``orbits_at`` and ``explore`` inside ``range``, ``plot_state``, seed keys, ``explore_initial`` keys
+and the initial states of ``simulations`` states of the model, unique simulation names, their
+overrides checked like the study's, ``law: exact`` only with a piecewise law, and what a law
+requires of its coefficients together (freeplay: epsilon < delta, K_out > K_in).
 """
 
 from __future__ import annotations
@@ -347,7 +347,13 @@ def _continuation_problems(
             found = found or _law_range_problems(loc + ("range",), canonical,
                                                  item.get("range"), names, values)
             found += _orbits_problems(loc, item)
+            found += _orbits_problems(loc, item, "explore")
             found += _seed_problems(loc, item.get("seeds"), family)
+            found += _initial_problems(loc + ("explore_initial",),
+                                       item.get("explore_initial"), family)
+            section = item.get("explore_section")
+            if isinstance(section, str):
+                found += _state_problems(loc + ("explore_section",), section, family)
         problems += found
     return problems
 
@@ -363,15 +369,32 @@ def _seed_problems(loc: Loc, seeds: Any, family: str) -> list[Problem]:
             for name in seed if isinstance(name, str) and name not in states]
 
 
-def _orbits_problems(loc: Loc, item: dict) -> list[Problem]:
-    """``orbits_at`` values outside the continuation's range."""
-    bounds, orbits = item.get("range"), item.get("orbits_at")
+def _initial_problems(loc: Loc, initial: Any, family: str) -> list[Problem]:
+    """An initial state (``explore_initial``) naming states the model lacks."""
+    dofs = FAMILIES[family].dofs
+    states = [d.name for d in dofs] + [d.rate for d in dofs]
+    if not isinstance(initial, dict):
+        return []
+    return [(loc + (name,), _choice_reason(states, repr(name)))
+            for name in initial if isinstance(name, str) and name not in states]
+
+
+def _state_problems(loc: Loc, name: str, family: str) -> list[Problem]:
+    """A state name (``explore_section``) the model lacks."""
+    dofs = FAMILIES[family].dofs
+    states = [d.name for d in dofs] + [d.rate for d in dofs]
+    return [] if name in states else [(loc, _choice_reason(states, repr(name)))]
+
+
+def _orbits_problems(loc: Loc, item: dict, key: str = "orbits_at") -> list[Problem]:
+    """``orbits_at`` (or ``explore``: ``key``) values outside the continuation's range."""
+    bounds, orbits = item.get("range"), item.get(key)
     if not (isinstance(bounds, list) and len(bounds) == 2 and isinstance(orbits, list)):
         return []
     lower, upper = (_finite(b) for b in bounds)
     if lower is None or upper is None or not lower < upper:
         return []
-    return [(loc + ("orbits_at", k), f"{number!r} is outside the range [{lower!r}, {upper!r}]")
+    return [(loc + (key, k), f"{number!r} is outside the range [{lower!r}, {upper!r}]")
             for k, number in enumerate(map(_finite, orbits))
             if number is not None and not lower <= number <= upper]
 

@@ -34,6 +34,11 @@ NAME_MAX = 64
 FORTRAN_INT_MAX = 2**31 - 1
 #: Most values in ``orbits_at``: AUTO reads at most 2048 characters per constants line (UZR).
 ORBITS_MAX = 64
+#: The default initial state of ``explore``: the first dof displaced by this (deg for angles).
+EXPLORE_OFFSET = 2.0
+#: Whirl periods an ``explore`` simulation discards before it classifies (classify_model's 15
+#: left a weakly attracting cycle of hardening case 2 still growing, its frequency 5 % off).
+EXPLORE_TRANSIENT = 60.0
 _NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
 _NAME_REASON = (
     "expected letters, digits, '_', '.', '-' (starting with a letter or digit), got {got}"
@@ -268,6 +273,34 @@ class OneParameterContinuation(_Strict):
         "times its law's size (freeplay: delta) or 0.05, 0.2 and 0.5 typical amplitudes.",
     )
 
+    explore: Annotated[tuple[Number, ...], AfterValidator(_at_most_orbits)] = Field(
+        (),
+        description="Parameter values (in its unit), each within `range`, at which the "
+        "settled motion is classified by time simulation after the AUTO runs: equilibrium, "
+        "periodic, quasi-periodic, chaotic or diverged, with the largest Lyapunov exponent, "
+        "frequencies and Poincaré section (for the `poincare`, `spectrum` and "
+        f"`orbit_diagram` plots); at most {ORBITS_MAX} values.",
+    )
+    explore_initial: Annotated[dict[str, float] | None, BeforeValidator(_as_state)] = Field(
+        None,
+        description="Initial state of the `explore` simulations, state name -> value (angles "
+        "in deg, rates in deg/s, other states in their unit; unnamed states 0), as the "
+        f"`seeds`. Unset: the model's first dof at {EXPLORE_OFFSET:g} (deg for an angle).",
+    )
+    explore_transient: Positive = Field(
+        EXPLORE_TRANSIENT,
+        description="Periods of the least damped whirl mode (of the linearisation at the "
+        "origin) simulated and discarded before the `explore` classification's window of 20 "
+        "periods, > 0 (a weakly attracting cycle needs many to settle).",
+    )
+    explore_section: Text | None = Field(
+        None,
+        description="State whose mean level, crossed upwards, is the Poincaré section of the "
+        "`explore` classification (`whirl models` lists the states). Unset: the rate of the "
+        "model's first dof (classical: `dtheta`): the section is at that dof's minima, the "
+        "points of the brute-force orbit diagram.",
+    )
+
     def start_value(self, study: Study) -> float:
         """``start``, or the study value of the parameter when unset (models built by hand)."""
         if self.start is not None:
@@ -368,7 +401,7 @@ class TwoParameterContinuation(_Strict):
 
 PlotKind = Literal["bifurcation", "linear", "root_locus", "damping_multiples", "projections",
                    "period", "phase", "boundary", "amplitude", "time_history", "hub_path",
-                   "law"]
+                   "law", "poincare", "spectrum", "orbit_diagram"]
 Continuation = Annotated[OneParameterContinuation | TwoParameterContinuation,
                         Field(discriminator="type")]
 
