@@ -16,15 +16,15 @@ Layout (units in a ``units`` attribute on every physical dataset)::
             floquet_multipliers (N, n) complex (periodic orbits)
             orbits/<label>/ time (K,) [s], states (K, n)  attrs: point_type, index, period,
                                                                 parameters
-            freeplay_<dof>/ amplitude_ratio (N,) A/delta; describing_function/ amplitude_ratio,
-                            stiffness, parameter (M,)  attrs: dof
             freeplay_<dof>/ (periodic, freeplay law on dof) amplitude_ratio (N,) = A/delta;
                             describing_function/ amplitude_ratio, stiffness, parameter (M,)
+                            attrs: dof
         special_points/             columns: branch, index, point_type, type_name, label,
                                     parameters (K, P), state (K, n), period, stable, status,
                                     criticality, note, bracket (K, 2), residual,
                                     lyapunov (first Lyapunov coefficient of Hopf points),
-                                    refined (K, 2), artefact (persistence as epsilon shrinks)
+                                    refined (K, 2), artefact (persistence as epsilon shrinks),
+                                    torus_angle (TR points, rad)
         seeds/                      (continuation `seeds`) columns: index, seed (K, n), kind,
                                     period, branch, message
         explorations/<k>/           (continuation `explore`, k from 0 in its order) attrs:
@@ -38,8 +38,8 @@ Layout (units in a ``units`` attribute on every physical dataset)::
         cross_checks/               (study `cross_check: true`) columns: branch, index, kind
                                     (orbit | equilibrium), parameter, expected, simulated,
                                     passed, state (the dof an orbit check compares), exact
-                                    (the exact freeplay law's maximum; NaN where none),
-                                    exact (an orbit's max by the exact piecewise law; NaN)
+                                    (an orbit's max by the exact piecewise law; NaN where
+                                    none)
     /linear/sweeps/<parameter>/     values, eigenvalues [1/s], damping_ratio, frequency [rad/s],
                                     whirl (FW | BW | --), datum (scalar, the parameter's
                                     unit; absent in older files); attrs: parameter, multiples
