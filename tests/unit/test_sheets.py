@@ -178,6 +178,13 @@ def test_index_lists_figures_in_number_order_escaped():
     assert np.char.count(page, "<section").item() == 2
 
 
+def test_figure_numbers_sort_by_number_then_letter():
+    from whirl_cli.figures.index import figure_order
+
+    numbers = ["3.12a", "3.3", "3.12", "4.1", "3.22"]
+    assert sorted(numbers, key=figure_order) == ["3.3", "3.12", "3.12a", "3.22", "4.1"]
+
+
 def test_damping_multiples_overlay_style_per_result_colour_per_parameter(continuation):  # noqa: F811
     sweep = replace(make_sweep(), datum=0.25)
     results = [replace(result_with(continuation, k2), linear_sweeps=(sweep,))

@@ -25,7 +25,7 @@ from pathlib import Path
 
 from ..errors import StudyError, WhirlError
 from ..results import StudyResult
-from .index import Entry, index_html
+from .index import Entry, figure_order, index_html
 from .sheet import Sheet, find_sheets, load_sheet
 
 KEY = "whirl-figure-key"
@@ -89,7 +89,7 @@ def make_figures(paths: Sequence[str | os.PathLike[str]], out_dir: Path, results
         raise WhirlError(f"cannot create figure folder {out_dir}: {exc}") from exc
     read: dict[Path, StudyResult] = {}
     outcomes = []
-    for sheet in sorted(sheets, key=lambda s: _order(s.figure)):
+    for sheet in sorted(sheets, key=lambda s: figure_order(s.figure)):
         missing = [f"{p}: {failed.get(p, 'no result')}" for p in sheet.studies()
                    if p not in outputs]
         if missing:
@@ -161,10 +161,6 @@ def stored_key(path: Path) -> str | None:
             return None
         at += 12 + length
     return None
-
-
-def _order(figure: str) -> tuple:
-    return tuple(int(p) if p.isdigit() else p for p in figure.split("."))
 
 
 def _entry(outcome: FigureOutcome, out_dir: Path) -> Entry:

@@ -3,6 +3,7 @@ the commands that made it (pure: text in, text out)."""
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from html import escape
 
@@ -24,7 +25,8 @@ class Entry:
 
 def index_html(entries: list[Entry], title: str) -> str:
     """The page: a heading, then one section per entry in figure-number order."""
-    sections = "\n".join(_section(e) for e in sorted(entries, key=_number))
+    sections = "\n".join(_section(e) for e in sorted(entries,
+                                                      key=lambda e: figure_order(e.figure)))
     return f"""<!DOCTYPE html>
 <html lang="en">
 <head>
@@ -46,8 +48,11 @@ code {{ background: #f4f4f4; padding: 0 0.3em; }}
 """
 
 
-def _number(entry: Entry) -> tuple:
-    return tuple(int(p) if p.isdigit() else p for p in entry.figure.replace("_", ".").split("."))
+def figure_order(figure: str) -> tuple:
+    """Sort key of a figure number: "3.3" before "3.12" before "3.12a" (each part by its
+    number, then its letter)."""
+    parts = [re.fullmatch(r"(\d*)(.*)", part).groups() for part in figure.split(".")]
+    return tuple((int(digits) if digits else -1, rest) for digits, rest in parts)
 
 
 def _section(entry: Entry) -> str:

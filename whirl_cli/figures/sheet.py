@@ -23,13 +23,12 @@ from typing import Annotated, Literal
 from pydantic import AfterValidator, Field, PrivateAttr, ValidationError, model_validator
 
 from ..errors import StudyError
+from ..plots.panels import OVERLAY_KINDS, PANEL_KINDS
 from ..study.messages import _report, _translate
 from ..study.schema import Boolean, Integer, Text, _bound, _fail, _Strict
 from ..study.source import _compose, _read_text, _Tree
 
-PanelKind = Literal["bifurcation", "projections", "period", "phase", "linear", "root_locus",
-                    "damping_multiples", "boundary", "overhang", "amplitude", "time_history",
-                    "hub_path", "law", "poincare", "spectrum", "orbit_diagram"]
+PanelKind = Literal[PANEL_KINDS]  # the kinds plots.panels.draw draws
 _FIGURE_RE = re.compile(r"\d+(\.\d+)*[a-z]?")
 _MAX_PANELS = 64
 
@@ -74,8 +73,8 @@ class PanelSpec(_Strict):
     def _one_source(self) -> PanelSpec:
         if (self.study is None) == (not self.overlay):
             _fail("give exactly one of `study` and `overlay`")
-        if self.overlay and self.kind not in ("bifurcation", "damping_multiples"):
-            _fail("only bifurcation and damping_multiples panels can be overlaid")
+        if self.overlay and self.kind not in OVERLAY_KINDS:
+            _fail(f"only {' and '.join(OVERLAY_KINDS)} panels can be overlaid")
         return self
 
 

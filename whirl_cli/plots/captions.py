@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
-from ..results import Simulation, StudyResult
+from ..results import Boundary, Simulation, StudyResult
 
 
 @dataclass(frozen=True)
@@ -63,6 +63,10 @@ class Captions:
         ``"case <k + 1>"``."""
         labels = self.slice_labels.get(continuation, ())
         return labels[k] if k < len(labels) and labels[k] else f"case {k + 1}"
+
+    def case_labels(self, boundary: Boundary) -> tuple[str, ...]:
+        """:meth:`slice_label` of every slice of ``boundary``, in order."""
+        return tuple(self.slice_label(boundary.name, k) for k in range(len(boundary.slices)))
 
 
 def captions(result: StudyResult) -> Captions:

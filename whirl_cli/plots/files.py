@@ -337,11 +337,9 @@ def _boundary_jobs(result: StudyResult, stem: str, state: str | None,
     jobs = []
     for boundary in result.boundaries:
         matched = None if grid is None else _oriented_grid(grid, boundary.parameter_names)
-        labels = lambda b=boundary: tuple(caption().slice_label(b.name, k)  # noqa: E731
-                                          for k in range(len(b.slices)))
         jobs.append((f"{stem}_{boundary.name}_boundary.png",
-                     lambda b=boundary, g=matched, labels=labels: boundary_plot(
-                         b, g, cases=b.slices, case_labels=labels(),
+                     lambda b=boundary, g=matched: boundary_plot(
+                         b, g, cases=b.slices, case_labels=caption().case_labels(b),
                          title=caption().title(b.parameter_names),
                          xlim=view.xlim, ylim=view.ylim)))
         continuation = next((c for c in result.continuations if c.name == boundary.name

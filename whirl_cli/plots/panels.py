@@ -31,7 +31,7 @@ from .diagrams import (
 from .freeplay import amplitude_diagram, has_amplitudes
 from .key import PLOT_KEY, _colours, display_unit, stability_segments
 from .linear import damping_multiples_plot, linear_sweep_plot, root_locus_plot
-from .maps import _oriented_grid, boundary_plot, overhang_diagram, slice_index
+from .maps import _oriented_grid, boundary_plot, overhang_diagram
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -125,7 +125,7 @@ def draw(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice = PanelCh
             return [ax]
         return _replaced(ax, lambda region: linear_sweep_plot(
             sweep, hz=choice.hz, title=title,
-            axes=tuple(region.subgridspec(2, 1).subplots(sharex=True))), share=False)
+            axes=tuple(region.subgridspec(2, 1).subplots(sharex=True))))
     return _draw_map(result, kind, ax, choice, caption)
 
 
@@ -213,8 +213,8 @@ def _draw_map(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice, cap
     boundary = result.boundaries[names.index(wanted)]
     if kind == "boundary":
         matched = None if grid is None else _oriented_grid(grid, boundary.parameter_names)
-        labels = tuple(caption.slice_label(boundary.name, k) for k in range(len(boundary.slices)))
-        boundary_plot(boundary, matched, cases=boundary.slices, case_labels=labels, ax=ax,
+        boundary_plot(boundary, matched, cases=boundary.slices,
+                      case_labels=caption.case_labels(boundary), ax=ax,
                       title=choice.title or caption.title(boundary.parameter_names))
         return [ax]
     k = 0 if choice.slice is None else choice.slice
@@ -226,16 +226,14 @@ def _draw_map(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice, cap
     if continuation is None:
         raise WhirlError(f"{result.study_name}: no continuation {boundary.name!r} for the "
                          "overhang diagram")
-    assert slice_index(boundary, value) == k
-    unit = boundary.parameter_units[1]
-    title = choice.title or (
-        f"{caption.title(boundary.parameter_names)}\n{caption.slice_label(boundary.name, k)}: "
-        f"{boundary.parameter_names[1]} = {float(value):g}{' ' + unit if unit else ''}")
+    from .files import _slice_title
+
+    title = choice.title or _slice_title(caption, boundary, k, value)
     overhang_diagram(continuation, boundary, value, state=choice.state, ax=ax, title=title)
     return [ax]
 
 
-def _replaced(ax: Axes, make, share: bool = True) -> list[Axes]:
+def _replaced(ax: Axes, make) -> list[Axes]:
     """Remove ``ax`` and let ``make(region)`` draw into its place; the new axes."""
     figure, region = ax.figure, ax.get_subplotspec()
     before = set(figure.axes)
