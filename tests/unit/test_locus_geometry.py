@@ -27,3 +27,75 @@ def test_degenerate_curves():
     width = np.array([1.0, 1.0])
     assert not _near_polyline(np.zeros(2), np.empty((0, 2)), width)
     assert _near_polyline(np.zeros(2), np.zeros((1, 2)), width)
+
+
+def _locus(points: np.ndarray, extremes: np.ndarray | None = None):
+    """A two-parameter locus through ``points`` (K, 2) with one state whose orbit extremes are
+    ``extremes`` (K,) (default: 0.1 along the whole locus)."""
+    from whirl_cli.results import Branch, BranchKind
+
+    n = len(points)
+    top = (np.full(n, 0.1) if extremes is None else extremes)[:, None]
+    return Branch("fold_of_cycles_1a", BranchKind.FOLD_OF_CYCLES_LOCUS, "", ("p", "q"),
+                  ("1", "1"), ("x",), ("1",), points.astype(float), top, -top, np.zeros(n),
+                  np.ones(n), np.ones(n, bool), np.zeros(n, int), np.zeros(n, int),
+                  np.zeros((n, 1), complex))
+
+
+def _circle(turns: float, points_per_turn: int = 200, centre=(0.5, 0.5)) -> np.ndarray:
+    angle = np.linspace(0, 2 * np.pi * turns, int(points_per_turn * turns) + 1)
+    return np.column_stack([centre[0] + 0.2 * np.cos(angle), centre[1] + 0.2 * np.sin(angle)])
+
+
+def test_a_locus_is_cut_where_it_returns_to_its_start():
+    from whirl_cli.continuation.geometry import _closed
+
+    width = np.ones(2)
+    cut = _closed(_locus(_circle(2.5)), width)
+    assert 200 <= len(cut) <= 202  # one turn and the point that closes it
+
+
+def test_a_locus_that_runs_onto_a_closed_loop_is_cut_after_one_turn_of_it():
+    """AUTO can switch onto a closed locus and go round it to its step limit, never back at
+    the start: the curve is cut where it retraces its own path the same way."""
+    from whirl_cli.continuation.geometry import _closed
+
+    lead = np.column_stack([np.linspace(0.9, 0.7, 41), np.full(41, 0.5)])[:-1]
+    curve = np.vstack([lead, _circle(3.0, centre=(0.5, 0.5))])
+    cut = _closed(_locus(curve), np.ones(2))
+    assert len(lead) + 200 <= len(cut) <= len(lead) + 210
+
+
+def test_a_hairpin_or_a_crossing_of_the_projection_is_not_cut():
+    """At a cusp a locus comes back along itself the other way; elsewhere its projection on
+    the parameters may pass over an earlier stretch where the orbit differs: neither is a
+    retrace (the end of such a locus would be lost)."""
+    from whirl_cli.continuation.geometry import _closed
+
+    width = np.ones(2)
+    out = np.column_stack([np.linspace(0.1, 0.6, 101), np.full(101, 0.3)])
+    hairpin = np.vstack([out, out[::-1][1:] + [0.0, 0.002], [[0.1, 0.5]]])
+    assert len(_closed(_locus(np.vstack([[0.05, 0.3], hairpin])), width)) == len(hairpin) + 1
+    # down, back up, down again over the same parameters with a larger orbit
+    path = np.vstack([[0.05, 0.25], out, out[::-1][1:], out[1:]])
+    extremes = np.concatenate([np.full(102, 0.1), np.linspace(0.1, 0.3, 100),
+                               np.full(100, 0.3)])
+    assert len(_closed(_locus(path, extremes), width)) == len(path)
+
+
+def test_mirror_image_starts_are_traced_once():
+    """Two starts of one type at the same parameters with the same period (a symmetric pair
+    of cycles) trace one curve in the parameter plane; a different period is another locus."""
+    from whirl_cli.continuation.loci import _without_twins
+    from whirl_cli.results import PointType, SpecialPoint
+
+    def start(k1: float, period: float, sign: float) -> SpecialPoint:
+        return SpecialPoint("slice_0.periodic_1", 3, int(PointType.LPC), ("K1", "K_psi"),
+                            np.array([k1, 0.2]), np.array([sign * 0.1, 0.0]), period, False)
+
+    starts = [(1, start(-0.0815, 0.82048, 1.0), "r1"),
+              (2, start(-0.0815, 0.8204811, -1.0), "r2"),
+              (3, start(-0.0815, 0.9137, 1.0), "r1"),
+              (4, start(-0.0815 + 1e-4, 0.82048, 1.0), "r1")]
+    kept = _without_twins(starts, np.array([0.8, 0.5]))
+    assert [k for k, _, _ in kept] == [1, 3, 4]

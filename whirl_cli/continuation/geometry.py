@@ -50,15 +50,41 @@ def _on_curve(point: np.ndarray, curve: np.ndarray, width: np.ndarray) -> bool:
     return bool(len(curve)) and float(np.min(np.abs((curve - point) / width).max(axis=1))) < 1e-3
 
 
-def _closed(curve: Branch, width: np.ndarray) -> Branch:
-    """A locus cut where it first returns to its start (AUTO goes round a closed locus until
-    its step limit)."""
+def _closed(curve: Branch, width: np.ndarray, follow: int = 5) -> Branch:
+    """A locus cut where it first comes back to its start, or back onto its own earlier path
+    and follows it the same way for ``follow`` more points: AUTO goes round a closed locus
+    until its step limit, also one it has run onto from elsewhere. Coming back means within
+    0.005 of the ranges of a point it had since left by more than 0.02: for the start in the
+    two parameters, elsewhere also in the orbit's extremes (scaled by their spread along the
+    locus; the parameter projection of a locus may pass over itself)."""
     if len(curve) < 10:
         return curve
-    distance = np.abs((curve.parameters - curve.parameters[0]) / width).max(axis=1)
-    away = np.flatnonzero(distance > 0.02)
-    if not len(away):
-        return curve
-    back = np.flatnonzero((distance < 0.005) & (np.arange(len(curve)) > away[0]))
-    return head(curve, int(back[0]) + 1) if len(back) else curve
+    scaled = curve.parameters[:, :2] / width
+    extremes = np.hstack([curve.state_max, curve.state_min])
+    spread = np.ptp(extremes, axis=0)
+    full = np.hstack([scaled, extremes / np.where(spread > 0, spread, 1.0)])
+    from_start = np.abs(scaled - scaled[0]).max(axis=1)
+    away = np.maximum.accumulate(from_start) > 0.02
+    farthest = np.zeros(len(full))  # how far the curve got from each point since it
+    for j in range(1, len(full)):
+        if away[j] and from_start[j] < 0.005:
+            return head(curve, j + 1)
+        distance = np.abs(full[:j] - full[j]).max(axis=1)
+        farthest[:j] = np.maximum(farthest[:j], distance)
+        for i in np.flatnonzero((distance < 0.005) & (farthest[:j] > 0.02)):
+            if i > 0 and _follows(full, int(i), j, follow):
+                return head(curve, j + 1)
+    return curve
 
+
+def _follows(scaled: np.ndarray, i: int, j: int, follow: int) -> bool:
+    """True if points j+1 .. j+follow each stay within 0.005 of the path near point i and
+    move along it the same way (their nearest earlier points go forward from i)."""
+    after = scaled[j + 1:j + 1 + follow]
+    lower, upper = max(i - follow, 0), min(i + 4 * follow, j)
+    if len(after) < follow or upper <= lower:
+        return False
+    distance = np.abs(after[:, None] - scaled[None, lower:upper]).max(axis=2)
+    nearest = distance.argmin(axis=1)
+    return bool(np.all(distance.min(axis=1) < 0.005) and np.all(np.diff(nearest) >= 0)
+                and nearest[-1] > nearest[0])

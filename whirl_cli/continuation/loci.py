@@ -87,8 +87,11 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
     """Locus branches from the start points, both directions, each locus once.
 
     Starts are taken slice by slice: a start lying on a locus of its type already traced
-    from an earlier slice is the same locus and is not run again (AUTO's runs, not just the
-    results, are saved). Duplicates left (two starts of one slice on one locus) are dropped."""
+    from an earlier slice is the same locus and is not run again, nor is a start with the
+    same type, parameters and period as another (a symmetric twin: its locus is the same
+    curve in the parameter plane). A slice's loci that repeat another locus are dropped
+    before those ending in MX are retried, so only kept loci are retried (AUTO's runs, not
+    just the results, are saved); duplicates left after the retries are dropped."""
     width = np.array([bounds[p][1] - bounds[p][0] for p in pair])
     numbered = list(enumerate(starts, 1))
     waves: dict[str, list] = {}
@@ -100,23 +103,74 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
             kind == point.point_type and _near_polyline(point.parameters[:2], curve.parameters,
                                                         width)
             for kind, curve in curves)]
-        curves += _trace(engine, name, pair, bounds, numerics, todo)
-    kept: list[Branch] = []
-    for _, curve in sorted(curves, key=lambda c: c[1].name):
-        curve = _closed(curve, width)
-        if len(curve) and not any(_on_curve(curve.parameters[0], other.parameters, width)
-                                  and _on_curve(curve.parameters[-1], other.parameters, width)
-                                  for other in kept):
-            kept.append(curve)
-    codim2 = [p for c in kept for p in special_points(c, skip_first=True)
-              if PointType(p.point_type) in CODIM2]
+        traced = _trace(engine, name, pair, bounds, numerics, _without_twins(todo, width))
+        fresh = _distinct([(kind, curve) for kind, _, curve in traced], curves, width)
+        ends = _codim2([c for _, c in curves + list(fresh.values())])
+        open_ = [k for k, (_, curve) in fresh.items() if len(curve) == len(traced[k][2])
+                 and not _ending_at(curve.parameters[-1, :2], ends, width)]
+        for k, curve in zip(open_, _retried(engine, [traced[k][1] for k in open_],
+                                            [fresh[k][1] for k in open_]), strict=True):
+            fresh[k] = (fresh[k][0], curve)
+        curves += list(fresh.values())
+    kept = [curve for _, curve in _distinct(sorted(curves, key=lambda c: c[1].name), [],
+                                            width).values()]
+    codim2 = _codim2(kept)
     return [_locus_end(c, codim2, bounds, width) for c in kept]
+
+
+def _codim2(curves: list[Branch]) -> list[SpecialPoint]:
+    """The codimension-2 points found on ``curves``."""
+    return [p for c in curves for p in special_points(c, skip_first=True)
+            if PointType(p.point_type) in CODIM2]
+
+
+def _ending_at(last: np.ndarray, codim2: list[SpecialPoint], width: np.ndarray
+               ) -> SpecialPoint | None:
+    """The codimension-2 point within 1 % of the ranges of a locus's end ``last``, if any
+    (where a locus naturally ends: AUTO stops there with MX and a retry cannot pass it)."""
+    return next((p for p in codim2 if np.abs((p.parameters[:2] - last) / width).max() < 0.01),
+                None)
+
+
+def _without_twins(starts: list[tuple[int, SpecialPoint, str]], width: np.ndarray
+                   ) -> list[tuple[int, SpecialPoint, str]]:
+    """``starts`` without those of the same type, parameters (to 1e-7 of the ranges) and
+    period (1e-5 relative) as an earlier one: mirror images under a symmetry of the model,
+    whose loci are one curve in the parameter plane (two different points agreeing so is
+    not generic)."""
+    kept: list[tuple[int, SpecialPoint, str]] = []
+    for k, point, runs in starts:
+        if not any(point.point_type == other.point_type
+                   and np.all(np.abs(point.parameters[:2] - other.parameters[:2]) <= 1e-7 * width)
+                   and abs(point.period - other.period) <= 1e-5 * abs(point.period)
+                   for _, other, _ in kept):
+            kept.append((k, point, runs))
+    return kept
+
+
+def _distinct(curves: list[tuple[int, Branch]], known: list[tuple[int, Branch]],
+              width: np.ndarray) -> dict[int, tuple[int, Branch]]:
+    """The (point type, locus) of ``curves`` by their index, each cut where it closes,
+    without those lying on a ``known`` locus of their type or on one kept before them (their
+    first, middle and last points on it: a closed locus starts and ends at one point)."""
+    kept: dict[int, tuple[int, Branch]] = {}
+    for k, (kind, curve) in enumerate(curves):
+        curve = _closed(curve, width)
+        ends = curve.parameters[[0, len(curve) // 2, -1]] if len(curve) else []
+        if len(curve) and not any(
+                kind == other_kind and all(_on_curve(p, other.parameters, width) for p in ends)
+                for other_kind, other in known + list(kept.values())):
+            kept[k] = (kind, curve)
+    return kept
 
 
 def _trace(engine: Engine, name: str, pair: tuple[str, str],
            bounds: dict[str, tuple[float, float]], numerics: Numerics,
-           starts: list[tuple[int, SpecialPoint, str]]) -> list[tuple[int, Branch]]:
-    """(point type, locus branch) of every start, both directions, run in parallel."""
+           starts: list[tuple[int, SpecialPoint, str]]
+           ) -> list[tuple[int, RunSpec, Branch]]:
+    """(point type, last run, locus branch) of every start, both directions, run in
+    parallel (loci that used up their chunk of steps continued, those ending in MX not yet
+    retried)."""
     model = engine.model
     specs = []
     for k, point, runs in starts:
@@ -145,8 +199,7 @@ def _trace(engine: Engine, name: str, pair: tuple[str, str],
     curves = [_read(engine, spec, outcome) for _, spec, outcome in final]
     width = np.array([bounds[p][1] - bounds[p][0] for p in pair])
     curves = _extended(engine, [spec for _, spec, _ in final], curves, numerics, bounds, width)
-    curves = _retried(engine, [spec for _, spec, _ in final], curves)
-    return [(kind, curve) for (kind, _, _), curve in zip(final, curves, strict=True)]
+    return [(kind, spec, curve) for (kind, spec, _), curve in zip(final, curves, strict=True)]
 
 
 #: Locus runs go LOCUS_CHUNK steps at a time: a closed locus is recognised after the chunk
@@ -217,9 +270,8 @@ def _locus_end(curve: Branch, codim2: list[SpecialPoint], bounds: dict[str, tupl
         return replace(curve, end="range")
     if len(curve) > 2 and np.abs((last - curve.parameters[0, :2]) / width).max() < 0.005:
         return replace(curve, end="closed")
-    near = [p for p in codim2 if np.abs((p.parameters[:2] - last) / width).max() < 0.01]
-    if near:
-        point = near[0]
+    point = _ending_at(last, codim2, width)
+    if point is not None:
         where = ", ".join(f"{v:.5g}" for v in point.parameters[:2])
         message = "ok" if curve.status == "ok" else \
             "AUTO stopped with MX at the codimension-2 point (the locus ends there)"
