@@ -10,8 +10,10 @@
 (d) linear analysis: ``whirl_cli.analysis.linear.sweep`` over 2000 airspeeds at once against a
     Python loop calling it point by point, and ``linear.grid`` over 400 x 400 (K_theta, K_psi)
     against a per-point loop.
-(e) ``whirl run`` wall time of every chapter-3 case (plots and cross-checks as the studies
-    ask), warm cache.
+(e) one row per study (chapter 3, gimballed, freeplay, peers): ``whirl run`` wall time (plots
+    and cross-checks as the study asks, warm cache), the summed wall time of the AUTO runs it
+    launched, their ratio, the runs and how many ended in MX; and a linear-only study
+    (``--no-plots``) against a bare ``python -c "import numpy"``.
 (f) a fold of cycles: the LPC of softening case 2 by continuation (``run_study``, and the AUTO
     runs of its periodic family) against bisection on time simulations.
 
@@ -34,8 +36,10 @@
 (h) freeplay: ``whirl run`` of every study in studies/freeplay (seeds, simulation, AUTO,
     persistence in epsilon, plots; target: under 10 s) beside the time a time-marching sweep
     at 0.025 m/s steps would take for one branch of the same cycles.
+(i) the airspeed diagram of combined_airspeed by continuation against time marching at
+    0.025 m/s steps from a large initial condition (which only brackets the fold of cycles).
 
-Run: ``.venv/bin/python benchmarks/bench.py [--only abcdefgh] [--exclude GLOB] [--fold-tol 1e-5]
+Run: ``.venv/bin/python benchmarks/bench.py [--only abcdefghi] [--exclude GLOB] [--fold-tol 1e-5]
 [--fold-periods 3000]``. With all 26 chapter-3 studies it takes about 35 minutes on two cores,
 most of it in the two-parameter ``boundary_*`` studies (``--exclude 'boundary_*.yaml'`` leaves
 them out); other load on the machine shows in the numbers (the load average is printed).
@@ -299,21 +303,67 @@ def grid_figures(model, overrides, size: int = 400) -> None:
 
 
 # ------------------------------------------------------------------------------ (e)
+@dataclass(frozen=True)
+class StudyFigures:
+    """One study's ``whirl run`` (as it asks, warm cache) and the AUTO runs it launched."""
+
+    name: str
+    wall: float  # s
+    auto: float  # s, summed wall_seconds of /runs
+    runs: int
+    mx: int  # runs that ended in MX
+    returncode: int
+
+
+def launched(path: Path) -> tuple[float, int, int]:
+    """(summed wall_seconds, runs, runs ending in MX) of the AUTO runs recorded in ``path``."""
+    total, count, mx = 0.0, 0, 0
+    with h5py.File(path, "r") as handle:
+        for group in handle.get("runs", {}).values():
+            total += float(group.attrs["wall_seconds"])
+            count += 1
+            mx += str(group.attrs["status"]) == "mx"
+    return total, count, mx
+
+
+def study_figures(path: Path, scratch: Path, env: dict[str, str]) -> StudyFigures:
+    out = scratch / "cases" / f"{path.parent.name}-{path.stem}.h5"
+    timed = run(WHIRL + ["run", str(path), "-o", str(out), "--overwrite"], env)
+    auto, runs, mx = launched(out) if out.exists() else (0.0, 0, 0)
+    return StudyFigures(path.stem, timed.seconds, auto, runs, mx, timed.returncode)
+
+
 def per_case(studies: Path, scratch: Path, env: dict[str, str]) -> None:
-    heading("(e) `whirl run` wall time per chapter-3 case (plots and cross-checks as the "
-            "study asks; warm cache)")
+    heading("(e) one row per study: `whirl run` wall time (plots and cross-checks as the study "
+            "asks, warm cache, --jobs 2) and the AUTO runs it launched")
+    groups = [("thesis_ch3", sorted(studies.glob("*.yaml")))] + [
+        (group, sorted((ROOT / "studies" / group).glob("*.yaml")))
+        for group in ("gimballed", "freeplay", "peers")]
+    print(f"  {'study':<34} {'wall s':>8} {'AUTO s':>8} {'wall/AUTO':>9} {'runs':>5} "
+          f"{'MX':>4}")
     rows = []
-    for path in sorted(studies.glob("*.yaml")):
-        timed = run(WHIRL + ["run", str(path), "-o", str(scratch / "cases" / f"{path.stem}.h5"),
-                             "--overwrite"], env)
-        rows.append((path.stem, timed))
-        mark = "" if timed.seconds < 10 else "   over 10 s"
-        print(f"  {path.stem:<26} {timed.seconds:6.2f} s  exit {timed.returncode}{mark}",
-              flush=True)
-    name, slowest = max(rows, key=lambda row: row[1].seconds)
-    over = sum(t.seconds >= 10 for _, t in rows)
-    print(f"  max {slowest.seconds:.2f} s ({name}); {over} of {len(rows)} cases at or over 10 s"
-          f"; median {np.median([t.seconds for _, t in rows]):.2f} s")
+    for group, paths in groups:
+        print(f"  {group}/")
+        for path in paths:
+            row = study_figures(path, scratch, env)
+            rows.append(row)
+            ratio = f"{row.wall / row.auto:9.2f}" if row.auto > 0 else f"{'-':>9}"
+            failed = "" if row.returncode == 0 else f"   exit {row.returncode}"
+            print(f"    {row.name:<32} {row.wall:8.2f} {row.auto:8.2f} {ratio} {row.runs:5d} "
+                  f"{row.mx:4d}{failed}", flush=True)
+    one_parameter = [r for r in rows if r.auto > 0 and not r.name.startswith("boundary_")]
+    ratios = [r.wall / r.auto for r in one_parameter]
+    if ratios:
+        worst = max(one_parameter, key=lambda r: r.wall / r.auto)
+        print(f"  studies with AUTO runs, boundaries aside: median wall/AUTO "
+              f"{np.median(ratios):.2f}, max {worst.wall / worst.auto:.2f} ({worst.name}); "
+              f"target <= 2")
+    linear = CHAPTER3 / "linear_datum_airspeed.yaml"
+    wall = best_of(lambda: run(WHIRL + ["run", str(linear), "-o", str(scratch / "linear.h5"),
+                                        "--no-plots", "--overwrite"], env))
+    bare = best_of(lambda: run([sys.executable, "-c", "import numpy"], env))
+    print(f"  linear-only study ({linear.stem}, --no-plots, best of 3) {wall:.2f} s vs bare "
+          f"`python -c 'import numpy'` {bare:.2f} s: {wall / bare:.1f}x (target <= 3x)")
 
 
 # ------------------------------------------------------------------------------ (f)
@@ -480,9 +530,56 @@ def freeplay_figures(scratch: Path, env: dict[str, str], step: float = 0.025) ->
               f"({speeds * one / timed.seconds:.1f} x), one branch of cycles only", flush=True)
 
 
+def airspeed_figures(scratch: Path, env: dict[str, str], step: float = 0.025,
+                     pitch_degrees: float = 15.0) -> None:
+    """(i): the airspeed diagram of combined_airspeed (the stable cycles above their fold)
+    by continuation (``whirl run --no-plots``, warm cache) against the same curve by time
+    marching: at every ``step`` m/s across the study's range, one simulation from a large
+    initial condition (``pitch_degrees`` on the first dof) until it settles
+    (:func:`whirl_cli.analysis.seeds.settle`), its amplitude recorded; the fold is then only
+    bracketed between the last airspeed that decayed and the first that kept a cycle."""
+    from whirl_cli.analysis import seeds
+    from whirl_cli.output.store import read
+    from whirl_cli.results import PointType
+    from whirl_cli.study import load_study
+
+    heading("(i) airspeed diagram (combined_airspeed): continuation vs time marching at "
+            f"{step} m/s steps")
+    path = CHAPTER3 / "combined_airspeed.yaml"
+    out = scratch / "airspeed.h5"
+    continuation = best_of(lambda: run(WHIRL + ["run", str(path), "-o", str(out), "--no-plots",
+                                                "--overwrite"], env), repeats=2)
+    (result,) = read(out).continuations
+    folds = [float(p.parameters[0]) for p in result.special_points
+             if p.point_type == PointType.LPC]
+    study = load_study(path)
+    spec = study.continuations[0]
+    model = study.variant()
+    seed = np.zeros(model.n_states)
+    seed[0] = np.radians(pitch_degrees)
+    speeds = np.arange(spec.range[0], spec.range[1] + step / 2, step)
+    started = time.perf_counter()
+    kinds = []
+    for speed in speeds:
+        params = model.parameter_vector({**study.parameter_values(), spec.parameter: speed})
+        kinds.append(seeds.settle(model, params, seed).kind)
+    marching = time.perf_counter() - started
+    cycles = [v for v, kind in zip(speeds, kinds, strict=True) if kind == "periodic"]
+    decayed = [v for v, kind in zip(speeds, kinds, strict=True)
+               if kind == "equilibrium" and (not cycles or v < min(cycles))]
+    bracket = (f"[{max(decayed):.3f}, {min(cycles):.3f}] m/s" if cycles and decayed
+               else "not bracketed")
+    print(f"  continuation: {continuation:.2f} s (whole study, --no-plots); fold of cycles at "
+          + ", ".join(f"{v:.5f}" for v in folds) + " m/s")
+    print(f"  time marching: {len(speeds)} airspeeds, {marching:.1f} s "
+          f"({', '.join(f'{kinds.count(k)} {k}' for k in sorted(set(kinds)))}); fold bracketed "
+          f"in {bracket}")
+    print(f"  time marching / continuation: {marching / continuation:.0f}x (target >= 100x)")
+
+
 def main(argv: Sequence[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--only", default="abcdefgh",
+    parser.add_argument("--only", default="abcdefghi",
                         help="letters of the figures to produce, e.g. 'ad' [default: all]")
     parser.add_argument("--fold-tol", type=float, default=1e-5,
                         help="bracket width at which the bisection of (f) stops [N m/rad]")
@@ -517,6 +614,8 @@ def main(argv: Sequence[str] | None = None) -> None:
             gimballed_figures(scratch, env)
         if "h" in only:
             freeplay_figures(scratch, env)
+        if "i" in only:
+            airspeed_figures(scratch, env)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
     print(f"\nload average at the end: {load()}")

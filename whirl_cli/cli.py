@@ -8,15 +8,18 @@ from __future__ import annotations
 
 import math
 import os
-import shutil
 import sys
-import tempfile
 from pathlib import Path
 
 import click
 
-from . import __version__
 from .errors import OutputError, WhirlError
+
+
+def _version() -> str:
+    from . import _version as installed
+
+    return installed()
 
 
 def _console():
@@ -26,7 +29,7 @@ def _console():
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(__version__, prog_name="whirl")
+@click.version_option(package_name="whirl", prog_name="whirl")
 def cli() -> None:
     """Nonlinear whirl-flutter continuation studies with AUTO-07p: YAML in, HDF5 and plots out."""
 
@@ -82,7 +85,7 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
         console.print(f"  {outcome.name:<32} {mark:<8} {outcome.n_points:>6} points "
                       f"{outcome.wall_seconds:7.3f} s{detail}", soft_wrap=True)
 
-    console.print(f"whirl {__version__}: {study.path} -> {output}", soft_wrap=True)
+    console.print(f"whirl {_version()}: {study.path} -> {output}", soft_wrap=True)
     from . import api
     from .interrupts import catching
     from .verdict import verdict
@@ -144,7 +147,7 @@ def summary(result_file: Path, output_format: str) -> None:
     result = api.read(result_file)
     study = _stored_study(result)
     dofs = study.variant().family.dof_names if study is not None else None
-    width = shutil.get_terminal_size().columns if sys.stdout.isatty() else None
+    width = os.get_terminal_size().columns if sys.stdout.isatty() else None
     click.echo(render(result, output_format, dofs, width), nl=False)
 
 
@@ -334,7 +337,7 @@ def doctor() -> None:
     from .models import get_model
 
     problems = []
-    click.echo(f"whirl {__version__}, Python {sys.version.split()[0]}")
+    click.echo(f"whirl {_version()}, Python {sys.version.split()[0]}")
     try:
         click.echo(f"gfortran: {toolchain.gfortran()}")
     except WhirlError as error:
@@ -351,6 +354,8 @@ def doctor() -> None:
             click.echo(f"compile: ok ({executable.path})")
             constants = equilibrium_constants(model, Numerics(), model.parameters[0].name,
                                               (0.0, 0.5), -1)
+            import tempfile
+
             with tempfile.TemporaryDirectory(prefix="whirl-doctor-") as scratch:
                 outcome = runner.run(executable.path, constants, Path(scratch) / "run", "doctor",
                                    timeout=60)
