@@ -67,12 +67,13 @@ def run(study: Study | str | os.PathLike[str], jobs: int = 1,
 
 
 def save(result: StudyResult, path: str | os.PathLike[str], plots: Sequence[str] = (),
-         overwrite: bool = False, state: str | None = None) -> Published:
+         overwrite: bool = False, state: str | None = None, jobs: int = 1) -> Published:
     """Write ``result`` to the HDF5 file ``path`` and its ``plots`` (kinds of
-    :data:`whirl_cli.plots.files.PLOT_KINDS`) next to it, as one unit (all or nothing)."""
+    :data:`whirl_cli.plots.files.PLOT_KINDS`, drawn in ``jobs`` processes) next to it, as one
+    unit (all or nothing)."""
     from .output.study_files import publish_study
 
-    return publish_study(result, Path(path), tuple(plots), overwrite, state=state)
+    return publish_study(result, Path(path), tuple(plots), overwrite, state=state, jobs=jobs)
 
 
 def read(path: str | os.PathLike[str]) -> StudyResult:

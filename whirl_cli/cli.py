@@ -54,7 +54,7 @@ def _output_file(ctx: click.Context, param: click.Parameter, value: str | None) 
               help="HDF5 result file [default: <study name>.h5 in the current directory].")
 @click.option("-j", "--jobs", type=click.IntRange(1, 64), default=min(os.cpu_count() or 1, 64),
               show_default=True,
-              help="AUTO runs (and time-simulation cross-checks) in parallel.")
+              help="AUTO runs (and time-simulation cross-checks, and plots) in parallel.")
 @click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
 @click.option("--plots/--no-plots", default=True, show_default=True,
               help="Write the study's plots (PNG) next to the output file.")
@@ -93,7 +93,7 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     with catching():  # an interrupt while plots are drawn is never lost either
         result = api.run(study, jobs=jobs, on_run=report, keep_runs=keep_runs)
         published = api.save(result, output, study.plots if plots else (), overwrite,
-                             state=study.plot_state)
+                             state=study.plot_state, jobs=jobs)
     for path in published.paths:
         console.print(f"wrote {path}", soft_wrap=True)
     found = verdict(result, published.plot_error)

@@ -6,17 +6,19 @@
 * :func:`quiet_worker` is the initializer of every worker process whirl forks (cross-check
   simulations, sweep studies), which are forked inside :func:`forking`; :func:`end_processes`
   ends such workers after an interrupt.
-* :func:`thread_map` maps over threads that never outlive the call, an interrupt included.
+* :func:`thread_map` maps over threads that never outlive the call, an interrupt included;
+  :func:`forked_map` over forked worker processes (CPU-bound Python: simulations, plots).
 """
 
 from __future__ import annotations
 
+import multiprocessing
 import os
 import signal
 import sys
 import threading
 from collections.abc import Callable, Iterable, Iterator
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from contextlib import contextmanager
 
 
@@ -186,3 +188,41 @@ def thread_map(function: Callable, items: Iterable, workers: int) -> list:
         except KeyboardInterrupt:
             pool.shutdown(wait=True)
             raise
+
+
+#: The function of the :func:`forked_map` in progress, inherited by its forked workers.
+_FORKED: Callable[[int], object] | None = None
+
+
+def _forked_call(k: int):
+    assert _FORKED is not None
+    return _FORKED(k)
+
+
+def forked_map(function: Callable[[int], object], count: int, jobs: int) -> list:
+    """``[function(0), ..., function(count - 1)]``, in up to ``jobs`` worker processes forked
+    from this one (they inherit ``function`` and all it refers to; only the results are
+    pickled back, in order); in this process if ``jobs`` < 2, ``count`` < 2 or fork is not
+    available. Fork only while no other thread of this process runs (e.g. AUTO's). The
+    workers ignore SIGINT and die with the parent (:func:`quiet_worker`); an interrupt or an
+    error here kills them at once."""
+    if jobs < 2 or count < 2 or "fork" not in multiprocessing.get_all_start_methods():
+        return [function(k) for k in range(count)]
+    global _FORKED
+    _FORKED = function
+    try:
+        pool = ProcessPoolExecutor(min(jobs, count), mp_context=multiprocessing.get_context("fork"),
+                                   initializer=quiet_worker)
+        try:
+            with forking():  # map submits every task (and forks the workers) at once
+                results = pool.map(_forked_call, range(count))
+            return list(results)
+        except BaseException:  # e.g. Ctrl-C: the workers hold nothing worth waiting for
+            workers = list((getattr(pool, "_processes", None) or {}).values())
+            pool.shutdown(wait=False, cancel_futures=True)
+            end_processes(workers)
+            raise
+        finally:
+            pool.shutdown(wait=True)
+    finally:
+        _FORKED = None

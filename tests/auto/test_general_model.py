@@ -94,8 +94,8 @@ def cli_run(tmp_path_factory):
                               for ax in figure.axes]
         return original(figure, dpi)
 
-    def render(result, kinds, stem, state=None, dpi=150):
-        nonlocal names
+    def render(result, kinds, stem, state=None, dpi=150, jobs=1):
+        nonlocal names  # drawn here (jobs=1): forked workers would record in their own copy
         names = iter(files.plot_names(result, kinds, stem, state))
         return rendering(result, kinds, stem, state, dpi)
 

@@ -333,6 +333,17 @@ def test_save_study_plots_selected_kind_and_overwrite(tmp_path, continuation):
     assert [p.name for p in tmp_path.iterdir()] == ["run_linear_K1.png"]
 
 
+def test_plots_drawn_in_worker_processes_are_the_same_files(continuation):
+    """``jobs`` forks workers to draw: the same names and PNG bytes, in the same order."""
+    from whirl_cli.plots.files import render_study_plots
+
+    result = StudyResult("study", "classical", (continuation,), (make_sweep(),), ())
+    kinds = ("bifurcation", "linear", "root_locus", "projections")
+    serial = render_study_plots(result, kinds, "run", jobs=1)
+    assert len(serial) == 4
+    assert render_study_plots(result, kinds, "run", jobs=2) == serial
+
+
 def test_save_study_plots_rejects_unknown_kind(tmp_path, continuation):
     result = StudyResult("study", "classical", (continuation,), (), ())
     with pytest.raises(WhirlError):

@@ -16,13 +16,11 @@ AUTO; perturbations and deviations of equilibria in units of the dofs' typical a
 
 from __future__ import annotations
 
-import multiprocessing
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..interrupts import end_processes, forking, quiet_worker
+from ..interrupts import forked_map
 from ..models import Model
 from ..results import Branch, BranchKind, CrossCheck, Orbit, PointType, Simulation
 from .global_bifurcations import BLOWUP_FACTOR
@@ -310,40 +308,11 @@ def cross_check(model: Model, overrides: dict[str, float], branches: tuple[Branc
     branches, perturbations for equilibria), spread along each branch. Not checked: points next
     to bifurcations, orbits in a period blow-up (T > 3 T_Hopf) and equilibria too weakly damped
     or too stiff to simulate in bounded time. ``jobs`` > 1 simulates in that many forked
-    processes (results identical, in the same order); the workers ignore SIGINT and die with
-    the parent (:func:`whirl_cli.interrupts.quiet_worker`), and an interrupt of the parent kills
-    them at once."""
+    processes (:func:`whirl_cli.interrupts.forked_map`: results identical, in the same
+    order; an interrupt of the parent kills them at once)."""
     tasks = planned_checks(branches, per_branch)
-    if jobs > 1 and len(tasks) > 1 and "fork" in multiprocessing.get_all_start_methods():
-        global _SHARED
-        _SHARED = (model, overrides, branches)
-        try:
-            context = multiprocessing.get_context("fork")
-            pool = ProcessPoolExecutor(min(jobs, len(tasks)), mp_context=context,
-                                       initializer=quiet_worker)
-            try:
-                with forking():  # map submits every task (and forks the workers) at once
-                    results = pool.map(_run_check, tasks)
-                return tuple(results)
-            except BaseException:  # e.g. Ctrl-C: the workers hold nothing worth waiting for
-                workers = list((getattr(pool, "_processes", None) or {}).values())
-                pool.shutdown(wait=False, cancel_futures=True)
-                end_processes(workers)
-                raise
-            finally:
-                pool.shutdown(wait=True)
-        finally:
-            _SHARED = None
-    return tuple(_check(model, overrides, branches, task) for task in tasks)
-
-
-#: (model, overrides, branches) of the cross-check in progress, inherited by forked workers.
-_SHARED: tuple | None = None
-
-
-def _run_check(task: tuple[int, str, int]) -> CrossCheck:
-    assert _SHARED is not None
-    return _check(*_SHARED, task)
+    return tuple(forked_map(lambda k: _check(model, overrides, branches, tasks[k]), len(tasks),
+                            jobs))
 
 
 def _check(model: Model, overrides: dict[str, float], branches: tuple[Branch, ...],

@@ -44,17 +44,18 @@ class Published:
 
 
 def publish_study(result: StudyResult, output: Path, kinds: Sequence[str],
-                  overwrite: bool = False, state: str | None = None) -> Published:
+                  overwrite: bool = False, state: str | None = None, jobs: int = 1
+                  ) -> Published:
     """Write ``result`` to ``output`` and its plots of ``kinds`` next to it (``<output
-    stem>_*.png``; bifurcation diagrams of ``state``, None: the first dof), as one unit; see
-    the module doc."""
+    stem>_*.png``; bifurcation diagrams of ``state``, None: the first dof; drawn in ``jobs``
+    processes), as one unit; see the module doc."""
     output = Path(output)
     plots, plot_error = [], ""
     if kinds:
         from ..plots.files import render_study_plots
 
         try:
-            plots = render_study_plots(result, tuple(kinds), output.stem, state)
+            plots = render_study_plots(result, tuple(kinds), output.stem, state, jobs=jobs)
         except Exception as error:  # a bug in drawing: keep the result, say what went wrong
             plot_error = f"plots: {type(error).__name__}: {error}"
     targets = [output.parent / name for name, _ in plots]

@@ -179,12 +179,16 @@ def plot_names(result: StudyResult, kinds: tuple[str, ...], stem: str,
 
 
 def render_study_plots(result: StudyResult, kinds: tuple[str, ...], stem: str,
-                       state: str | None = None, dpi: int = 150, view: View = View()
-                       ) -> list[tuple[str, bytes]]:
+                       state: str | None = None, dpi: int = 150, view: View = View(),
+                       jobs: int = 1) -> list[tuple[str, bytes]]:
     """(file name, PNG bytes) of every figure of :func:`save_study_plots`, rendered in
-    memory; nothing is written."""
-    return [(name, _png(figure, dpi))
-            for name, figure in study_figures(result, kinds, stem, state, view)]
+    memory, in ``jobs`` forked processes (:func:`whirl_cli.interrupts.forked_map`; the same
+    bytes in the same order for any ``jobs``); nothing is written."""
+    from ..interrupts import forked_map
+
+    named = _named_jobs(result, kinds, stem, state, view)
+    return forked_map(lambda k: (named[k][0], _png(_viewed(named[k][1](), view), dpi)),
+                      len(named), jobs)
 
 
 def study_figures(result: StudyResult, kinds: tuple[str, ...], stem: str = "",
