@@ -33,7 +33,7 @@
 (g) the 8-state gimballed model: code generation (numeric module and Fortran) and compilation
     of ``gimballed_poly`` in a cold cache (target: under 60 s), then ``whirl run`` of every
     study in studies/gimballed (target: under 20 s each).
-(h) freeplay: ``whirl run`` of every study in studies/freeplay (seeds, simulation, AUTO,
+(h) freeplay: ``whirl run`` of the airspeed studies in studies/freeplay (seeds, simulation, AUTO,
     persistence in epsilon, plots; target: under 10 s) beside the time a time-marching sweep
     at 0.025 m/s steps would take for one branch of the same cycles.
 (i) the airspeed diagram of combined_airspeed by continuation against time marching at
@@ -502,16 +502,16 @@ def gimballed_figures(scratch: Path, env: dict[str, str]) -> None:
 
 
 def freeplay_figures(scratch: Path, env: dict[str, str], step: float = 0.025) -> None:
-    """(h): the freeplay airspeed studies (seeds, simulation, AUTO, persistence, plots) against
-    the time a time-marching sweep at ``step`` m/s would take for the same curve (one seed
-    settled per airspeed, measured at the study's start)."""
+    """(h): the freeplay airspeed studies, ``*_airspeed.yaml`` (seeds, simulation, AUTO,
+    persistence, plots) against the time a time-marching sweep at ``step`` m/s would take for
+    the same curve (one seed settled per airspeed, measured at the study's start)."""
     import numpy as np
 
     from whirl_cli.analysis import seeds
     from whirl_cli.study import load_study
 
     heading("(h) freeplay: continuation from seeds vs a time-marching sweep")
-    for path in sorted((ROOT / "studies" / "freeplay").glob("*.yaml")):
+    for path in sorted((ROOT / "studies" / "freeplay").glob("*_airspeed.yaml")):
         timed = run(WHIRL + ["run", str(path), "-o", str(scratch / f"{path.stem}.h5"),
                              "--overwrite"], env)
         study = load_study(path)

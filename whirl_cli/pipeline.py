@@ -64,7 +64,8 @@ def _run_study(study: Study, workroot: Path, jobs: int,
             continuations.append(continuation)
             found_boundaries.append(boundary)
             continue
-        starts, outcomes = seeded_orbits(model, parameters, spec)
+        starts, outcomes = seeded_orbits(model, parameters, spec.parameter, spec.start,
+                                         spec.seeds)
 
         def continued(name: str, values: dict[str, float], spec=spec, starts=starts):
             return one_parameter(
@@ -164,23 +165,24 @@ def explorations(model, overrides: dict[str, float], spec) -> tuple[Exploration,
     return tuple(found)
 
 
-def seeded_orbits(model, overrides: dict[str, float], spec
+def seeded_orbits(model, overrides: dict[str, float], parameter: str, start: float, given
                   ) -> tuple[tuple[OrbitStart, ...], tuple[SeedOutcome, ...]]:
-    """The continuation's ``seeds`` simulated at its start value: one orbit start per distinct
-    limit cycle they settle on, and what became of every seed (issue 15, item 3)."""
-    if not spec.seeds:
+    """A continuation's seeds (``given``: ``auto`` or state mappings) simulated with
+    ``parameter`` at ``start``: one orbit start per distinct limit cycle they settle on, and
+    what became of every seed (issue 15, item 3)."""
+    if not given:
         return (), ()
-    values = {**overrides, spec.parameter: float(spec.start)}
+    values = {**overrides, parameter: float(start)}
     params = model.parameter_vector(values)
-    if spec.seeds == "auto":
+    if given == "auto":
         initial = seeds.auto_seeds(model, values)
     else:
-        initial = [seeds.seed_state(model, given) for given in spec.seeds]
+        initial = [seeds.seed_state(model, state) for state in given]
     settled = [seeds.settle(model, params, y0) for y0 in initial]
     kept = seeds.distinct(settled)
     families = {k: f"periodic_o{n}" for n, k in enumerate(kept, 1)}
-    starts = tuple(OrbitStart(replace(settled[k].orbit, parameters=np.array([spec.start])),
-                              float(spec.start), f"seed {k + 1} settled by time simulation")
+    starts = tuple(OrbitStart(replace(settled[k].orbit, parameters=np.array([start])),
+                              float(start), f"seed {k + 1} settled by time simulation")
                    for k in kept)
     outcomes = tuple(
         SeedOutcome(k + 1, s.seed, s.kind, s.orbit.period if s.orbit else float("nan"),
@@ -188,6 +190,25 @@ def seeded_orbits(model, overrides: dict[str, float], spec
                     s.message)
         for k, s in enumerate(settled))
     return starts, outcomes
+
+
+def slice_seeds(model, overrides: dict[str, float], spec
+                ) -> tuple[tuple[tuple[OrbitStart, ...], ...], tuple[SeedOutcome, ...]]:
+    """A two-parameter continuation's seeds simulated at ``start`` on every slice: the orbit
+    starts of each slice, and every seed's outcome (numbered across the slices, families
+    named ``slice_<k>.periodic_o<n>`` as the slice branches are)."""
+    first, second = spec.parameters
+    if not spec.seeds:
+        return (), ()
+    per_slice, outcomes = [], []
+    for k, value in enumerate(spec.slice_values):
+        starts, found = seeded_orbits(model, {**overrides, second: value}, first, spec.start,
+                                      spec.seeds)
+        per_slice.append(starts)
+        outcomes += [replace(o, index=len(outcomes) + n + 1,
+                             branch=o.branch and f"slice_{k}.{o.branch}")
+                     for n, o in enumerate(found)]
+    return tuple(per_slice), tuple(outcomes)
 
 
 def resolved_parameters(model, overrides: dict[str, float]) -> tuple[ParameterValue, ...]:
@@ -204,9 +225,11 @@ def _two_parameter(engine: Engine, study: Study, spec, parameters: dict[str, flo
     model = engine.model
     pair = tuple(spec.parameters)
     bounds = spec.bounds(study.names())
+    orbits, outcomes = slice_seeds(model, parameters, spec)
     continuation, curves = two_parameter(engine, spec.name, pair, bounds, spec.start,
                                          spec.slice_values, tuple(spec.loci), parameters,
-                                         numerics)
+                                         numerics, slice_orbits=orbits)
+    continuation = replace(continuation, seeds=outcomes)
     per_slice = [tuple(b for b in continuation.branches if b.name.startswith(f"slice_{k}."))
                  for k in range(len(spec.slices))]
     found = boundaries.boundary(spec.name, model, parameters, pair, bounds, spec.method,

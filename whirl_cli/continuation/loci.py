@@ -17,6 +17,7 @@ from .engine import Engine, Numerics, RunSpec, _read
 from .equilibria import equilibrium_constants
 from .geometry import _at_range_edge, _chunk_used, _closed, _near_polyline, _on_curve
 from .one_parameter import one_parameter
+from .periodic import OrbitStart
 
 #: Special point type -> (locus name in studies, branch kind of its locus).
 LOCI = {
@@ -46,11 +47,14 @@ def locus_constants(model: Model, numerics: Numerics, pair: tuple[str, str],
 def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
                   bounds: dict[str, tuple[float, float]], start: float,
                   slices: tuple[float, ...], loci: tuple[str, ...],
-                  parameters: dict[str, float], numerics: Numerics
+                  parameters: dict[str, float], numerics: Numerics,
+                  slice_orbits: tuple[tuple[OrbitStart, ...], ...] = ()
                   ) -> tuple[ContinuationResult, list[Branch]]:
     """One-parameter runs at every slice of the second parameter, then the loci of their
     special points (both directions, each locus once). Returns the continuation (slice branches
-    named ``slice_<k>.<branch>`` and the locus branches) and the locus branches."""
+    named ``slice_<k>.<branch>`` and the locus branches) and the locus branches.
+    ``slice_orbits``: per slice, orbits (e.g. settled seeds) whose periodic families that
+    slice's run continues too (their folds of cycles start loci as a Hopf family's do)."""
     first, second = pair
     wanted = {kind for kind, (locus, _) in LOCI.items() if locus in loci}
     periodic = PointType.LPC in wanted
@@ -60,7 +64,8 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
     starts: list[tuple[SpecialPoint, str]] = []
     for k, value in enumerate(slices):
         result = one_parameter(engine, f"{name}.slice_{k}", first, start, bounds[first],
-                               {**parameters, second: value}, numerics, periodic=periodic)
+                               {**parameters, second: value}, numerics, periodic=periodic,
+                               start_orbits=slice_orbits[k] if slice_orbits else ())
         runs = {b.name: b.run for b in result.branches}
         for branch in result.branches:
             branches.append(replace(branch, name=f"slice_{k}.{branch.name}"))

@@ -336,6 +336,7 @@ def _continuation_problems(
             taken.add(name)
         if item.get("type") == "two-parameter":
             problems += _pair_problems(loc, item, names, family, values)
+            problems += _seed_problems(loc, item.get("seeds"), family)
             continue
         found = _parameter_problems(loc + ("parameter",), parameter, names, family)
         if not found and isinstance(parameter, str):

@@ -111,6 +111,17 @@ def _as_seeds(value: Any) -> str | tuple[dict[str, float], ...]:
     return tuple({k: float(v) for k, v in seed.items()} for seed in value)
 
 
+#: The description of ``seeds`` (one- and two-parameter continuations share the key).
+SEEDS_TEXT = (
+    "Initial states simulated at `start` until they settle; every distinct limit cycle found "
+    "is continued both ways (cycles no Hopf point leads to). A list of mappings state name -> "
+    "value (angles in deg, rates in deg/s, other states in their unit; unnamed states 0), or "
+    "`auto`: each nonlinear dof displaced alone by 2, 4 and 8 times its law's size (freeplay: "
+    "delta) or 0.05, 0.2 and 0.5 typical amplitudes. Two-parameter: simulated at `start` on "
+    "every slice; the folds of cycles of the families found are loci starts (e.g. freeplay "
+    "LCOs, which no Hopf point leads to).")
+
+
 def _as_state(value: Any) -> dict[str, float]:
     """A mapping state name -> finite number (the names are checked against the model)."""
     if not _is_state(value):
@@ -264,14 +275,7 @@ class OneParameterContinuation(_Strict):
         description="Parameter values (in its unit) at which every branch stores a labelled "
         "solution: orbit profiles for phase-plane plots (AUTO UZR).",
     )
-    seeds: Annotated[Any, BeforeValidator(_as_seeds)] = Field(
-        (),
-        description="Initial states simulated at `start` until they settle; every distinct "
-        "limit cycle found is continued both ways (cycles no Hopf point leads to). A list of "
-        "mappings state name -> value (angles in deg, rates in deg/s, other states in their "
-        "unit; unnamed states 0), or `auto`: each nonlinear dof displaced alone by 2, 4 and 8 "
-        "times its law's size (freeplay: delta) or 0.05, 0.2 and 0.5 typical amplitudes.",
-    )
+    seeds: Annotated[Any, BeforeValidator(_as_seeds)] = Field((), description=SEEDS_TEXT)
 
     explore: Annotated[tuple[Number, ...], AfterValidator(_at_most_orbits)] = Field(
         (),
@@ -369,6 +373,7 @@ class TwoParameterContinuation(_Strict):
         "a number or `{value: number, label: text}` (`label` names it in figures); unset: its "
         "study value.",
     )
+    seeds: Annotated[Any, BeforeValidator(_as_seeds)] = Field((), description=SEEDS_TEXT)
     loci: tuple[LocusKind, ...] = Field(
         ("hopf", "branch_point", "fold", "fold_of_cycles"),
         description="Which loci to continue: `hopf`, `branch_point` (pitchfork), `fold` (of "
