@@ -20,6 +20,7 @@ from .continuation.engine import Engine, Numerics
 from .continuation.loci import two_parameter
 from .continuation.one_parameter import one_parameter
 from .continuation.periodic import OrbitStart
+from .interrupts import forked_map, thread_map
 from .output.provenance import provenance
 from .results import (
     Boundary,
@@ -65,7 +66,7 @@ def _run_study(study: Study, workroot: Path, jobs: int,
             found_boundaries.append(boundary)
             continue
         starts, outcomes = seeded_orbits(model, parameters, spec.parameter, spec.start,
-                                         spec.seeds)
+                                         spec.seeds, jobs)
 
         def continued(name: str, values: dict[str, float], spec=spec, starts=starts):
             return one_parameter(
@@ -73,11 +74,11 @@ def _run_study(study: Study, workroot: Path, jobs: int,
                 numerics, branch_points=spec.branch_points, periodic=spec.periodic,
                 orbits_at=spec.orbits_at, start_orbits=starts)
 
-        continuation = replace(continued(spec.name, parameters), seeds=outcomes)
-        if model.smoothing_parameters:  # special points must persist as the smoothing shrinks
-            refined = [continued(f"{spec.name}_eps{k}", persistence.refined_parameters(
-                parameters, model.smoothing_parameters, factor))
-                for k, factor in enumerate(persistence.FACTORS, 1)]
+        # with a smoothed law, special points must persist as the smoothing shrinks: the
+        # continuation is repeated at each refined smoothing, all side by side
+        base, *refined = repeated(continued, spec.name, parameters, model.smoothing_parameters)
+        continuation = replace(base, seeds=outcomes)
+        if refined:
             continuation = persistence.annotate(continuation, refined,
                                                 spec.range[1] - spec.range[0])
         if freeplay.freeplay_dofs(model):  # amplitudes / delta, describing function
@@ -110,6 +111,22 @@ def _run_study(study: Study, workroot: Path, jobs: int,
         attributes=provenance(study), boundaries=tuple(found_boundaries), linear_grid=grid,
         parameters=resolved_parameters(model, parameters),
         simulations=tuple(simulations(study, model)))
+
+
+def repeated(continued: Callable, name: str, parameters: dict[str, float],
+             smoothing: tuple[str, ...]) -> list[ContinuationResult]:
+    """``continued(name, parameters)``, then, if the model smooths a law (``smoothing``: its
+    widths), the same with every width times each of :data:`persistence.FACTORS` (runs
+    ``<name>_eps<k>``): all side by side (they share nothing but the compiled program)."""
+    factors = (1.0, *persistence.FACTORS) if smoothing else (1.0,)
+
+    def one(k: int) -> ContinuationResult:
+        if k == 0:
+            return continued(name, parameters)
+        return continued(f"{name}_eps{k}", persistence.refined_parameters(
+            parameters, smoothing, factors[k]))
+
+    return thread_map(one, range(len(factors)), len(factors))
 
 
 def simulations(study: Study, model) -> list[Simulation]:
@@ -165,11 +182,11 @@ def explorations(model, overrides: dict[str, float], spec) -> tuple[Exploration,
     return tuple(found)
 
 
-def seeded_orbits(model, overrides: dict[str, float], parameter: str, start: float, given
-                  ) -> tuple[tuple[OrbitStart, ...], tuple[SeedOutcome, ...]]:
+def seeded_orbits(model, overrides: dict[str, float], parameter: str, start: float, given,
+                  jobs: int = 1) -> tuple[tuple[OrbitStart, ...], tuple[SeedOutcome, ...]]:
     """A continuation's seeds (``given``: ``auto`` or state mappings) simulated with
-    ``parameter`` at ``start``: one orbit start per distinct limit cycle they settle on, and
-    what became of every seed (issue 15, item 3)."""
+    ``parameter`` at ``start``, ``jobs`` at a time (forked processes): one orbit start per
+    distinct limit cycle they settle on, and what became of every seed (issue 15, item 3)."""
     if not given:
         return (), ()
     values = {**overrides, parameter: float(start)}
@@ -178,7 +195,8 @@ def seeded_orbits(model, overrides: dict[str, float], parameter: str, start: flo
         initial = seeds.auto_seeds(model, values)
     else:
         initial = [seeds.seed_state(model, state) for state in given]
-    settled = [seeds.settle(model, params, y0) for y0 in initial]
+    settled = forked_map(lambda k: seeds.settle(model, params, initial[k]), len(initial),
+                         jobs)
     kept = seeds.distinct(settled)
     families = {k: f"periodic_o{n}" for n, k in enumerate(kept, 1)}
     starts = tuple(OrbitStart(replace(settled[k].orbit, parameters=np.array([start])),
@@ -192,7 +210,7 @@ def seeded_orbits(model, overrides: dict[str, float], parameter: str, start: flo
     return starts, outcomes
 
 
-def slice_seeds(model, overrides: dict[str, float], spec
+def slice_seeds(model, overrides: dict[str, float], spec, jobs: int = 1
                 ) -> tuple[tuple[tuple[OrbitStart, ...], ...], tuple[SeedOutcome, ...]]:
     """A two-parameter continuation's seeds simulated at ``start`` on every slice: the orbit
     starts of each slice, and every seed's outcome (numbered across the slices, families
@@ -203,7 +221,7 @@ def slice_seeds(model, overrides: dict[str, float], spec
     per_slice, outcomes = [], []
     for k, value in enumerate(spec.slice_values):
         starts, found = seeded_orbits(model, {**overrides, second: value}, first, spec.start,
-                                      spec.seeds)
+                                      spec.seeds, jobs)
         per_slice.append(starts)
         outcomes += [replace(o, index=len(outcomes) + n + 1,
                              branch=o.branch and f"slice_{k}.{o.branch}")
@@ -225,7 +243,7 @@ def _two_parameter(engine: Engine, study: Study, spec, parameters: dict[str, flo
     model = engine.model
     pair = tuple(spec.parameters)
     bounds = spec.bounds(study.names())
-    orbits, outcomes = slice_seeds(model, parameters, spec)
+    orbits, outcomes = slice_seeds(model, parameters, spec, engine.jobs)
     continuation, curves = two_parameter(engine, spec.name, pair, bounds, spec.start,
                                          spec.slice_values, tuple(spec.loci), parameters,
                                          numerics, slice_orbits=orbits)
