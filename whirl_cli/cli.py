@@ -476,7 +476,21 @@ def compare(file_a: Path, file_b: Path, rtol: float | None, atol: float | None,
 
 
 def main() -> None:
-    """Console entry point: whirl errors as one message, unexpected errors without traceback."""
+    """Console entry point: whirl errors as one message, unexpected errors without traceback.
+
+    Once the command is over (its outputs complete or removed), SIGINT and SIGTERM take their
+    default action: one arriving while the interpreter shuts down (joining the worker pools'
+    threads) ends the process at once instead of printing a KeyboardInterrupt traceback."""
+    try:
+        _main()
+    finally:
+        import signal
+
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def _main() -> None:
     try:
         cli.main(standalone_mode=False)
     except click.exceptions.Abort as error:  # click's wrapper of a KeyboardInterrupt
