@@ -329,7 +329,8 @@ def _stored_study(result):
 # ------------------------------------------------------------------------------------ doctor
 @cli.command()
 def doctor() -> None:
-    """Check gfortran and AUTO-07p: find them, compile a model, run AUTO once."""
+    """Check gfortran and AUTO-07p: find them, compile a model, run AUTO once (with the engine
+    WHIRL_AUTO_ENGINE chooses: debian or bifpy)."""
     from .auto import runner, toolchain
     from .auto.codegen import fortran_source
     from .continuation.engine import Numerics
@@ -343,8 +344,14 @@ def doctor() -> None:
     except WhirlError as error:
         problems.append(error.message)
     try:
-        click.echo(f"AUTO-07p: {toolchain.AUTO_DIR} ({len(toolchain.runtime_objects())} runtime "
-                   f"objects, package {toolchain.auto_version()})")
+        click.echo(f"AUTO engine: {toolchain.engine_name()} ({toolchain.ENGINE_VARIABLE}, one "
+                   f"of {', '.join(toolchain.ENGINES)}; default {toolchain.DEFAULT_ENGINE})")
+        chosen = toolchain.engine()
+        click.echo(f"AUTO-07p: {chosen.version}: {chosen.location} "
+                   f"({', '.join(o.name for o in chosen.objects)})"
+                   if chosen.name == "bifpy" else
+                   f"AUTO-07p: {chosen.location} ({len(chosen.objects)} runtime objects, "
+                   f"package {chosen.version})")
     except WhirlError as error:
         problems.append(error.message)
     if not problems:

@@ -15,6 +15,7 @@ import pytest
 from click.testing import CliRunner
 
 from whirl_cli import __version__
+from whirl_cli.auto.toolchain import auto_version
 from whirl_cli.cli import cli
 from whirl_cli.errors import WhirlError
 from whirl_cli.output import store
@@ -50,13 +51,14 @@ def renamed(path: Path, name: str, **replace: str) -> Path:
     return target
 
 
-def fake_output(path: Path, sha: str, version: str = __version__, code: str | None = None
-                ) -> None:
+def fake_output(path: Path, sha: str, version: str = __version__, code: str | None = None,
+                auto: str | None = None) -> None:
     """A result file that has only the root attributes a sweep's plan reads (by default the
-    ones of an output of this very code)."""
+    ones of an output of this very code and AUTO engine)."""
     with h5py.File(path, "w") as handle:
         handle.attrs.update(whirl_schema=1, study_sha256=sha, whirl_version=version,
-                            whirl_code_sha256=code_sha256() if code is None else code)
+                            whirl_code_sha256=code_sha256() if code is None else code,
+                            auto_version=auto_version() if auto is None else auto)
 
 
 # ------------------------------------------------------------------------------ plan (no AUTO)
@@ -87,6 +89,8 @@ def test_plan_decides_run_skip_and_invalid(tmp_path):
     fake_output(out / "linear-case2.h5", study.sha256, code="0" * 64)
     assert plan([first], out, plots=False)[0].reason == "whirl's code changed"
     assert plan([first], out, force=True)[0].action == RUN
+    fake_output(out / "linear-case2.h5", study.sha256, auto="0.9.1")
+    assert plan([first], out, plots=False)[0].reason == f"AUTO engine 0.9.1 -> {auto_version()}"
     fake_output(out / "linear-case2.h5", "0" * 64)
     assert plan([first], out)[0].reason == "study changed"
     fake_output(out / "linear-case2.h5", study.sha256, version="0.0.1")

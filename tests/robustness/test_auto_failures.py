@@ -174,7 +174,7 @@ def test_missing_gfortran_or_auto_is_a_clear_message(broken, tmp_path):
     (empty / "bin").mkdir(parents=True)
     cache = tmp_path / "cache"
     extra = {"PATH": str(empty / "bin")} if broken == "gfortran" else {
-        "WHIRL_AUTO_DIR": str(empty)}
+        "WHIRL_AUTO_DIR": str(empty), "WHIRL_AUTO_ENGINE": "debian"}
     env = environment(cache, **extra)
     study = Path(__file__).parents[2] / "studies" / "thesis_ch3" / "linear_case2.yaml"
     output = tmp_path / "out" / "r.h5"
@@ -193,4 +193,36 @@ def test_missing_gfortran_or_auto_is_a_clear_message(broken, tmp_path):
         assert "sudo apt-get install auto-07p gfortran" in stderr
         assert "Traceback" not in stdout + stderr
     assert not output.exists() and not list((tmp_path / "out").glob("*"))
+    assert not list(cache.rglob("*.exe"))
+
+
+@pytest.mark.parametrize("case", ["unknown", "bifpy_broken"])
+def test_unavailable_engine_is_a_clear_message(case, tmp_path):
+    """WHIRL_AUTO_ENGINE naming no engine, or bifpy installed without its AUTO build (a package
+    ``bifpy`` without ``auto/_lib``, found first on PYTHONPATH): `whirl run` and `whirl doctor`
+    exit 1 with what is wrong and how to fix it, no output file, no traceback."""
+    cache = tmp_path / "cache"
+    if case == "unknown":
+        extra = {"WHIRL_AUTO_ENGINE": "cygwin"}
+        expected = ("WHIRL_AUTO_ENGINE='cygwin' is not an AUTO engine; choose one of: "
+                    "debian, bifpy")
+    else:
+        shadow = tmp_path / "shadow" / "bifpy"
+        shadow.mkdir(parents=True)
+        (shadow / "__init__.py").write_text("")
+        extra = {"WHIRL_AUTO_ENGINE": "bifpy", "PYTHONPATH": str(shadow.parent)}
+        expected = (f"WHIRL_AUTO_ENGINE=bifpy: main.o, libbifpy.a not found in "
+                    f"{shadow / 'auto' / '_lib'}")
+    env = environment(cache, **extra)
+    study = Path(__file__).parents[2] / "studies" / "thesis_ch3" / "linear_case2.yaml"
+    output = tmp_path / "out" / "r.h5"
+    for command in ([str(WHIRL), "run", str(study), "-o", str(output)], [str(WHIRL), "doctor"]):
+        done = subprocess.run(command, env=env, cwd=tmp_path, capture_output=True, text=True,
+                              timeout=120, check=False)
+        assert done.returncode == 1, (command, done.stdout, done.stderr)
+        assert expected in done.stderr, done.stderr
+        if case == "bifpy_broken":
+            assert "pip install" in done.stderr and "make setup" in done.stderr
+        assert "Traceback" not in done.stdout + done.stderr
+    assert not output.exists()
     assert not list(cache.rglob("*.exe"))

@@ -251,12 +251,12 @@ def _classify(returncode: int | None, timed_out: bool, stdout: str, n_points: in
     assert returncode is not None
     if returncode < 0 or returncode > 128:
         return "crashed", f"AUTO crashed with {_describe_signal(returncode)}"
-    if returncode != 0:
-        return "error", f"AUTO exited with status {returncode}"
-    for pattern, meaning in FATAL_PATTERNS:
+    for pattern, meaning in FATAL_PATTERNS:  # before the status: bifpy's AUTO exits 1 here
         found = re.search(pattern, stdout)
         if found:
             return "error", f"{meaning}: AUTO said '{found.group(0).strip()}'"
+    if returncode != 0:
+        return "error", f"AUTO exited with status {returncode}"
     if n_points == 0:
         return "error", "AUTO wrote no solution points"
     if any(kind == "MX" for kind, _ in labels):

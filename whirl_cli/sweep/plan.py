@@ -1,9 +1,10 @@
 """Planning a sweep (pure, no AUTO): which studies to (re)run, skip, complete or refuse.
 
 :func:`plan` finds the study files, validates them, names each output
-``<out_dir>/<study name>.h5`` and decides per study: ``run`` (no output yet, the study or whirl
-changed, or ``force``), ``skip`` (the output holds the same ``study_sha256``,
-``whirl_version`` and ``whirl_code_sha256``), ``plot`` (up to date, but plots it should have are
+``<out_dir>/<study name>.h5`` and decides per study: ``run`` (no output yet, the study, whirl
+or the AUTO engine changed, or ``force``), ``skip`` (the output holds the same
+``study_sha256``, ``whirl_version``, ``whirl_code_sha256`` and, where stored,
+``auto_version``), ``plot`` (up to date, but plots it should have are
 missing: they are drawn from the stored result) or ``invalid`` (the YAML does not validate, or
 two files share a name).
 """
@@ -18,6 +19,7 @@ from pathlib import Path
 import h5py
 
 from .. import __version__
+from ..auto.toolchain import auto_version
 from ..errors import StudyError, WhirlError
 from ..output.provenance import code_sha256
 from ..output.study_files import missing_plots
@@ -77,8 +79,10 @@ def plan(paths: Iterable[str | os.PathLike[str]], out_dir: str | os.PathLike[str
     """What a sweep of ``paths`` into ``out_dir`` will do, study by study (no AUTO, no writes).
 
     A study is skipped when ``<out_dir>/<study name>.h5`` exists with the same
-    ``study_sha256``, ``whirl_version`` and ``whirl_code_sha256`` root attributes, unless
-    ``force``; if ``plots`` and some of its plots are missing, they are drawn ("plot").
+    ``study_sha256``, ``whirl_version``, ``whirl_code_sha256`` and ``auto_version`` (the AUTO
+    engine, :func:`whirl_cli.auto.toolchain.auto_version`; not checked if not stored) root
+    attributes, unless ``force``; if ``plots`` and some of its plots are missing, they are
+    drawn ("plot").
     """
     out_dir = Path(out_dir)
     items: list[SweepItem] = []
@@ -123,6 +127,8 @@ def _decide(study: Study, output: Path, force: bool) -> tuple[str, str, tuple[st
         return RUN, f"whirl {stored.whirl_version} -> {__version__}", ()
     if stored.code_sha256 != code_sha256():
         return RUN, "whirl's code changed", ()
+    if stored.auto_version and stored.auto_version != auto_version():
+        return RUN, f"AUTO engine {stored.auto_version} -> {auto_version()}", ()
     return SKIP, "up to date", stored.problems
 
 
@@ -134,6 +140,7 @@ class StoredState:
     whirl_version: str
     code_sha256: str  # "" in files written before whirl recorded it
     problems: tuple[str, ...]  # by the failure policy of :mod:`whirl_cli.verdict`
+    auto_version: str = ""  # the AUTO engine's version (toolchain.auto_version); "" if unknown
 
 
 def stored_state(output: Path) -> StoredState:
@@ -156,5 +163,6 @@ def stored_state(output: Path) -> StoredState:
                 if failed:
                     problems.append(f"{failed} cross-check(s) failed in {name}")
         return StoredState(text(attrs["study_sha256"]), text(attrs["whirl_version"]),
-                           text(attrs.get("whirl_code_sha256", "")), tuple(problems))
+                           text(attrs.get("whirl_code_sha256", "")), tuple(problems),
+                           text(attrs.get("auto_version", "")))
 

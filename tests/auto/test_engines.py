@@ -1,0 +1,89 @@
+"""Both AUTO engines (WHIRL_AUTO_ENGINE=debian|bifpy) on the real solver: each one compiles
+whirl's equations into its own cache entry, reports itself, and gives the reference numbers;
+the two agree point for point. No skips: `make setup` installs both engines (Debian's package
+and the PyPI package bifpy), and a missing one fails here with its install hint."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from whirl_cli.auto import codegen, toolchain
+from whirl_cli.cli import cli
+from whirl_cli.models import get_model
+from whirl_cli.pipeline import run_study
+from whirl_cli.results import PointType
+from whirl_cli.study import load_study
+
+from ..conftest import STUDIES
+
+
+def _study(engine: str, name: str, workdir, monkeypatch):
+    """Run studies/thesis_ch3/<name>.yaml with ``engine`` in ``workdir``."""
+    monkeypatch.setenv(toolchain.ENGINE_VARIABLE, engine)
+    return run_study(load_study(STUDIES / f"{name}.yaml"), workdir, jobs=2)
+
+
+def _points(result, kind):
+    return sorted(float(p.parameters[0]) for c in result.continuations
+                  for p in c.special_points if p.point_type == kind and p.status == "located")
+
+
+@pytest.mark.parametrize("engine", toolchain.ENGINES)
+def test_engine_compiles_into_its_own_cache_entry(engine, monkeypatch):
+    """The cache key holds the engine: the same source gives one executable per engine."""
+    model = get_model("classical")
+    built = {}
+    for name in toolchain.ENGINES:
+        monkeypatch.setenv(toolchain.ENGINE_VARIABLE, name)
+        built[name] = toolchain.compile_equations(lambda: codegen.fortran_source(model),
+                                                  model.name, codegen.source_key(model))
+        assert built[name].path.is_file()
+    assert len({b.path for b in built.values()}) == len(toolchain.ENGINES)
+    monkeypatch.setenv(toolchain.ENGINE_VARIABLE, engine)
+    chosen = toolchain.engine()
+    assert chosen.name == engine and all(o.is_file() for o in chosen.objects)
+    assert toolchain.auto_version() == chosen.version != "unknown"
+
+
+@pytest.mark.parametrize("engine", toolchain.ENGINES)
+def test_doctor_names_the_engine_that_runs(engine):
+    """`whirl doctor` says which engine runs, with its version, and that its AUTO run works."""
+    done = CliRunner().invoke(cli, ["doctor"], env={toolchain.ENGINE_VARIABLE: engine})
+    assert done.exit_code == 0, done.output
+    assert f"AUTO engine: {engine} (" in done.output
+    assert toolchain.auto_version(engine) in done.output
+    assert "AUTO run: ok" in done.output and "everything needed is installed" in done.output
+
+
+@pytest.mark.parametrize("engine", toolchain.ENGINES)
+def test_engine_gives_softening_case2_reference_numbers(engine, tmp_path, monkeypatch):
+    """Softening case 2 (K_psi = 0.3, K2 = -10) with each engine: every run ok, Hopf points at
+    K1 = 0.0807 and 0.2888, the pitchfork at 0.03598 (models.md 4) and the fold of cycles at
+    K1 = 0.451878 (README, Performance (f)), and the engine stored as auto_version."""
+    result = _study(engine, "softening_case2", tmp_path, monkeypatch)
+    assert [r.status for r in result.runs] == ["ok"] * len(result.runs), result.runs
+    assert _points(result, PointType.HB) == pytest.approx([0.0807, 0.2888], abs=1e-4)
+    assert _points(result, PointType.BP) == pytest.approx([0.03598], abs=1e-5)
+    assert max(_points(result, PointType.LPC)) == pytest.approx(0.451878, abs=1e-5)
+    assert result.attributes["auto_version"] == toolchain.auto_version(engine)
+
+
+def test_engines_agree_on_combined_case2(tmp_path, monkeypatch):
+    """Combined case 2 (18 runs: equilibria, periodic families, a fold of cycles) with both
+    engines: the same special points, types and branches, parameters and amplitudes equal to
+    1e-6 (relative to the largest value)."""
+    found = {}
+    for engine in toolchain.ENGINES:
+        result = _study(engine, "combined_case2", tmp_path / engine, monkeypatch)
+        assert all(r.status == "ok" for r in result.runs), (engine, result.runs)
+        found[engine] = [
+            ((p.branch, int(p.point_type)), np.concatenate([p.parameters, p.state]))
+            for c in result.continuations for p in c.special_points
+            if p.status == "located"]
+    reference, other = (found[e] for e in toolchain.ENGINES)
+    assert [key for key, _ in reference] == [key for key, _ in other]
+    scale = max(float(np.abs(v).max()) for _, v in reference)
+    for (key, a), (_, b) in zip(reference, other, strict=True):
+        assert a == pytest.approx(b, abs=1e-6 * scale), key
