@@ -28,8 +28,16 @@ def _console():
     return Console(stderr=True, highlight=False)
 
 
+def _show_version(ctx: click.Context, _param: click.Parameter, value: bool) -> None:
+    """``--version``: the installed version, looked up only when asked (whirl_cli._version)."""
+    if value and not ctx.resilient_parsing:
+        click.echo(f"whirl, version {_version()}")
+        ctx.exit()
+
+
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(package_name="whirl", prog_name="whirl")
+@click.option("--version", is_flag=True, expose_value=False, is_eager=True,
+              callback=_show_version, help="Show the version and exit.")
 def cli() -> None:
     """Nonlinear whirl-flutter continuation studies with AUTO-07p: YAML in, HDF5 and plots out."""
 
@@ -147,7 +155,9 @@ def summary(result_file: Path, output_format: str) -> None:
     result = api.read(result_file)
     study = _stored_study(result)
     dofs = study.variant().family.dof_names if study is not None else None
-    width = os.get_terminal_size().columns if sys.stdout.isatty() else None
+    import shutil
+
+    width = shutil.get_terminal_size().columns if sys.stdout.isatty() else None
     click.echo(render(result, output_format, dofs, width), nl=False)
 
 

@@ -77,14 +77,15 @@ def _closed(curve: Branch, width: np.ndarray, follow: int = 5) -> Branch:
     return curve
 
 
-def _follows(scaled: np.ndarray, i: int, j: int, follow: int) -> bool:
-    """True if points j+1 .. j+follow each stay within 0.005 of the path near point i and
-    move along it the same way (their nearest earlier points go forward from i)."""
-    after = scaled[j + 1:j + 1 + follow]
+def _follows(points: np.ndarray, i: int, j: int, follow: int) -> bool:
+    """True if ``points`` (scaled coordinates of a curve) j+1 .. j+follow each stay within
+    0.005 of the path near point i and move along it the same way (their nearest earlier
+    points go forward from i)."""
+    after = points[j + 1:j + 1 + follow]
     lower, upper = max(i - follow, 0), min(i + 4 * follow, j)
     if len(after) < follow or upper <= lower:
         return False
-    distance = np.abs(after[:, None] - scaled[None, lower:upper]).max(axis=2)
+    distance = np.abs(after[:, None] - points[None, lower:upper]).max(axis=2)
     nearest = distance.argmin(axis=1)
     return bool(np.all(distance.min(axis=1) < 0.005) and np.all(np.diff(nearest) >= 0)
                 and nearest[-1] > nearest[0])

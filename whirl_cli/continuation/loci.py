@@ -111,10 +111,10 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
         traced = _trace(engine, name, pair, bounds, numerics, _without_twins(todo, width))
         fresh = _distinct([(kind, curve) for kind, _, curve in traced], curves, width)
         ends = _codim2([c for _, c in curves + list(fresh.values())])
-        open_ = [k for k, (_, curve) in fresh.items() if len(curve) == len(traced[k][2])
-                 and not _ending_at(curve.parameters[-1, :2], ends, width)]
-        for k, curve in zip(open_, _retried(engine, [traced[k][1] for k in open_],
-                                            [fresh[k][1] for k in open_]), strict=True):
+        unclosed = [k for k, (_, curve) in fresh.items() if len(curve) == len(traced[k][2])
+                    and not _ending_at(curve.parameters[-1, :2], ends, width)]
+        for k, curve in zip(unclosed, _retried(engine, [traced[k][1] for k in unclosed],
+                                               [fresh[k][1] for k in unclosed]), strict=True):
             fresh[k] = (fresh[k][0], curve)
         curves += list(fresh.values())
     kept = [curve for _, curve in _distinct(sorted(curves, key=lambda c: c[1].name), [],
@@ -161,9 +161,9 @@ def _distinct(curves: list[tuple[int, Branch]], known: list[tuple[int, Branch]],
     kept: dict[int, tuple[int, Branch]] = {}
     for k, (kind, curve) in enumerate(curves):
         curve = _closed(curve, width)
-        ends = curve.parameters[[0, len(curve) // 2, -1]] if len(curve) else []
+        probes = curve.parameters[[0, len(curve) // 2, -1]] if len(curve) else []
         if len(curve) and not any(
-                kind == other_kind and all(_on_curve(p, other.parameters, width) for p in ends)
+                kind == other_kind and all(_on_curve(p, other.parameters, width) for p in probes)
                 for other_kind, other in known + list(kept.values())):
             kept[k] = (kind, curve)
     return kept
