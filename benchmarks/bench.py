@@ -88,15 +88,20 @@ def run(arguments: Sequence[str], env: dict[str, str]) -> Timed:
     return Timed(" ".join(arguments[2:]), seconds, done.returncode)
 
 
+def launched(path: Path) -> tuple[float, int, int, int]:
+    """(summed wall_seconds, runs, runs ending in MX, runs that failed otherwise) of the AUTO
+    runs recorded in the result file ``path``."""
+    with h5py.File(path, "r") as handle:
+        runs = [group.attrs for group in handle.get("runs", {}).values()]
+        statuses = [str(r["status"]) for r in runs]
+        total = float(sum(float(r["wall_seconds"]) for r in runs))
+    return total, len(runs), statuses.count("mx"), sum(s not in ("ok", "mx") for s in statuses)
+
+
 def auto_seconds(directory: Path) -> tuple[float, int]:
     """(summed wall_seconds, count) of the AUTO runs recorded in every .h5 of ``directory``."""
-    total, count = 0.0, 0
-    for path in sorted(directory.glob("*.h5")):
-        with h5py.File(path, "r") as handle:
-            for group in handle.get("runs", {}).values():
-                total += float(group.attrs["wall_seconds"])
-                count += 1
-    return total, count
+    found = [launched(path) for path in sorted(directory.glob("*.h5"))]
+    return sum(f[0] for f in found), sum(f[1] for f in found)
 
 
 def cache_entries(cache: Path) -> int:
@@ -315,21 +320,10 @@ class StudyFigures:
     returncode: int
 
 
-def launched(path: Path) -> tuple[float, int, int]:
-    """(summed wall_seconds, runs, runs ending in MX) of the AUTO runs recorded in ``path``."""
-    total, count, mx = 0.0, 0, 0
-    with h5py.File(path, "r") as handle:
-        for group in handle.get("runs", {}).values():
-            total += float(group.attrs["wall_seconds"])
-            count += 1
-            mx += str(group.attrs["status"]) == "mx"
-    return total, count, mx
-
-
 def study_figures(path: Path, scratch: Path, env: dict[str, str]) -> StudyFigures:
     out = scratch / "cases" / f"{path.parent.name}-{path.stem}.h5"
     timed = run(WHIRL + ["run", str(path), "-o", str(out), "--overwrite"], env)
-    auto, runs, mx = launched(out) if out.exists() else (0.0, 0, 0)
+    auto, runs, mx, _ = launched(out) if out.exists() else (0.0, 0, 0, 0)
     return StudyFigures(path.stem, timed.seconds, auto, runs, mx, timed.returncode)
 
 

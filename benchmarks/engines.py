@@ -25,7 +25,7 @@ import tempfile
 import time
 from pathlib import Path
 
-import h5py
+from bench import launched  # benchmarks/ is this script's directory
 
 ROOT = Path(__file__).resolve().parents[1]
 WHIRL = ROOT / ".venv" / "bin" / "whirl"
@@ -36,12 +36,8 @@ LPC_ISP2 = {"*.fold_of_cycles_*": {"ISP": 2}}
 
 def run_figures(path: Path) -> dict[str, float]:
     """AUTO seconds (sum of /runs wall_seconds), runs, MX ends and other failures of a result."""
-    with h5py.File(path, "r") as handle:
-        runs = [dict(handle["runs"][name].attrs) for name in handle["runs"]]
-    statuses = [str(r["status"]) for r in runs]
-    return {"auto": float(sum(float(r["wall_seconds"]) for r in runs)),
-            "runs": len(runs), "mx": statuses.count("mx"),
-            "failed": sum(s not in ("ok", "mx") for s in statuses)}
+    auto, runs, mx, failed = launched(path)
+    return {"auto": auto, "runs": runs, "mx": mx, "failed": failed}
 
 
 def run_once(study: Path, engine: str, out: Path, cache: Path) -> dict[str, float]:
