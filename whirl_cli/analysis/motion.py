@@ -57,7 +57,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .lyapunov import exponent_between, tangent_run
+from .lyapunov import TangentRun, exponent_between, tangent_run
 
 KINDS = ("equilibrium", "periodic", "quasi-periodic", "chaotic", "diverged")
 
@@ -67,6 +67,10 @@ MAX_MULTIPLICITY = 8
 CURVE_DIMENSION = 1.5
 #: Spectral peaks kept, down to this fraction of the largest (power).
 PEAK_FLOOR = 1e-4
+#: The evidence of a cycle read from the spectrum alone, and of chaos not resolved by lambda.
+SPECTRUM_ONLY = ("the spectrum is one fundamental and its harmonics, though the section did "
+                 "not repeat")
+WEAKLY_CHAOTIC = "weakly chaotic"
 
 
 @dataclass(frozen=True, eq=False)
@@ -248,7 +252,7 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
              bound: np.ndarray | float = np.inf, method: str = "DOP853",
              renormalise: float | None = None, amplitude_tolerance: float = 1e-6,
              section_tolerance: float = 1e-2, lyapunov_tolerance: float | None = None,
-             seed: int = 0) -> MotionClass:
+             seed: int = 0, extend: int = 0) -> MotionClass:
     """The settled motion of dy/dt = ``f(y)`` from ``y0`` (see the module doc for the rule).
 
     ``transient``: seconds discarded (state only); ``duration``: seconds of settled window
@@ -267,6 +271,37 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
         atol = rtol * 1e-3 * scale
     run = tangent_run(f, jac, y0, transient, duration, dt, renormalise=renormalise, rtol=rtol,
                       atol=atol, bound=bound, method=method, scale=scale, seed=seed)
+    motion = _classified(run, scale, amplitude_tolerance, section_state, section_tolerance,
+                         lyapunov_tolerance)
+    for _ in range(extend):
+        if not _undecided(motion) or run.tangent is None:
+            break
+        # the section and the spectrum disagree: a window as long again, continued (state and
+        # tangent) from its end, resolves a second frequency twice as fine
+        more = tangent_run(f, jac, run.states[-1], 0.0, run.time[-1], dt, rtol=rtol,
+                           atol=atol, bound=bound, method=method, scale=scale,
+                           renormalise=renormalise, tangent=run.tangent)
+        run = TangentRun(np.r_[run.time, run.time[-1] + more.time[1:]],
+                         np.concatenate((run.states, more.states[1:])),
+                         np.r_[run.growth, run.growth[-1] + more.growth[1:]], more.diverged,
+                         more.message, more.tangent)
+        motion = _classified(run, scale, amplitude_tolerance, section_state, section_tolerance,
+                             lyapunov_tolerance)
+    return motion
+
+
+def _undecided(motion: MotionClass) -> bool:
+    """The section did not repeat while the spectrum says periodic, or lambda is not resolved
+    from zero and the section is a cloud: what a longer window may settle."""
+    return motion.kind != "diverged" and (SPECTRUM_ONLY in motion.evidence
+                                          or WEAKLY_CHAOTIC in motion.evidence)
+
+
+def _classified(run: TangentRun, scale: np.ndarray, amplitude_tolerance: float,
+                section_state: int | None, section_tolerance: float,
+                lyapunov_tolerance: float | None) -> MotionClass:
+    """The class of a :class:`~whirl_cli.analysis.lyapunov.TangentRun` (the module doc's rule)."""
+    n = run.states.shape[1]
     empty = np.zeros((0, n))
     if run.diverged:
         return MotionClass("diverged", np.nan, np.nan, (), empty, np.nan, 0, (), np.nan,
@@ -296,7 +331,7 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
     bases = base_frequencies(peaks, 1.5 * bins)
     dominant = float(peaks[0]) if len(peaks) else 0.0
     threshold = (lyapunov_tolerance if lyapunov_tolerance is not None
-                 else 0.01 * 2 * np.pi * max(dominant, 1.0 / duration))
+                 else 0.01 * 2 * np.pi * max(dominant, 1.0 / time[-1]))
     returns = float(np.mean(np.diff(crossings))) if len(crossings) > 1 else np.nan
     evidence = [
         f"Lyapunov: lambda = {exponent:.4g} +- {error:.2g} 1/s (threshold {threshold:.3g})",
@@ -323,8 +358,7 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
                         f"{rate:.3g} per return, towards a period-{converging} orbit")
     elif len(bases) == 1 and broadband < 0.01:
         kind, found = "periodic", bases
-        evidence.append("the spectrum is one fundamental and its harmonics, though the section "
-                        f"did not repeat within {section_tolerance:g}")
+        evidence.append(f"{SPECTRUM_ONLY} within {section_tolerance:g}")
     elif (np.isfinite(dimension) and dimension < CURVE_DIMENSION) or len(bases) == 2:
         others = [p for p in peaks if abs(p * returns - round(p * returns)) > 1.5 * bins
                   * returns]
@@ -332,7 +366,7 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
                                                              else ())
     else:
         kind, found = "chaotic", strongest
-        evidence.append("weakly chaotic: lambda not resolved from zero, the section a cloud")
+        evidence.append(f"{WEAKLY_CHAOTIC}: lambda not resolved from zero, the section a cloud")
     return MotionClass(kind, exponent, error, tuple(found), section, dimension, multiplicity,
                        tuple(float(p) for p in peaks), broadband,
                        f"{kind}: " + "; ".join(evidence))
@@ -342,7 +376,8 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
 def classify_model(model, overrides: dict[str, float] | None = None, y0=None, *,
                    periods: float = 20.0, transient_periods: float = 15.0,
                    samples_per_period: int = 40, rtol: float = 1e-6,
-                   bound: float = 10.0, method: str = "LSODA", **options) -> MotionClass:
+                   bound: float = 10.0, method: str = "odeint", extend: int = 1,
+                   **options) -> MotionClass:
     """:func:`classify` for a whirl model (:class:`whirl_cli.models.Model`) at the parameter
     values ``overrides`` (study names, as :func:`whirl_cli.analysis.simulate.integrate`'s
     callers build them: defaults with these applied), from ``y0`` (SI; default: every dof at
@@ -378,6 +413,15 @@ def classify_model(model, overrides: dict[str, float] | None = None, y0=None, *,
         period = 2 * np.pi / abs(oscillatory[np.argmax(oscillatory.real)].imag)
     else:
         period = 1.0 / max(float(np.abs(eigenvalues.real).min()), 1e-3)
-    return classify(field, jacobian, y0, transient=transient_periods * period,
-                    duration=periods * period, dt=period / samples_per_period, scale=scale,
-                    rtol=rtol, bound=bound * scale, method=method, **options)
+    dt = period / samples_per_period
+    if method == "odeint":  # Python floats: the generated code's scalar arithmetic is faster
+        def f(y):
+            return field(y.tolist())
+
+        def jac(y):
+            return jacobian(y.tolist())
+    else:
+        f, jac = field, jacobian
+    return classify(f, jac, y0, transient=transient_periods * period,
+                    duration=periods * period, dt=dt, scale=scale,
+                    rtol=rtol, bound=bound * scale, method=method, extend=extend, **options)
