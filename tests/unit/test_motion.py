@@ -218,12 +218,13 @@ def near_resonance():
     return field, jacobian
 
 
-def test_a_torus_near_resonance_needs_the_longer_window_to_be_quasi_periodic():
+@pytest.mark.parametrize("method", ["odeint", "DOP853"])
+def test_a_torus_near_resonance_needs_the_longer_window_to_be_quasi_periodic(method):
     """In 60 s (frequency bins of 1/60 Hz) 12 f_b is within 1.5 bins of f_a, so the spectrum
     reads as harmonics of f_b while the section (at f_a's returns, rotating by f_b / f_a) is
     a closed curve; the window doubled once resolves the two bases."""
     field, jacobian = near_resonance()
-    options = dict(transient=10.0, duration=60.0, dt=0.025, section_state=0, method="odeint")
+    options = dict(transient=10.0, duration=60.0, dt=0.025, section_state=0, method=method)
     short = classify(field, jacobian, [0.5, 0.0, 0.5, 0.0], extend=0, **options)
     assert short.kind == "periodic" and "did not repeat" in short.evidence, short.evidence
     assert short.multiplicity == 0
@@ -233,3 +234,4 @@ def test_a_torus_near_resonance_needs_the_longer_window_to_be_quasi_periodic():
     assert sorted(longer.frequencies) == pytest.approx([1 / 12 + 1.5e-3, 1.0], abs=0.1 / 120)
     assert abs(longer.lyapunov) < 1e-3
     assert len(longer.section) > len(short.section)  # twice the returns
+    assert "window doubled to 120 s" in longer.evidence

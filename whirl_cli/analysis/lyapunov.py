@@ -19,12 +19,17 @@ seconds (10 s for Lorenz), inside the part :func:`exponent_between` discards. Me
 two crossings of one Poincaré section (the same phase of a periodic orbit) the bounded
 oscillation of |v| along a cycle cancels, which a fixed window would leave as O(1) / duration.
 
+:func:`odeint_tangent_run` is the same with LSODA driven by scipy's ``odeint`` (what
+:func:`whirl_cli.analysis.motion.classify_model` uses): the Fortran driver calls back only for f
+and J, where ``solve_ivp`` adds Python work to every step (two thirds of the cost with the
+generated models' fast fields).
+
 Units: time in the units of ``f`` (s for whirl's models), exponents in 1 / that unit.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -47,8 +52,7 @@ class TangentRun:
     tangent vector's length relative to its start (renormalisations added back);
     ``diverged``: the state left ``bound`` or the integration failed (``message`` says which);
     the arrays then hold what was computed before. ``tangent`` (n,): the tangent vector at
-    the last sample, unit length in the scales (:func:`odeint_tangent_run` only; else
-    None)."""
+    the end, unit length in the scales (None if diverged), to continue the run from."""
 
     time: np.ndarray
     states: np.ndarray
@@ -85,7 +89,9 @@ def tangent_run(f, jac, y0, transient: float, duration: float, dt: float, *,
     the first tangent vector (``seed``) is isotropic in them. Implicit methods (Radau, BDF,
     LSODA) get the Jacobian blockdiag(J, J) of the augmented system (the H v coupling left out:
     it only slows their Newton iteration, not the accuracy). ``method`` "odeint": LSODA through
-    :func:`odeint_tangent_run` instead (the same steps at a fraction of the Python cost)."""
+    :func:`odeint_tangent_run` instead (the same steps at a fraction of the Python cost).
+    ``tangent``: the first tangent vector (default :func:`first_tangent`), to continue a run
+    from its end (its last state and :attr:`TangentRun.tangent`)."""
     if method == "odeint":
         return odeint_tangent_run(f, jac, y0, transient, duration, dt, rtol=rtol, atol=atol,
                                   bound=bound, scale=scale, seed=seed, renormalise=renormalise,
@@ -127,7 +133,7 @@ def tangent_run(f, jac, y0, transient: float, duration: float, dt: float, *,
 
     options = {"jac": augmented_jacobian} if implicit else {}
     unit = np.broadcast_to(np.asarray(scale, dtype=float), (n,))
-    v = first_tangent(f, y0, unit, seed)
+    v = first_tangent(f, y0, unit, seed) if tangent is None else np.asarray(tangent, float)
 
     count = int(np.floor(duration / dt + 1e-9)) + 1
     grid = np.minimum(np.arange(count) * dt, duration)
@@ -164,7 +170,7 @@ def tangent_run(f, jac, y0, transient: float, duration: float, dt: float, *,
         norm = float(np.linalg.norm(z[n:] / unit))
         offset += np.log(norm)
         z[n:] /= norm
-    return _joined(times, states, growth, n, False, "")
+    return replace(_joined(times, states, growth, n, False, ""), tangent=z[n:].copy())
 
 
 def first_tangent(f, y: np.ndarray, unit: np.ndarray, seed: int) -> np.ndarray:

@@ -3,7 +3,9 @@ quasi-periodic, chaotic (or diverged), from three independent pieces of evidence
 
 :func:`classify` takes any ODE (``f(y) -> dy/dt``, ``jac(y) -> df/dy``, numpy); it integrates a
 transient and then the settled window with one tangent vector
-(:func:`whirl_cli.analysis.lyapunov.tangent_run`), and reads the samples three ways:
+(:func:`whirl_cli.analysis.lyapunov.tangent_run`; ``method`` "odeint", classify_model's, is
+LSODA through scipy's ``odeint``: the same steps as ``solve_ivp``'s LSODA with far less Python
+per step), and reads the samples three ways:
 
 (a) **Poincaré section**: the crossings of y_k = mean(y_k) with y_k rising (k: the state that
     moves most relative to its scale), located on a cubic through the four samples around
@@ -42,6 +44,17 @@ The class (:class:`MotionClass`), in this order:
    frequencies -> ``quasi-periodic``; else (a cloud, a broadband spectrum) -> ``chaotic``
    (weakly: lambda not resolved from zero; the evidence says so).
 
+**The window, doubled once.** Where the section does not repeat but the spectrum reads one
+fundamental (rule 4's spectrum-only ``periodic``), or lambda is not resolved and the section
+is a cloud (weakly ``chaotic``), section and spectrum disagree: near a resonance p:q of a
+torus the spectrum cannot tell f_a from q/p f_b within 1.5 bins (bin = 1 / window), while the
+section is a closed curve. With ``extend`` = 1 (``classify_model``'s default) the window is
+then continued as long again from its end (state and tangent vector, no new transient) and
+the whole is classified again: bins half as wide, twice the section points; a cycle whose
+section merely had not settled then repeats, and the evidence says so. A spectrum that still
+reads one fundamental keeps ``periodic`` (the section's interpolation noise on the fast
+harmonics of a cycle can keep it from repeating to 1e-2, the gimballed study at K1 = 0.2).
+
 threshold = ``lyapunov_tolerance`` (1/s), by default 0.01 x 2 pi f_dom (an e-fold in 16
 periods of the dominant frequency f_dom of the spectrum). Frequencies (Hz) reported: the
 fundamental 1 / (k x mean return time) of a period-k orbit, the section's 1 / mean return time
@@ -53,7 +66,7 @@ the linearisation at the start, see its docstring. Time in seconds, frequencies 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -263,7 +276,9 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
     beyond it is divergence (per state or one number); ``section_state``: the state whose
     mean level, crossed upwards, defines the section (default: the one with the largest
     standard deviation / scale); ``method``, ``rtol``, ``renormalise``: the integration
-    (:func:`whirl_cli.analysis.lyapunov.tangent_run`)."""
+    (:func:`whirl_cli.analysis.lyapunov.tangent_run`); ``extend``: how many times the window
+    may be doubled where section and spectrum disagree (module doc; the run continued from
+    its end)."""
     y0 = np.asarray(y0, dtype=float)
     n = y0.size
     scale = np.broadcast_to(np.asarray(1.0 if scale is None else scale, dtype=float), (n,))
@@ -285,8 +300,12 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
                          np.concatenate((run.states, more.states[1:])),
                          np.r_[run.growth, run.growth[-1] + more.growth[1:]], more.diverged,
                          more.message, more.tangent)
+        first = motion.evidence.split(":")[0]
         motion = _classified(run, scale, amplitude_tolerance, section_state, section_tolerance,
                              lyapunov_tolerance)
+        motion = replace(motion, evidence=f"{motion.evidence}; window doubled to "
+                         f"{run.time[-1]:.4g} s (before: {first}, the section and the spectrum "
+                         "disagreeing)")
     return motion
 
 
@@ -388,16 +407,20 @@ def classify_model(model, overrides: dict[str, float] | None = None, y0=None, *,
     if the origin is not an equilibrium): T_w = 2 pi / Im(lambda) of the least damped
     oscillatory eigenvalue (the whirl mode that goes unstable; without one, the slowest decay
     time 1 / |Re lambda|); the transient is ``transient_periods`` T_w (state only), the window
-    ``periods`` T_w (state + tangent), sampled at T_w / ``samples_per_period``. LSODA
-    (``method``; it steps over the lightly excited fast gimbal modes of the gimballed model
-    where DOP853 has to resolve them: half the cost) at ``rtol`` (1e-6; atol ``rtol`` x 1e-3 x
-    the state scales, i.e. 1e-9 rad for the classical model's angles); |y_i| > ``bound`` x the
-    state scale (10 rad) is divergence. ``options``: the other keywords of :func:`classify`.
-    Cost: the gimballed model (8 states; whirl at 2.5-5 Hz, gimbal modes at ~88 Hz that set
-    LSODA's step: ~1500 steps per second simulated) takes 25 000-45 000 evaluations of f and
-    J, 1.4-2.7 s on the 2 shared cores measured (f ~25-40 us); 30 periods instead of 20 cost
-    40 % more. Fewer periods leave more orbits 'not settled' (the frequency of a gimballed LCO
-    was then 0.3 % off the settled one)."""
+    ``periods`` T_w (state + tangent), sampled at T_w / ``samples_per_period``, doubled once
+    (``extend``) where section and spectrum disagree. LSODA through ``odeint`` (``method``; it
+    steps over the lightly excited fast gimbal modes of the gimballed model where DOP853 has
+    to resolve them: half the cost) at ``rtol`` (1e-6; atol ``rtol`` x 1e-3 x the state
+    scales, i.e. 1e-9 rad for the classical model's angles), on the generated field with
+    Python-float states (the generated scalar code runs several times faster on them than on
+    numpy scalars); |y_i| > ``bound`` x the state scale (10 rad) is divergence. ``options``:
+    the other keywords of :func:`classify`. Cost: the gimballed model (8 states; whirl at
+    1.2-9 Hz, gimbal modes at up to ~88 Hz that set LSODA's step: ~2000 evaluations of f per
+    second simulated) takes 0.3-0.8 s CPU per value with the default 60-period transient of
+    ``explore`` (f ~5 us, J ~12 us), up to 2.2 s where the whirl mode is slow (1.2 Hz: 80
+    periods are 67 s simulated) and 1.3 s with the window doubled (README, Performance).
+    Fewer periods leave more orbits 'not settled' (the frequency of a gimballed LCO was then
+    0.3 % off the settled one)."""
     params = model.parameter_vector(overrides or {})
     field, jacobian = model.field_at(params)
     scale = np.asarray(model.state_scale, dtype=float)
