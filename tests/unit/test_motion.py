@@ -235,3 +235,23 @@ def test_a_torus_near_resonance_needs_the_longer_window_to_be_quasi_periodic(met
     assert abs(longer.lyapunov) < 1e-3
     assert len(longer.section) > len(short.section)  # twice the returns
     assert "window doubled to 120 s" in longer.evidence
+
+
+def test_a_trajectory_at_rest_at_a_stable_point_ends_the_transient_early():
+    """Damped oscillator (decay zeta omega = 0.25 1/s) from amplitude 1: at rest (spread below
+    1e-6 over a quarter window) after ln(1e6) / 0.25 = 55 s, before the 200 s transient ends;
+    the class and exponent are the full run's."""
+    omega, zeta = 2 * np.pi, 0.04
+
+    def field(y):
+        return np.array([y[1], -omega**2 * y[0] - 2 * zeta * omega * y[1]])
+
+    def jacobian(_y):
+        return np.array([[0.0, 1.0], [-omega**2, -2 * zeta * omega]])
+
+    motion = classify(field, jacobian, [1.0, 0.0], transient=200.0, duration=30.0, dt=0.01,
+                      scale=[1.0, omega], method="odeint")
+    assert motion.kind == "equilibrium", motion.evidence
+    assert motion.lyapunov == pytest.approx(-zeta * omega, abs=0.03)
+    ended = float(motion.evidence.split("the transient ended at t = ")[1].split(" s")[0])
+    assert 55.0 < ended < 80.0

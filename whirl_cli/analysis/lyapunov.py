@@ -52,7 +52,9 @@ class TangentRun:
     tangent vector's length relative to its start (renormalisations added back);
     ``diverged``: the state left ``bound`` or the integration failed (``message`` says which);
     the arrays then hold what was computed before. ``tangent`` (n,): the tangent vector at
-    the end, unit length in the scales (None if diverged), to continue the run from."""
+    the end, unit length in the scales (None if diverged), to continue the run from;
+    ``settled``: where the transient ended early, at rest (s; NaN if it ran in full:
+    :func:`odeint_tangent_run`'s ``at_rest``)."""
 
     time: np.ndarray
     states: np.ndarray
@@ -60,6 +62,7 @@ class TangentRun:
     diverged: bool
     message: str
     tangent: np.ndarray | None = None
+    settled: float = np.nan
 
 
 def _escape(bound: np.ndarray):
@@ -75,7 +78,8 @@ def tangent_run(f, jac, y0, transient: float, duration: float, dt: float, *,
                 renormalise: float | None = None, rtol: float = 1e-8,
                 atol: float | np.ndarray | None = None, bound: float | np.ndarray = np.inf,
                 method: str = "DOP853", scale: float | np.ndarray = 1.0,
-                seed: int = 0, tangent: np.ndarray | None = None) -> TangentRun:
+                seed: int = 0, tangent: np.ndarray | None = None,
+                at_rest: float | None = None) -> TangentRun:
     """Integrate ``transient`` seconds from ``y0`` (state only), then ``duration`` seconds of
     state and tangent vector, sampled every ``dt`` (scipy ``solve_ivp``, ``method``, ``rtol``;
     ``atol`` per state, default ``rtol`` x 1e-3 x max(|y0|, 1); the tangent's atol is ``rtol`` x
@@ -91,11 +95,12 @@ def tangent_run(f, jac, y0, transient: float, duration: float, dt: float, *,
     it only slows their Newton iteration, not the accuracy). ``method`` "odeint": LSODA through
     :func:`odeint_tangent_run` instead (the same steps at a fraction of the Python cost).
     ``tangent``: the first tangent vector (default :func:`first_tangent`), to continue a run
-    from its end (its last state and :attr:`TangentRun.tangent`)."""
+    from its end (its last state and :attr:`TangentRun.tangent`); ``at_rest``: "odeint"
+    only, see :func:`odeint_tangent_run`."""
     if method == "odeint":
         return odeint_tangent_run(f, jac, y0, transient, duration, dt, rtol=rtol, atol=atol,
                                   bound=bound, scale=scale, seed=seed, renormalise=renormalise,
-                                  tangent=tangent)
+                                  tangent=tangent, at_rest=at_rest)
     from scipy.integrate import solve_ivp
 
     y0 = np.asarray(y0, dtype=float)
@@ -190,16 +195,20 @@ def odeint_tangent_run(f, jac, y0, transient: float, duration: float, dt: float,
                        rtol: float = 1e-6, atol: float | np.ndarray | None = None,
                        bound: float | np.ndarray = np.inf, scale: float | np.ndarray = 1.0,
                        seed: int = 0, renormalise: float | None = None,
-                       tangent: np.ndarray | None = None) -> TangentRun:
+                       tangent: np.ndarray | None = None,
+                       at_rest: float | None = None) -> TangentRun:
     """:func:`tangent_run` with LSODA through ``scipy.integrate.odeint`` (the Fortran driver
     calls back only for f and the Jacobian, with far less Python per step than
-    ``solve_ivp``; LSODA switches to BDF where the fast, damped modes would hold an explicit
-    method at its stability limit): the transient sampled every ``dt`` (the bound checked
-    there), then the window in chunks of ``renormalise`` seconds (default ``duration`` / 20),
+    ``solve_ivp``): the transient sampled every ``dt`` (the bound checked there), then the
+    window in chunks of ``renormalise`` seconds (default ``duration`` / 20),
     the tangent renormalised between them; ``atol`` default ``rtol`` x 1e-3 x ``scale``, the
     tangent's ``rtol`` x :data:`TANGENT_ATOL` x ``scale``. ``tangent``: the first tangent
     vector (unit length in the scales; default :func:`first_tangent`), to continue a run from
-    its end (the last state and :attr:`TangentRun.tangent`)."""
+    its end (the last state and :attr:`TangentRun.tangent`). ``at_rest`` (in the scales):
+    the transient, integrated in pieces of ``duration`` / 4, ends early after a piece over
+    which no state moved by as much (peak to peak) and where the Jacobian's eigenvalues all
+    have negative real parts: the trajectory has come to rest at a linearly stable
+    equilibrium, where it stays (``TangentRun.settled``: the time it ended)."""
     from scipy.integrate import odeint
 
     y = np.asarray(y0, dtype=float).copy()
@@ -220,14 +229,23 @@ def odeint_tangent_run(f, jac, y0, transient: float, duration: float, dt: float,
         return values, good and not outside.any(), (int(np.argmax(outside)) if outside.any()
                                                     else len(grid)), info["message"]
 
+    settled = np.nan
     if transient > 0:
-        grid = np.linspace(0.0, transient, max(2, int(np.ceil(transient / dt)) + 1))
-        values, ok, got, why = run(lambda z, _t: f(z), lambda z, _t: jac(z), y, grid, atol)
-        if not ok:
-            when = grid[min(got, len(grid) - 1)]
-            reason = "left the bound" if got < len(grid) else f"failed: {why}"
-            return TangentRun(*empty, f"transient {reason} at t = {when:.4g}")
-        y = values[-1]
+        # in pieces of a quarter window when a state at rest may end the transient early
+        pieces = max(1, int(np.ceil(transient / (0.25 * duration)))) if at_rest else 1
+        edges = np.linspace(0.0, transient, pieces + 1)
+        for a, b in zip(edges[:-1], edges[1:], strict=True):
+            grid = np.linspace(a, b, max(2, int(np.ceil((b - a) / dt)) + 1))
+            values, ok, got, why = run(lambda z, _t: f(z), lambda z, _t: jac(z), y, grid,
+                                       atol)
+            if not ok:
+                when = grid[min(got, len(grid) - 1)]
+                reason = "left the bound" if got < len(grid) else f"failed: {why}"
+                return TangentRun(*empty, f"transient {reason} at t = {when:.4g}")
+            y = values[-1]
+            if b < transient and at_rest and _at_rest(values, jac, unit, at_rest):
+                settled = float(b)
+                break
 
     def augmented(z, _t):
         return np.concatenate((f(z[:n]), jac(z[:n]) @ z[n:]))
@@ -264,7 +282,16 @@ def odeint_tangent_run(f, jac, y0, transient: float, duration: float, dt: float,
         total += float(np.log(norms[-1]))
         z[n:] /= norms[-1]
     return TangentRun(np.arange(count) * dt, np.concatenate(states), np.concatenate(growth),
-                      False, "", z[n:].copy())
+                      False, "", z[n:].copy(), settled)
+
+
+def _at_rest(values: np.ndarray, jac, unit: np.ndarray, tolerance: float) -> bool:
+    """The samples ``values`` (K, n) spread less than ``tolerance`` scales in every state and
+    the Jacobian at the last one is stable (every eigenvalue's real part negative)."""
+    n = len(unit)
+    if np.max(np.ptp(values[:, :n], axis=0) / unit) >= tolerance:
+        return False
+    return bool(np.all(np.linalg.eigvals(jac(values[-1, :n])).real < 0))
 
 
 def _joined(times, states, growth, n, diverged, message) -> TangentRun:

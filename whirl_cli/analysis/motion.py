@@ -285,9 +285,13 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
     if atol is None:
         atol = rtol * 1e-3 * scale
     run = tangent_run(f, jac, y0, transient, duration, dt, renormalise=renormalise, rtol=rtol,
-                      atol=atol, bound=bound, method=method, scale=scale, seed=seed)
+                      atol=atol, bound=bound, method=method, scale=scale, seed=seed,
+                      at_rest=amplitude_tolerance)
     motion = _classified(run, scale, amplitude_tolerance, section_state, section_tolerance,
                          lyapunov_tolerance)
+    if np.isfinite(run.settled):
+        motion = replace(motion, evidence=f"{motion.evidence}; the transient ended at t = "
+                         f"{run.settled:.4g} s, at rest at a linearly stable point")
     for _ in range(extend):
         if not _undecided(motion) or run.tangent is None:
             break
