@@ -421,8 +421,9 @@ def classify_model(model, overrides: dict[str, float] | None = None, y0=None, *,
     the other keywords of :func:`classify`. Cost: the gimballed model (8 states; whirl at
     1.2-9 Hz, gimbal modes at up to ~88 Hz that set LSODA's step: ~2000 evaluations of f per
     second simulated) takes 0.3-0.8 s CPU per value with the default 60-period transient of
-    ``explore`` (f ~5 us, J ~12 us), up to 2.2 s where the whirl mode is slow (1.2 Hz: 80
-    periods are 67 s simulated) and 1.3 s with the window doubled (README, Performance).
+    ``explore`` (f ~5 us, J ~12 us), up to 2 s where the whirl mode is slow (1.2 Hz: 80
+    periods are 67 s simulated; the transient ended at rest at 17 s) and 1.1-1.5 s with the
+    window doubled, measured under a load of 8-11 on the 2 cores (README, Performance).
     Fewer periods leave more orbits 'not settled' (the frequency of a gimballed LCO was then
     0.3 % off the settled one)."""
     params = model.parameter_vector(overrides or {})
