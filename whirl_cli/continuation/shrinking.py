@@ -14,7 +14,7 @@ Two ways, tried in this order for each special point of a type AUTO detects:
 2. **epsilon locus** (folds of cycles, one smoothing width): the fold continued in the
    principal parameter and the smoothing width (AUTO's two-parameter LPC locus,
    :func:`whirl_cli.continuation.loci.locus_constants`, on twice the mesh of the run that
-   found it; steps scaled to the width), both ways from the fold, with user points (UZ) at
+   found it, at most four times the study's; steps scaled to the width), both ways from the fold, with user points (UZ) at
    the reduced widths: the principal parameter where the locus crosses each of them.
 
 A point for which neither gives a value at every factor is left to the repetition (the
@@ -37,10 +37,13 @@ STOP_CODES = {PointType.LP: "LP", PointType.LPC: "LP", PointType.HB: "HB", Point
               PointType.BPC: "BP", PointType.PD: "PD", PointType.TR: "TR"}
 #: Steps a restart may take beyond twice the steps between its start and the point.
 SPARE_STEPS = 10
-#: The epsilon locus: its first and largest steps and its step limit, in smoothing widths
-#: (the locus moves mostly in the width, which changes by 3/4 of itself), and its mesh as a
-#: multiple of the mesh of the run that found the fold.
+#: The epsilon locus: its first and largest steps, in smoothing widths (the locus moves mostly
+#: in the width, which changes by 3/4 of itself), its step limit, and its mesh as a multiple
+#: of the mesh of the run that found the fold (on that mesh it fails to reach epsilon/4 on
+#: studies/freeplay/pitch_airspeed.yaml's upper fold)...
 LOCUS_STEP, LOCUS_STEP_MAX, LOCUS_STEPS, LOCUS_MESH = 0.02, 0.1, 200, 2
+#: ... but at most this multiple of the study's mesh (a fold found by a refined retry).
+LOCUS_MESH_CAP = 4
 #: A user point on the locus is at a reduced width if within this fraction of it (AUTO locates
 #: user points to EPSS, set to a thousandth of the smallest width on the locus).
 WIDTH_MATCH = 1e-2
@@ -149,7 +152,8 @@ def _by_locus(engine: Engine, name: str, folds: dict[int, SpecialPoint], runs: d
         if source is None:
             continue
         pair = (point.parameter_names[0], width)
-        mesh = LOCUS_MESH * engine.specs[source].constants["NTST"]
+        mesh = min(LOCUS_MESH * engine.specs[source].constants["NTST"],
+                   LOCUS_MESH_CAP * numerics.mesh_intervals)
         for direction, side in ((1, "a"), (-1, "b")):
             constants = locus_constants(model, numerics, pair, {
                 pair[0]: bounds, width: (0.8 * value * min(factors), 1.25 * value)},
