@@ -116,12 +116,16 @@ def persisted(engine: Engine, base: ContinuationResult, continued: Callable, spe
     recomputed as the smoothing shrinks (:mod:`whirl_cli.continuation.persistence`): by short
     runs near each point (:func:`whirl_cli.continuation.shrinking.recompute`), and, only if
     one is left that they did not recompute, by the continuation ``continued`` repeated at
-    every factor (runs ``<name>_eps<k>``)."""
+    every factor (runs ``<name>_eps<k>``). If a point is of a type no short run recomputes
+    (a period blow-up), the continuation is repeated for all of them at once."""
     smoothing = engine.model.smoothing_parameters
     bounds = tuple(spec.range)
-    recomputed = shrinking.recompute(engine, spec.name, base, parameters, smoothing,
-                                     persistence.FACTORS, persistence.CHECKED, bounds,
-                                     numerics)
+    recomputed = {}
+    if all(p.point_type in shrinking.STOP_CODES for p in base.special_points
+           if p.point_type in persistence.CHECKED):
+        recomputed = shrinking.recompute(engine, spec.name, base, parameters, smoothing,
+                                         persistence.FACTORS, persistence.CHECKED, bounds,
+                                         numerics)
     refined = repeated(continued, spec.name, parameters, smoothing) \
         if persistence.needs_repetition(base, recomputed) else []
     return persistence.annotate(base, refined, bounds[1] - bounds[0], recomputed=recomputed)

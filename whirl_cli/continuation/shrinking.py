@@ -14,12 +14,14 @@ Two ways, tried in this order for each special point of a type AUTO detects:
 2. **epsilon locus** (folds of cycles, one smoothing width): the fold continued in the
    principal parameter and the smoothing width (AUTO's two-parameter LPC locus,
    :func:`whirl_cli.continuation.loci.locus_constants`, on twice the mesh of the run that
-   found it, at most four times the study's; steps scaled to the width), both ways from the fold, with user points (UZ) at
-   the reduced widths: the principal parameter where the locus crosses each of them.
+   found it, at most four times the study's; steps scaled to the width), both ways from the
+   fold, with user points (UZ) at the reduced widths: the principal parameter where the locus
+   crosses each of them.
 
 A point for which neither gives a value at every factor is left to the repetition (the
-caller repeats the continuation for those points only). The values agree with the
-repetition's to the persistence tolerance (``tests/auto/test_persistence_paths.py``).
+caller repeats the continuation if any such point is left, and takes only their values from
+it). The values agree with the repetition's to the persistence tolerance
+(``tests/auto/test_seeds.py``, which makes the repetition too).
 """
 
 from __future__ import annotations
@@ -41,7 +43,7 @@ SPARE_STEPS = 10
 #: in the width, which changes by 3/4 of itself), its step limit, and its mesh as a multiple
 #: of the mesh of the run that found the fold (on that mesh it fails to reach epsilon/4 on
 #: studies/freeplay/pitch_airspeed.yaml's upper fold)...
-LOCUS_STEP, LOCUS_STEP_MAX, LOCUS_STEPS, LOCUS_MESH = 0.02, 0.1, 200, 2
+LOCUS_STEP, LOCUS_STEP_MAX, LOCUS_STEPS, LOCUS_MESH = 0.02, 0.5, 200, 2
 #: ... but at most this multiple of the study's mesh (a fold found by a refined retry).
 LOCUS_MESH_CAP = 4
 #: A user point on the locus is at a reduced width if within this fraction of it (AUTO locates
@@ -67,7 +69,8 @@ def recompute(engine: Engine, name: str, continuation: ContinuationResult,
     """The special points of ``continuation`` (by index) of the ``checked`` types recomputed
     at every smoothing width (``smoothing``: their names; ``parameters``: the study's values,
     the widths among them or the model's datums) times each of ``factors``; points neither
-    way recomputes are absent. Runs ``<name>/shrink_<k>_<f>`` and ``<name>/locus_<k><side>``."""
+    way recomputes are absent. Runs ``<name>/shrink_<k>_eps<j>`` (point ``k``, ``j``-th factor)
+    and ``<name>/locus_<k><side>`` (``a``, ``b``; ``...2`` after the first 5 steps)."""
     widths = _widths(engine, parameters, smoothing)
     runs = {b.name: b.run for b in continuation.branches}
     todo = {k: p for k, p in enumerate(continuation.special_points)
@@ -95,8 +98,8 @@ def _source(engine: Engine, runs: dict[str, str], point: SpecialPoint) -> str | 
         return None
 
 
-def _restart_spec(engine: Engine, name: str, k: int, point: SpecialPoint, source: str,
-                  widths: dict[str, float], factor: float) -> RunSpec | None:
+def _restart_spec(engine: Engine, name: str, k: int, j: int, point: SpecialPoint,
+                  source: str, widths: dict[str, float], factor: float) -> RunSpec | None:
     """The short run from the label before ``point`` in ``source`` at ``factor`` times the
     smoothing, or None (no earlier label in that run)."""
     spec = engine.specs[source]
@@ -110,7 +113,7 @@ def _restart_spec(engine: Engine, name: str, k: int, point: SpecialPoint, source
     constants.update(PAR={w: v * factor for w, v in widths.items()},
                      STOP=[f"{STOP_CODES[PointType(point.point_type)]}1"],
                      NMX=2 * steps + SPARE_STEPS)
-    return RunSpec(f"{name}/shrink_{k}_{factor:g}", constants, spec.kind,
+    return RunSpec(f"{name}/shrink_{k}_eps{j}", constants, spec.kind,
                    f"{point.type_name} at {point.parameter_names[0]} = "
                    f"{point.parameters[0]:.6g} on {point.branch}, smoothing x {factor:g}",
                    spec.parameter_names, restart=(source, start), data=None)
@@ -125,7 +128,8 @@ def _restarted(engine: Engine, name: str, points: dict[int, SpecialPoint],
         source = _source(engine, runs, point)
         if PointType(point.point_type) not in STOP_CODES or source is None:
             continue
-        made = [_restart_spec(engine, name, k, point, source, widths, f) for f in factors]
+        made = [_restart_spec(engine, name, k, j, point, source, widths, f)
+                for j, f in enumerate(factors, 1)]
         if all(made):
             specs += [(k, spec) for spec in made]
     values: dict[int, list[float]] = {}
