@@ -123,9 +123,10 @@ def persisted(engine: Engine, base: ContinuationResult, continued: Callable, spe
     recomputed = {}
     if all(p.point_type in shrinking.STOP_CODES for p in base.special_points
            if p.point_type in persistence.CHECKED):
-        recomputed = shrinking.recompute(engine, spec.name, base, parameters, smoothing,
-                                         persistence.FACTORS, persistence.CHECKED, bounds,
-                                         numerics)
+        recomputed = shrinking.recompute(
+            engine, spec.name, base, parameters, smoothing, persistence.FACTORS,
+            persistence.CHECKED, bounds, numerics,
+            reach=persistence.TOLERANCE * (bounds[1] - bounds[0]))
     refined = repeated(continued, spec.name, parameters, smoothing) \
         if persistence.needs_repetition(base, recomputed) else []
     return persistence.annotate(base, refined, bounds[1] - bounds[0], recomputed=recomputed)

@@ -18,10 +18,12 @@ Two ways, tried in this order for each special point of a type AUTO detects:
    fold, with user points (UZ) at the reduced widths: the principal parameter where the locus
    crosses each of them.
 
-A point for which neither gives a value at every factor is left to the repetition (the
-caller repeats the continuation if any such point is left, and takes only their values from
-it). The values agree with the repetition's to the persistence tolerance
-(``tests/auto/test_seeds.py``, which makes the repetition too).
+A point for which neither gives a value at every factor, each within the persistence
+tolerance of the one before, is left to the repetition (the caller repeats the continuation if
+any such point is left, and takes only their values from it): the short runs confirm that a
+point persists, the repetition judges the others (missing, or moved: artefacts). The values
+agree with the repetition's to the persistence tolerance (``tests/auto/test_seeds.py``, which
+makes the repetition too).
 """
 
 from __future__ import annotations
@@ -65,21 +67,34 @@ class Recomputed:
 def recompute(engine: Engine, name: str, continuation: ContinuationResult,
               parameters: dict[str, float], smoothing: tuple[str, ...],
               factors: tuple[float, ...], checked: frozenset[int], bounds: tuple[float, float],
-              numerics: Numerics) -> dict[int, Recomputed]:
+              numerics: Numerics, reach: float) -> dict[int, Recomputed]:
     """The special points of ``continuation`` (by index) of the ``checked`` types recomputed
     at every smoothing width (``smoothing``: their names; ``parameters``: the study's values,
     the widths among them or the model's datums) times each of ``factors``; points neither
-    way recomputes are absent. Runs ``<name>/shrink_<k>_eps<j>`` (point ``k``, ``j``-th factor)
-    and ``<name>/locus_<k><side>`` (``a``, ``b``; ``...2`` after the first 5 steps)."""
+    way recomputes within ``reach`` (of the principal parameter) of the point at every factor,
+    each factor's value within ``reach`` of the one before, are absent: the short runs only
+    confirm that a point persists (a point they find elsewhere may be another one of its
+    type: the repetition, which looks at all of them, decides). Runs
+    ``<name>/shrink_<k>_eps<j>`` (point ``k``, ``j``-th factor) and
+    ``<name>/shrink_<k>_locus<side>`` (``a``, ``b``; ``...2`` after the first 5 steps)."""
     widths = _widths(engine, parameters, smoothing)
     runs = {b.name: b.run for b in continuation.branches}
     todo = {k: p for k, p in enumerate(continuation.special_points)
             if p.point_type in checked and p.label and p.branch in runs}
-    found = _restarted(engine, name, todo, runs, widths, factors)
+    found = _close(_restarted(engine, name, todo, runs, widths, factors), todo, reach)
     folds = {k: p for k, p in todo.items() if k not in found and p.point_type == PointType.LPC}
     if len(widths) == 1 and folds:
-        found |= _by_locus(engine, name, folds, runs, widths, factors, bounds, numerics)
+        found |= _close(_by_locus(engine, name, folds, runs, widths, factors, bounds,
+                                  numerics), todo, reach)
     return found
+
+
+def _close(found: dict[int, Recomputed], points: dict[int, SpecialPoint],
+           reach: float) -> dict[int, Recomputed]:
+    """``found`` without the points whose values stray: NaN, or a step of more than
+    ``reach`` from the point to its first value or between values."""
+    return {k: r for k, r in found.items() if np.all(np.abs(np.diff(np.concatenate(
+        [points[k].parameters[:1], r.values]))) <= reach)}
 
 
 def _widths(engine: Engine, parameters: dict[str, float],
@@ -166,7 +181,7 @@ def _by_locus(engine: Engine, name: str, folds: dict[int, SpecialPoint], runs: d
                              DSMAX=LOCUS_STEP_MAX * value, DSMIN=1e-6 * value,
                              EPSS=1e-3 * value * min(factors))
             first.append((k, RunSpec(
-                f"{name}/locus_{k}{side}", constants, BranchKind.FOLD_OF_CYCLES_LOCUS,
+                f"{name}/shrink_{k}_locus{side}", constants, BranchKind.FOLD_OF_CYCLES_LOCUS,
                 f"LPC at {pair[0]} = {point.parameters[0]:.6g} on {point.branch}", pair,
                 restart=(source, point.label))))
     second = [(k, replace(spec, name=spec.name + "2", restart=(outcome.name,
