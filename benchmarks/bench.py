@@ -34,7 +34,8 @@
     of ``gimballed_poly`` in a cold cache (target: under 60 s), then ``whirl run`` of every
     study in studies/gimballed (target: under 20 s each).
 (h) freeplay: ``whirl run`` of the airspeed studies in studies/freeplay (seeds, simulation, AUTO,
-    persistence in epsilon, plots; target: under 10 s) beside the time a time-marching sweep
+    persistence in epsilon, plots; warm cache; target: under 10 s; wall, CPU, AUTO seconds, and
+    how each special point was recomputed as epsilon shrinks) beside the time a time-marching sweep
     at 0.025 m/s steps would take for one branch of the same cycles.
 (i) the airspeed diagram of combined_airspeed by continuation against time marching at
     0.025 m/s steps from a large initial condition (which only brackets the fold of cycles).
@@ -53,6 +54,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import shutil
 import subprocess
 import sys
@@ -78,18 +80,25 @@ class Timed:
     command: str
     seconds: float
     returncode: int
+    cpu: float = float("nan")  # user + sys of the command and its children [s]
+
+
+def children_cpu() -> float:
+    """User + sys time [s] of this process's waited-for children so far."""
+    used = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return used.ru_utime + used.ru_stime
 
 
 def run(arguments: Sequence[str], env: dict[str, str]) -> Timed:
-    """Run a command (output discarded) and time it."""
-    start = time.perf_counter()
+    """Run a command (output discarded) and time it (wall and CPU)."""
+    start, cpu = time.perf_counter(), children_cpu()
     done = subprocess.run(list(arguments), cwd=ROOT, env=env, stdout=subprocess.DEVNULL,
                           stderr=subprocess.PIPE, text=True, check=False)
     seconds = time.perf_counter() - start
     if done.returncode not in (0, 1):
         raise RuntimeError(f"{' '.join(arguments)} failed ({done.returncode}):\n"
                            f"{done.stderr[-2000:]}")
-    return Timed(" ".join(arguments[2:]), seconds, done.returncode)
+    return Timed(" ".join(arguments[2:]), seconds, done.returncode, children_cpu() - cpu)
 
 
 def launched(path: Path) -> tuple[float, int, int, int]:
@@ -499,6 +508,16 @@ def gimballed_figures(scratch: Path, env: dict[str, str]) -> None:
               f"{'' if timed.seconds < 20 else '  (over 20 s)'}", flush=True)
 
 
+def warm(model) -> None:
+    """Compile ``model``'s equations into the benchmark's cache (``WHIRL_CACHE_DIR``), so that
+    a timed run finds them compiled."""
+    from whirl_cli.auto import toolchain
+    from whirl_cli.auto.codegen import fortran_source, source_key
+
+    toolchain.compile_equations(lambda: fortran_source(model), model.name,
+                                source_key=source_key(model))
+
+
 def freeplay_figures(scratch: Path, env: dict[str, str], step: float = 0.025) -> None:
     """(h): the freeplay airspeed studies, ``*_airspeed.yaml`` (seeds, simulation, AUTO,
     persistence, plots) against the time a time-marching sweep at ``step`` m/s would take for
@@ -506,26 +525,35 @@ def freeplay_figures(scratch: Path, env: dict[str, str], step: float = 0.025) ->
     import numpy as np
 
     from whirl_cli.analysis import seeds
+    from whirl_cli.output import store
     from whirl_cli.study import load_study
 
-    heading("(h) freeplay: continuation from seeds vs a time-marching sweep")
+    heading("(h) freeplay: continuation from seeds vs a time-marching sweep (warm cache)")
     for path in sorted((ROOT / "studies" / "freeplay").glob("*_airspeed.yaml")):
-        timed = run(WHIRL + ["run", str(path), "-o", str(scratch / f"{path.stem}.h5"),
-                             "--overwrite"], env)
+        output = scratch / f"{path.stem}.h5"
+        warm(load_study(path).variant())
+        timed = run(WHIRL + ["run", str(path), "-o", str(output), "--overwrite"], env)
         study = load_study(path)
         spec = study.continuations[0]
         model = study.variant()
         values = {**study.parameter_values(), spec.parameter: spec.start}
         seed = seeds.auto_seeds(model, values)[1]  # 4 half-gaps: on the cycle
         params = model.parameter_vector(values)
-        started = time.perf_counter()
+        started, cpu = time.perf_counter(), time.process_time()
         seeds.settle(model, params, seed)
-        one = time.perf_counter() - started
+        one, one_cpu = time.perf_counter() - started, time.process_time() - cpu
         speeds = int(np.ceil((spec.range[1] - spec.range[0]) / step)) + 1
-        print(f"  whirl run {path.stem:<16} {timed.seconds:6.2f} s  exit {timed.returncode}"
-              f"{'' if timed.seconds < 10 else '  (over 10 s)'}; time marching: {speeds} "
-              f"airspeeds x {one:.2f} s = {speeds * one:.1f} s "
-              f"({speeds * one / timed.seconds:.1f} x), one branch of cycles only", flush=True)
+        auto, runs, mx, _ = launched(output)
+        paths = [p.refined_by for c in store.read(output).continuations
+                 for p in c.special_points if p.refined_by]
+        print(f"  whirl run {path.stem:<16} {timed.seconds:6.2f} s wall, {timed.cpu:6.2f} s CPU"
+              f"  exit {timed.returncode}{'' if timed.seconds < 10 else '  (over 10 s)'}; "
+              f"AUTO {auto:.2f} s in {runs} runs ({mx} MX); special points recomputed by "
+              f"{', '.join(f'{paths.count(w)} {w}' for w in sorted(set(paths))) or 'none'}",
+              flush=True)
+        print(f"    time marching at {step} m/s: {speeds} airspeeds x {one:.2f} s "
+              f"({one_cpu:.2f} s CPU) = {speeds * one:.1f} s ({speeds * one / timed.seconds:.1f}"
+              f" x the study's wall), one branch of cycles only", flush=True)
 
 
 def airspeed_figures(scratch: Path, env: dict[str, str], step: float = 0.025,

@@ -15,7 +15,7 @@ import numpy as np
 
 from .analysis import boundaries, freeplay, linear, motion, seeds, simulate
 from .auto.runner import RunOutcome, interruptible
-from .continuation import persistence
+from .continuation import persistence, shrinking
 from .continuation.engine import Engine, Numerics
 from .continuation.loci import two_parameter
 from .continuation.one_parameter import one_parameter
@@ -74,13 +74,10 @@ def _run_study(study: Study, workroot: Path, jobs: int,
                 numerics, branch_points=spec.branch_points, periodic=spec.periodic,
                 orbits_at=spec.orbits_at, start_orbits=starts)
 
-        # with a smoothed law, special points must persist as the smoothing shrinks: the
-        # continuation is repeated at each refined smoothing, all side by side
-        base, *refined = repeated(continued, spec.name, parameters, model.smoothing_parameters)
-        continuation = replace(base, seeds=outcomes)
-        if refined:
-            continuation = persistence.annotate(continuation, refined,
-                                                spec.range[1] - spec.range[0])
+        continuation = replace(continued(spec.name, parameters), seeds=outcomes)
+        if model.smoothing_parameters:
+            continuation = persisted(engine, continuation, continued, spec, parameters,
+                                     numerics)
         if freeplay.freeplay_dofs(model):  # amplitudes / delta, describing function
             continuation = replace(continuation, freeplay=freeplay.freeplay_amplitudes(
                 model, parameters, continuation, tuple(spec.range)))
@@ -113,20 +110,38 @@ def _run_study(study: Study, workroot: Path, jobs: int,
         simulations=tuple(simulations(study, model)))
 
 
+def persisted(engine: Engine, base: ContinuationResult, continued: Callable, spec,
+              parameters: dict[str, float], numerics: Numerics) -> ContinuationResult:
+    """``base`` (a continuation of a model that smooths a law) with its special points
+    recomputed as the smoothing shrinks (:mod:`whirl_cli.continuation.persistence`): by short
+    runs near each point (:func:`whirl_cli.continuation.shrinking.recompute`), and, only if
+    one is left that they did not recompute, by the continuation ``continued`` repeated at
+    every factor (runs ``<name>_eps<k>``). If a point is of a type no short run recomputes
+    (a period blow-up), the continuation is repeated for all of them at once."""
+    smoothing = engine.model.smoothing_parameters
+    bounds = tuple(spec.range)
+    recomputed = {}
+    if all(p.point_type in shrinking.STOP_CODES for p in base.special_points
+           if p.point_type in persistence.CHECKED):
+        recomputed = shrinking.recompute(
+            engine, spec.name, base, parameters, smoothing, persistence.FACTORS,
+            persistence.CHECKED, bounds, numerics,
+            reach=persistence.TOLERANCE * (bounds[1] - bounds[0]))
+    refined = repeated(continued, spec.name, parameters, smoothing) \
+        if persistence.needs_repetition(base, recomputed) else []
+    return persistence.annotate(base, refined, bounds[1] - bounds[0], recomputed=recomputed)
+
+
 def repeated(continued: Callable, name: str, parameters: dict[str, float],
              smoothing: tuple[str, ...]) -> list[ContinuationResult]:
-    """``continued(name, parameters)``, then, if the model smooths a law (``smoothing``: its
-    widths), the same with every width times each of :data:`persistence.FACTORS` (runs
-    ``<name>_eps<k>``): all side by side (they share nothing but the compiled program)."""
-    factors = (1.0, *persistence.FACTORS) if smoothing else (1.0,)
-
+    """``continued`` with every smoothing width (``smoothing``) times each of
+    :data:`persistence.FACTORS` (runs ``<name>_eps<k>``, ``k`` from 1): side by side (they
+    share nothing but the compiled program)."""
     def one(k: int) -> ContinuationResult:
-        if k == 0:
-            return continued(name, parameters)
-        return continued(f"{name}_eps{k}", persistence.refined_parameters(
-            parameters, smoothing, factors[k]))
+        return continued(f"{name}_eps{k + 1}", persistence.refined_parameters(
+            parameters, smoothing, persistence.FACTORS[k]))
 
-    return thread_map(one, range(len(factors)), len(factors))
+    return thread_map(one, range(len(persistence.FACTORS)), len(persistence.FACTORS))
 
 
 def simulations(study: Study, model) -> list[Simulation]:

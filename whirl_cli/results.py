@@ -198,6 +198,10 @@ class SpecialPoint:
     #: (laws that smooth a piecewise one, e.g. freeplay; NaN: not recomputed or not found)
     refined: np.ndarray = field(default_factory=lambda: np.full(2, np.nan))
     artefact: bool = False  # does not persist as the smoothing shrinks (see ``note``)
+    #: how ``refined`` was computed: "restart", "epsilon locus" (short runs near the point,
+    #: :mod:`whirl_cli.continuation.shrinking`), "repetition" (the continuation repeated) or
+    #: "" (not recomputed)
+    refined_by: str = ""
     #: torus (TR, Neimark-Sacker) points: the angle in (0, pi) rad of the complex pair of
     #: Floquet multipliers on the unit circle, exp(+-i angle) (NaN: not TR, no multipliers)
     torus_angle: float = float("nan")

@@ -37,7 +37,9 @@ def run(tmp_path_factory):
         if text not in cache:
             cache[text] = run_study(validate_text(text), tmp_path_factory.mktemp("freeplay"),
                                     jobs=2)
-            runs = cache[text].runs
+            # every run converged, but the short runs of the persistence check, which may
+            # end in MX (their point is then recomputed by repeating the continuation)
+            runs = [r for r in cache[text].runs if ".shrink_" not in r.name]
             assert [r.status for r in runs] == ["ok"] * len(runs), runs
         return cache[text]
 

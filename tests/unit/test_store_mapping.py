@@ -76,7 +76,8 @@ def synthetic_result() -> results.StudyResult:
     point = results.SpecialPoint("b_periodic", 1, 5, ("V",), np.array([0.5]), np.zeros(2), 0.2,
                                  True, label=3, status="bracketed", criticality="sub",
                                  note="n", bracket=np.array([0.4, 0.6]), residual=0.1,
-                                 parameter_units=("m/s",))
+                                 parameter_units=("m/s",), refined=np.array([0.51, 0.52]),
+                                 refined_by="epsilon locus")
     result = results.StudyResult(
         "s", "m", (results.ContinuationResult(
             "c", "one-parameter", (branch("b_equilibrium", results.BranchKind.EQUILIBRIUM, 4),

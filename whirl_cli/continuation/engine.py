@@ -87,6 +87,8 @@ class Engine:
                                                  source_key=source_key(model))
         self.outcomes: dict[str, runner.RunOutcome] = {}
         self._slots = threading.BoundedSemaphore(self.jobs)
+        #: the specification of every run made, by AUTO name (as ``outcomes``)
+        self.specs: dict[str, RunSpec] = {}
 
     def run_many(self, specs: Sequence[RunSpec]) -> list[runner.RunOutcome]:
         """Execute ``specs`` (independent of each other) and return outcomes in spec order;
@@ -105,6 +107,7 @@ class Engine:
                                  spec.name.replace("/", "."), restart=restart_file,
                                  timeout=self.timeout, data=spec.data)
         self.outcomes[outcome.name] = outcome
+        self.specs[outcome.name] = spec
         if self.on_run is not None:
             self.on_run(outcome)
         return outcome

@@ -2,11 +2,13 @@
 
 A smoothing (freeplay's epsilon) can create bifurcations of its own that vanish as it shrinks
 (``../shared/models.md`` section 7), so a special point of such a model counts as physical only
-if it persists: the continuation is repeated with every smoothing width halved and quartered,
-and each special point is looked for again there (the same type, the nearest in the principal
-parameter). :func:`annotate` stores the two values (``SpecialPoint.refined``) and flags a point
-that is not found again, or moves by more than ``tolerance`` of the range, as a smoothing
-artefact (``artefact``, and why in its ``note``).
+if it persists: it is recomputed with every smoothing width halved and quartered, by short runs
+near it where they succeed (:mod:`whirl_cli.continuation.shrinking`), else by repeating the
+continuation at those widths and looking for it there (the same type, the nearest in the
+principal parameter). :func:`annotate` stores the two values (``SpecialPoint.refined``, and
+how they were found in ``refined_by``) and flags a point that is not found again, or moves by
+more than ``tolerance`` of the range, as a smoothing artefact (``artefact``, and why in its
+``note``).
 """
 
 from __future__ import annotations
@@ -34,19 +36,33 @@ def refined_parameters(parameters: dict[str, float], smoothing: tuple[str, ...],
 
 
 def annotate(base: ContinuationResult, refined: list[ContinuationResult],
-             width: float, tolerance: float = TOLERANCE) -> ContinuationResult:
-    """``base`` with each special point's values in ``refined`` (the runs at :data:`FACTORS`)
-    and its artefact flag."""
-    points = tuple(_annotated(point, refined, width, tolerance)
-                   for point in base.special_points)
+             width: float, tolerance: float = TOLERANCE,
+             recomputed: dict | None = None) -> ContinuationResult:
+    """``base`` with each special point's values at :data:`FACTORS` and its artefact flag:
+    those of ``recomputed`` (index of the point -> its
+    :class:`~whirl_cli.continuation.shrinking.Recomputed`) as they are, the others' looked for
+    in ``refined`` (the continuation repeated at :data:`FACTORS`; empty if every point was
+    recomputed)."""
+    recomputed = recomputed or {}
+    points = tuple(_annotated(point, refined, width, tolerance, recomputed.get(k))
+                   for k, point in enumerate(base.special_points))
     return replace(base, special_points=points)
 
 
+def needs_repetition(base: ContinuationResult, recomputed: dict) -> bool:
+    """True if a checked special point of ``base`` is not among ``recomputed`` (by index)."""
+    return any(p.point_type in CHECKED and k not in recomputed
+               for k, p in enumerate(base.special_points))
+
+
 def _annotated(point: SpecialPoint, refined: list[ContinuationResult], width: float,
-               tolerance: float) -> SpecialPoint:
+               tolerance: float, recomputed=None) -> SpecialPoint:
     if point.point_type not in CHECKED:
         return point
-    values = np.array([_nearest(point, run) for run in refined])
+    if recomputed is not None:
+        values, method = np.asarray(recomputed.values, dtype=float), recomputed.method
+    else:
+        values, method = np.array([_nearest(point, run) for run in refined]), "repetition"
     steps = np.diff(np.concatenate([[point.parameters[0]], values]))
     missing = [f"epsilon x {f:g}" for f, v in zip(FACTORS, values, strict=True)
                if np.isnan(v)]
@@ -58,7 +74,8 @@ def _annotated(point: SpecialPoint, refined: list[ContinuationResult], width: fl
         why = f"smoothing artefact: moves by {moved:.3g} as epsilon shrinks"
     else:
         why = ""
-    return replace(point, refined=values, artefact=artefact, note=_joined(point.note, why))
+    return replace(point, refined=values, artefact=artefact, note=_joined(point.note, why),
+                   refined_by=method)
 
 
 def _nearest(point: SpecialPoint, run: ContinuationResult) -> float:

@@ -24,6 +24,7 @@ Layout (units in a ``units`` attribute on every physical dataset)::
                                     criticality, note, bracket (K, 2), residual,
                                     lyapunov (first Lyapunov coefficient of Hopf points),
                                     refined (K, 2), artefact (persistence as epsilon shrinks),
+                                    refined_by (restart | epsilon locus | repetition | ""),
                                     torus_angle (TR points, rad)
         seeds/                      (continuation `seeds`) columns: index, seed (K, n), kind,
                                     period, branch, message
@@ -153,6 +154,7 @@ SPECIAL_POINT = (
     Field("lyapunov", kind="float", default=float("nan")),  # units: see _lyapunov_unit
     Field("refined", width=2, default=lambda: np.full(2, np.nan)),  # units: the bracket's
     Field("artefact", kind="bool", default=False),
+    Field("refined_by", kind="text", default=""),  # older files: not recorded
     Field("torus_angle", kind="float", units="rad", default=float("nan")),
 )
 #: The resolved :class:`ParameterValue` table of a study (``parameters/``; schema 2).
