@@ -238,14 +238,18 @@ LOCUS_CHUNK = 400
 def _extended(engine: Engine, specs: list[RunSpec], curves: list[Branch], numerics: Numerics,
               bounds: dict[str, tuple[float, float]], width: np.ndarray) -> list[Branch]:
     """Loci that used up a chunk of steps without closing or reaching the range, continued
-    chunk by chunk from their last point (up to ``numerics.max_steps`` in all)."""
+    chunk by chunk from their last point (up to ``numerics.max_steps`` in all). A chunk that
+    adds no point (AUTO stops at once, e.g. restarted beyond a hard bound RL0/RL1 after
+    missing the UZSTOP edge in the first step of a restart, where AUTO locates no event) ends
+    its locus: continuing it again would repeat the same run for ever."""
     done = list(curves)
+    stalled: set[int] = set()
     chunk = 1
     while True:
         again, where = [], []
         for k, (spec, curve) in enumerate(zip(specs, done, strict=True)):
-            if spec.constants.get("NMX") != LOCUS_CHUNK or not _chunk_used(curve, width,
-                                                                          bounds):
+            if spec.constants.get("NMX") != LOCUS_CHUNK or k in stalled or not _chunk_used(
+                    curve, width, bounds):
                 continue
             if len(curve) >= numerics.max_steps or not curve.label[-1]:
                 continue
@@ -258,6 +262,8 @@ def _extended(engine: Engine, specs: list[RunSpec], curves: list[Branch], numeri
             extra = _read(engine, spec, outcome)
             if len(extra) > 1:
                 done[k] = join(done[k], extra, done[k].name)
+            else:
+                stalled.add(k)
         chunk += 1
 
 
