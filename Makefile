@@ -10,6 +10,7 @@ OUT ?= out
 .PHONY: setup system-deps test test-fast lint run generate clean
 
 setup: system-deps $(VENV)/.installed
+	@$(BIN)/python -m compileall -q whirl_cli >/dev/null
 
 # Debian packages AUTO-07p needs at run time: the AUTO runtime and gfortran to compile equations.
 system-deps:

@@ -39,7 +39,11 @@
 (i) the airspeed diagram of combined_airspeed by continuation against time marching at
     0.025 m/s steps from a large initial condition (which only brackets the fold of cycles).
 
-Run: ``.venv/bin/python benchmarks/bench.py [--only abcdefghi] [--exclude GLOB] [--fold-tol 1e-5]
+(j) the ``explore`` classifier (``whirl_cli.analysis.motion.classify_model``): CPU seconds per
+    parameter value of the gimballed studies' ``explore`` lists (target: under 2 s), then each
+    list with 2 forked workers (wall per value).
+
+Run: ``.venv/bin/python benchmarks/bench.py [--only abcdefghij] [--exclude GLOB] [--fold-tol 1e-5]
 [--fold-periods 3000]``. With all 26 chapter-3 studies it takes about 35 minutes on two cores,
 most of it in the two-parameter ``boundary_*`` studies (``--exclude 'boundary_*.yaml'`` leaves
 them out); other load on the machine shows in the numbers (the load average is printed).
@@ -571,9 +575,51 @@ def airspeed_figures(scratch: Path, env: dict[str, str], step: float = 0.025,
     print(f"  time marching / continuation: {marching / continuation:.0f}x (target >= 100x)")
 
 
+# ------------------------------------------------------------------------------ (j)
+#: The gimballed studies whose ``explore`` values (j) classifies.
+EXPLORED = ("explore_combined_case2_soft.yaml", "torus_airspeed.yaml")
+
+
+def cpu_seconds(children: bool = False) -> float:
+    """User + system CPU seconds of this process (``children``: of its finished children)."""
+    import resource
+
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN if children else resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
+
+
+def classifier_figures() -> None:
+    """CPU seconds per ``explore`` value (``whirl_cli.pipeline.explorations`` of one value,
+    in this process), then all of a study's values with 2 forked workers (wall, and CPU of
+    parent and workers)."""
+    from whirl_cli import pipeline
+    from whirl_cli.study import load_study
+
+    heading("(j) explore classifier: CPU seconds per parameter value (target: under 2 s)")
+    for name in EXPLORED:
+        study = load_study(ROOT / "studies" / "gimballed" / name)
+        spec = next(c for c in study.continuations if c.explore)
+        model = study.variant()
+        values = study.parameter_values()
+        model.field_at(model.parameter_vector(values))  # the generated module, loaded once
+        for value in spec.explore:
+            one = spec.model_copy(update={"explore": (value,)})
+            started = cpu_seconds()
+            (found,) = pipeline.explorations(model, values, one)
+            doubled = " (window doubled)" if "window doubled" in found.evidence else ""
+            print(f"  {name} {spec.parameter} = {value:g}: {cpu_seconds() - started:.2f} s CPU, "
+                  f"{found.kind}{doubled}", flush=True)
+        started, wall = cpu_seconds() + cpu_seconds(True), time.perf_counter()
+        pipeline.explorations(model, values, spec, jobs=2)
+        wall = time.perf_counter() - wall
+        spent = cpu_seconds() + cpu_seconds(True) - started
+        print(f"  {name}: {len(spec.explore)} values, --jobs 2: {wall:.2f} s wall "
+              f"({wall / len(spec.explore):.2f} s per value), {spent:.2f} s CPU", flush=True)
+
+
 def main(argv: Sequence[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--only", default="abcdefghi",
+    parser.add_argument("--only", default="abcdefghij",
                         help="letters of the figures to produce, e.g. 'ad' [default: all]")
     parser.add_argument("--fold-tol", type=float, default=1e-5,
                         help="bracket width at which the bisection of (f) stops [N m/rad]")
@@ -610,6 +656,8 @@ def main(argv: Sequence[str] | None = None) -> None:
             freeplay_figures(scratch, env)
         if "i" in only:
             airspeed_figures(scratch, env)
+        if "j" in only:
+            classifier_figures()
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
     print(f"\nload average at the end: {load()}")

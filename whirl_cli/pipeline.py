@@ -86,7 +86,7 @@ def _run_study(study: Study, workroot: Path, jobs: int,
                 model, parameters, continuation, tuple(spec.range)))
         if spec.explore:
             continuation = replace(continuation, explorations=explorations(
-                model, parameters, spec))
+                model, parameters, spec, jobs))
         continuations.append(continuation)
     if study.cross_check:
         continuations = [replace(c, cross_checks=simulate.cross_check(
@@ -138,7 +138,8 @@ def simulations(study: Study, model) -> list[Simulation]:
         str(spec.name), study.simulation_overrides(spec)) for spec in study.simulations]
 
 
-def explorations(model, overrides: dict[str, float], spec) -> tuple[Exploration, ...]:
+def explorations(model, overrides: dict[str, float], spec,
+                 jobs: int = 1) -> tuple[Exploration, ...]:
     """The settled motion at each ``explore`` value of a one-parameter continuation, by
     simulation (:func:`whirl_cli.analysis.motion.classify_model`) at the study's parameters
     with the continuation parameter at that value, from ``explore_initial`` (default: the
@@ -146,9 +147,10 @@ def explorations(model, overrides: dict[str, float], spec) -> tuple[Exploration,
     ``explore_transient`` whirl periods, on the section where ``explore_section`` (default:
     the first dof's rate, i.e. at that dof's minima) crosses its mean upwards.
 
-    One value after another (the integration is CPU-bound Python: threads would not run
-    them side by side; a few seconds per value for the gimballed model). A failure is the
-    result ``diverged`` with its message, never raised."""
+    ``jobs`` values at a time in forked processes (:func:`whirl_cli.interrupts.forked_map`:
+    each value's simulation is independent of the others, so the results are identical for
+    any ``jobs``, in the order of ``explore``). A failure is the result ``diverged`` with its
+    message, never raised."""
     from .study.schema import EXPLORE_OFFSET
 
     parameter = model.parameter(model.canonical(spec.parameter))
@@ -159,8 +161,9 @@ def explorations(model, overrides: dict[str, float], spec) -> tuple[Exploration,
     units = tuple(s.unit for s in model.states)
     section = names.index(spec.explore_section if spec.explore_section is not None
                           else model.dofs[0].rate)
-    found = []
-    for value in spec.explore:
+
+    def one(k: int) -> Exploration:
+        value = spec.explore[k]
         try:
             motion_class = motion.classify_model(
                 model, {**overrides, parameter.name: float(value)}, y0,
@@ -170,7 +173,7 @@ def explorations(model, overrides: dict[str, float], spec) -> tuple[Exploration,
                 "diverged", np.nan, np.nan, (), np.zeros((0, len(names))), np.nan, 0, (),
                 np.nan, f"diverged: the classification failed ({type(error).__name__}: "
                 f"{error})")
-        found.append(Exploration(
+        return Exploration(
             float(value), parameter.name, parameter.unit, names, units, y0.copy(),
             motion_class.kind, float(motion_class.lyapunov),
             float(motion_class.lyapunov_error),
@@ -178,8 +181,9 @@ def explorations(model, overrides: dict[str, float], spec) -> tuple[Exploration,
             np.asarray(motion_class.section, dtype=float).reshape(-1, len(names)),
             float(motion_class.section_dimension), int(motion_class.multiplicity),
             np.asarray(motion_class.peaks, dtype=float), float(motion_class.broadband),
-            motion_class.evidence))
-    return tuple(found)
+            motion_class.evidence)
+
+    return tuple(forked_map(one, len(spec.explore), jobs))
 
 
 def seeded_orbits(model, overrides: dict[str, float], parameter: str, start: float, given,

@@ -13,11 +13,11 @@ unit circle at angle ~0.51 rad (|mu| < 1 before, > 1 after), far from 0 and pi; 
 (V = 11.82 m/s) the simulation from the explore's default start is classified quasi-periodic,
 its largest Lyapunov exponent zero within its threshold, and its spectrum holds the cycle's
 frequency f_c and combinations m f_c + n f_2 with f_2 = angle / (2 pi) f_c, the second frequency
-the multipliers predict. At V = 11.9 the classifier says ``periodic`` at ~2 Hz instead: the
-window (20 periods of the linear whirl mode, ~2 s) cannot tell the torus from a 1:12 resonance
-(f_c ~ 24.2 Hz ~ 12 x 2.0 Hz within 1.5 frequency bins), so its spectrum reads as harmonics of
-f_2; its section does not repeat and lies on a curve (correlation dimension < 1.5), which is
-a torus, and that is what is asserted there.
+the multipliers predict. At V = 11.9 the same holds, though there the first window (20 periods
+of the linear whirl mode, ~2.3 s) cannot tell the torus from a 1:12 resonance (f_c ~ 24.2 Hz ~
+12 x 2.0 Hz within 1.5 frequency bins: the spectrum reads as harmonics of f_2) while its
+section does not repeat; the classifier then doubles the window, which resolves the two base
+frequencies.
 """
 
 from __future__ import annotations
@@ -101,34 +101,47 @@ def _combination(frequency: float, f_c: float, f_2: float, tolerance: float) -> 
     return best
 
 
+def _assert_torus(found, point, window: float) -> None:
+    """``found`` is quasi-periodic at the cycle frequency f_c, every spectral peak a
+    combination of f_c and angle / (2 pi) f_c (within 2 bins of ``window`` s), one of them not
+    a harmonic, lambda zero within the threshold."""
+    print(f"\n  V = {found.value}: {found.evidence}")
+    assert found.kind == "quasi-periodic", found.evidence
+    f_c = float(found.frequencies[0])  # the section's return frequency: the cycle's
+    assert f_c == pytest.approx(1 / point.period, rel=0.02)
+    f_2 = point.torus_angle / (2 * np.pi) * f_c
+    combos = [_combination(p, f_c, f_2, 2 / window) for p in found.peaks]
+    print(f"  f_c = {f_c:.3f} Hz, f_2 = {f_2:.3f} Hz (from the angle); peaks "
+          + ", ".join(f"{p:.3f} = |{m} f_c + {n} f_2|"
+                      for p, (m, n) in zip(found.peaks, combos, strict=True)))
+    assert all(c != (0, 0) for c in combos)
+    assert any(n != 0 for _, n in combos)
+    assert abs(found.lyapunov) < 0.01 * 2 * np.pi * f_c + 3 * found.lyapunov_error
+
+
 def test_just_past_the_torus_point_the_motion_is_quasi_periodic_at_the_predicted_frequency():
     """At V = 11.82 m/s (0.3 % past the TR point) the simulation settles on a two-frequency
     motion: class quasi-periodic, lambda zero within the threshold, every spectral peak a
-    combination of the cycle frequency and angle / (2 pi) times it, one of them not a harmonic."""
+    combination of the cycle frequency and angle / (2 pi) times it, one of them not a harmonic
+    (the first window suffices: section and spectrum agree)."""
     point, _ = _torus_point()
     near, _farther = computed().continuations[0].explorations
     assert near.value > point.parameters[0]
-    print(f"\n  V = {near.value}: {near.evidence}")
-    assert near.kind == "quasi-periodic", near.evidence
-    f_c = float(near.frequencies[0])  # the section's return frequency: the cycle's
-    assert f_c == pytest.approx(1 / point.period, rel=0.02)
-    f_2 = point.torus_angle / (2 * np.pi) * f_c
-    bin_width = 1 / _window(near.value)
-    combos = [_combination(p, f_c, f_2, 2 * bin_width) for p in near.peaks]
-    print(f"  f_c = {f_c:.3f} Hz, f_2 = {f_2:.3f} Hz (from the angle); peaks "
-          + ", ".join(f"{p:.3f} = |{m} f_c + {n} f_2|"
-                      for p, (m, n) in zip(near.peaks, combos, strict=True)))
-    assert all(c != (0, 0) for c in combos)
-    assert any(n != 0 for _, n in combos)
-    assert abs(near.lyapunov) < 0.01 * 2 * np.pi * f_c + 3 * near.lyapunov_error
+    assert "did not repeat" not in near.evidence
+    _assert_torus(near, point, _window(near.value))
 
 
-def test_farther_past_it_the_section_is_a_closed_curve():
-    """At V = 11.9 m/s the classifier's spectrum rule says periodic (see the module doc); the
-    section is the evidence of the torus: no lag-k repeat, points on a curve."""
+def test_farther_past_it_the_doubled_window_resolves_the_torus():
+    """At V = 11.9 m/s the first window's spectrum reads as harmonics of f_2 (near 1:12) while
+    the section does not repeat: the window is doubled, and the motion is quasi-periodic as
+    at 11.82, its section a closed curve (no lag-k repeat, correlation dimension < 1.5), twice
+    as many section points as returns in one window."""
+    point, _ = _torus_point()
     farther = computed().continuations[0].explorations[1]
-    print(f"\n  V = {farther.value}: {farther.kind}; {farther.evidence}")
+    window = 2 * _window(farther.value)
+    _assert_torus(farther, point, window)
+    assert "window doubled" in farther.evidence
     assert farther.multiplicity == 0
     assert farther.section_dimension < CURVE_DIMENSION
-    f_c = float(farther.peaks[0])
-    assert abs(farther.lyapunov) < 0.01 * 2 * np.pi * f_c + 3 * farther.lyapunov_error
+    returns = window * float(farther.frequencies[0])
+    assert len(farther.section) == pytest.approx(returns, abs=2)

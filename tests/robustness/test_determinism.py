@@ -1,5 +1,6 @@
 """Determinism: the same study run twice (once with one AUTO job, once with two in parallel)
-gives equal files. Every dataset is equal (numpy array_equal, NaN positions included), every
+gives equal files: a one-parameter study, and a boundary whose slices and loci run side by
+side. Every dataset is equal (numpy array_equal, NaN positions included), every
 attribute too, except the provenance attribute ``created`` (root) and ``wall_seconds``
 (each run record). Groups and datasets are the same, in the same order."""
 
@@ -48,8 +49,8 @@ def equal(a, b) -> bool:
     return bool(np.array_equal(a, b))
 
 
-def test_the_same_study_twice_gives_equal_files(tmp_path):
-    study = STUDIES / "softening_case2.yaml"  # periodic branches (NaN periods), cross-checks
+def run_twice(study, tmp_path) -> tuple[dict, dict]:
+    """The contents of ``study`` run with one AUTO job and with two."""
     paths = []
     for k, jobs in enumerate(("1", "2")):
         path = tmp_path / f"run{k}.h5"
@@ -57,21 +58,47 @@ def test_the_same_study_twice_gives_equal_files(tmp_path):
                                           "--no-plots"])
         assert result.exit_code == 0, result.output
         paths.append(path)
-    first, second = contents(paths[0]), contents(paths[1])
+    return contents(paths[0]), contents(paths[1])
+
+
+def differences(first: dict, second: dict) -> list[str]:
+    """What differs between two files' contents, volatile attributes apart."""
     assert list(first) == list(second)  # same objects, same order
-    differences = []
-    nan_datasets = 0
+    found = []
     for name, (data, attributes) in first.items():
         other_data, other_attributes = second[name]
         if not equal(data, other_data):
-            differences.append(f"{name}: data")
-        nan_datasets += isinstance(data, np.ndarray) and data.dtype.kind in "fc" and bool(
-            np.isnan(data).any())
+            found.append(f"{name}: data")
         assert list(attributes) == list(other_attributes), name
         for key, value in attributes.items():
             if not volatile(name, key) and not equal(value, other_attributes[key]):
-                differences.append(f"{name}@{key}: {value!r} != {other_attributes[key]!r}")
-    assert not differences, differences
+                found.append(f"{name}@{key}: {value!r} != {other_attributes[key]!r}")
+    return found
+
+
+def test_the_same_study_twice_gives_equal_files(tmp_path):
+    study = STUDIES / "softening_case2.yaml"  # periodic branches (NaN periods), cross-checks
+    first, second = run_twice(study, tmp_path)
+    assert not differences(first, second)
+    nan_datasets = sum(isinstance(data, np.ndarray) and data.dtype.kind in "fc"
+                       and bool(np.isnan(data).any()) for data, _ in first.values())
     assert nan_datasets > 0  # the comparison did see NaN positions
     periodic = [n for n in first if "/branches/periodic_" in n and n.endswith("/period")]
     assert periodic and any(n.startswith("runs/") for n in first)
+
+
+def test_a_boundary_twice_gives_equal_files(tmp_path):
+    """Two slices (run side by side with two jobs) whose fold-of-cycles loci grow chunk by
+    chunk: the same loci, cut and dropped at the same points, whatever the timing."""
+    text = (STUDIES / "boundary_softening.yaml").read_text()
+    study = tmp_path / "boundary.yaml"
+    study.write_text(text.replace("slices: [0.4, 0.3, 0.2, 0.05, 0.037]", "slices: [0.3, 0.2]")
+                     .replace("points: 321", "points: 41").replace("points: 201", "points: 21"))
+    first, second = run_twice(study, tmp_path)
+    assert not differences(first, second)
+    loci = [n for n in first if n.startswith("continuations/boundary/branches/fold_of_cycles")
+            and n.count("/") == 3]
+    chunked = [n for n in first if n.startswith("runs/") and "fold_of_cycles" in n
+               and n.rsplit("_", 1)[-1].rstrip("0123456789").endswith("c")]
+    assert loci, "no fold-of-cycles locus traced"
+    print(f"{len(loci)} fold-of-cycles loci, {len(chunked)} chunk continuations")

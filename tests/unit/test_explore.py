@@ -76,6 +76,18 @@ def test_far_from_cycles_at_a_linearly_stable_value_the_motion_is_an_equilibrium
     assert len(found.frequencies) == 0
 
 
+def test_explorations_are_the_same_bits_for_any_jobs(explored):
+    """Two values side by side in forked processes: every field as one after another."""
+    study = validate_text(hardening_study(), "h.yaml")
+    forked = pipeline.explorations(study.variant(), study.parameter_values(),
+                                   study.continuations[0], jobs=2)
+    for a, b in zip(explored, forked, strict=True):
+        for name in Exploration.__dataclass_fields__:
+            x, y = getattr(a, name), getattr(b, name)
+            assert (np.array_equal(x, y, equal_nan=x.dtype.kind == "f")
+                    if isinstance(x, np.ndarray) else x == y or (x != x and y != y)), name
+
+
 def test_the_initial_state_is_the_first_dof_at_2_degrees_unless_given():
     study = validate_text(hardening_study("[0.45]"), "h.yaml")
     spec = study.continuations[0]

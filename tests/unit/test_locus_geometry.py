@@ -144,6 +144,6 @@ def test_a_locus_chunk_that_adds_no_point_ends_the_locus(monkeypatch):
 
     monkeypatch.setattr(loci, "_read", lambda _engine, _spec, _outcome: _locus(
         np.array([[0.4, 0.3]])))
-    (done,) = loci._extended(Engine(), [spec], [curve], Numerics(),
-                             {"p": (0.0, 1.0), "q": (0.0, 0.5)}, np.array([1.0, 0.5]))
-    assert calls == [["c/fold_of_cycles_1a2c1"]] and len(done) == 3
+    kept, _ = loci._grown(Engine(), {0: (PointType.LPC, spec, curve)}, [], Numerics(),
+                          {"p": (0.0, 1.0), "q": (0.0, 0.5)}, np.array([1.0, 0.5]))
+    assert calls == [["c/fold_of_cycles_1a2c1"]] and len(kept[0][2]) == 3

@@ -177,3 +177,81 @@ def test_classical_model_far_from_any_lco_is_an_equilibrium():
     slowest = np.linalg.eigvals(model.jacobian_numpy(np.zeros(4),
                                                      model.parameter_vector(overrides))).real.max()
     assert motion.lyapunov == pytest.approx(slowest, abs=max(0.15, 3 * motion.lyapunov_error))
+
+
+# ----------------------------------------------------------------------------- odeint path
+def test_odeint_path_gives_the_lorenz_exponent():
+    """classify_model's integrator (LSODA through odeint, the tangent continued chunk by
+    chunk) on Lorenz: the literature exponent to 2 %."""
+    field, jacobian = lorenz()
+    motion = classify(field, jacobian, [1.0, 1.0, 1.0], transient=20.0, duration=400.0,
+                      dt=0.02, rtol=1e-6, method="odeint")
+    assert motion.kind == "chaotic", motion.evidence
+    assert motion.lyapunov == pytest.approx(LORENZ_EXPONENT, rel=0.02)
+
+
+def test_odeint_path_on_a_cycle_has_a_zero_exponent_and_the_same_bits_every_run():
+    field, jacobian = hopf(1.0, 2 * np.pi, 0.5)
+    motion, again = (classify(field, jacobian, [0.1, 0.0], transient=20.0, duration=60.0,
+                              dt=0.025, section_state=0, method="odeint") for _ in range(2))
+    assert motion.kind == "periodic", motion.evidence
+    assert motion.lyapunov == again.lyapunov and motion.evidence == again.evidence
+    assert np.array_equal(motion.section, again.section)
+    assert abs(motion.lyapunov) < 1e-3
+    assert motion.frequencies[0] == pytest.approx((2 * np.pi - 0.5) / (2 * np.pi), rel=1e-5)
+
+
+def near_resonance():
+    """Two uncoupled Hopf oscillators at 1 Hz and 1/12 Hz + 1.5e-3 Hz: a torus whose second
+    frequency is 0.018 Hz off a 1:12 resonance (f_a - 12 f_b = -0.018 Hz)."""
+    first = hopf(1.0, 2 * np.pi, 0.0)
+    second = hopf(1.0, 2 * np.pi * (1 / 12 + 1.5e-3), 0.0)
+
+    def field(y):
+        return np.r_[first[0](y[:2]), second[0](y[2:])]
+
+    def jacobian(y):
+        block = np.zeros((4, 4))
+        block[:2, :2], block[2:, 2:] = first[1](y[:2]), second[1](y[2:])
+        return block
+
+    return field, jacobian
+
+
+@pytest.mark.parametrize("method", ["odeint", "DOP853"])
+def test_a_torus_near_resonance_needs_the_longer_window_to_be_quasi_periodic(method):
+    """In 60 s (frequency bins of 1/60 Hz) 12 f_b is within 1.5 bins of f_a, so the spectrum
+    reads as harmonics of f_b while the section (at f_a's returns, rotating by f_b / f_a) is
+    a closed curve; the window doubled once resolves the two bases."""
+    field, jacobian = near_resonance()
+    options = dict(transient=10.0, duration=60.0, dt=0.025, section_state=0, method=method)
+    short = classify(field, jacobian, [0.5, 0.0, 0.5, 0.0], extend=0, **options)
+    assert short.kind == "periodic" and "did not repeat" in short.evidence, short.evidence
+    assert short.multiplicity == 0
+    longer = classify(field, jacobian, [0.5, 0.0, 0.5, 0.0], extend=1, **options)
+    assert longer.kind == "quasi-periodic", longer.evidence
+    # the second from the spectrum: within a tenth of a bin of the doubled window (1/120 Hz)
+    assert sorted(longer.frequencies) == pytest.approx([1 / 12 + 1.5e-3, 1.0], abs=0.1 / 120)
+    assert abs(longer.lyapunov) < 1e-3
+    assert len(longer.section) > len(short.section)  # twice the returns
+    assert "window doubled to 120 s" in longer.evidence
+
+
+def test_a_trajectory_at_rest_at_a_stable_point_ends_the_transient_early():
+    """Damped oscillator (decay zeta omega = 0.25 1/s) from amplitude 1: at rest (spread below
+    1e-6 over a quarter window) after ln(1e6) / 0.25 = 55 s, before the 200 s transient ends;
+    the class and exponent are the full run's."""
+    omega, zeta = 2 * np.pi, 0.04
+
+    def field(y):
+        return np.array([y[1], -omega**2 * y[0] - 2 * zeta * omega * y[1]])
+
+    def jacobian(_y):
+        return np.array([[0.0, 1.0], [-omega**2, -2 * zeta * omega]])
+
+    motion = classify(field, jacobian, [1.0, 0.0], transient=200.0, duration=30.0, dt=0.01,
+                      scale=[1.0, omega], method="odeint")
+    assert motion.kind == "equilibrium", motion.evidence
+    assert motion.lyapunov == pytest.approx(-zeta * omega, abs=0.03)
+    ended = float(motion.evidence.split("the transient ended at t = ")[1].split(" s")[0])
+    assert 55.0 < ended < 80.0

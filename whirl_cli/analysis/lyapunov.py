@@ -19,12 +19,17 @@ seconds (10 s for Lorenz), inside the part :func:`exponent_between` discards. Me
 two crossings of one Poincaré section (the same phase of a periodic orbit) the bounded
 oscillation of |v| along a cycle cancels, which a fixed window would leave as O(1) / duration.
 
+:func:`odeint_tangent_run` is the same with LSODA driven by scipy's ``odeint`` (what
+:func:`whirl_cli.analysis.motion.classify_model` uses): the Fortran driver calls back only for f
+and J, where ``solve_ivp`` adds Python work to every step (two thirds of the cost with the
+generated models' fast fields).
+
 Units: time in the units of ``f`` (s for whirl's models), exponents in 1 / that unit.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -46,13 +51,18 @@ class TangentRun:
     ``time`` (K,) from the end of the transient; ``states`` (K, n); ``growth`` (K,): ln of the
     tangent vector's length relative to its start (renormalisations added back);
     ``diverged``: the state left ``bound`` or the integration failed (``message`` says which);
-    the arrays then hold what was computed before."""
+    the arrays then hold what was computed before. ``tangent`` (n,): the tangent vector at
+    the end, unit length in the scales (None if diverged), to continue the run from;
+    ``settled``: where the transient ended early, at rest (s; NaN if it ran in full:
+    :func:`odeint_tangent_run`'s ``at_rest``)."""
 
     time: np.ndarray
     states: np.ndarray
     growth: np.ndarray
     diverged: bool
     message: str
+    tangent: np.ndarray | None = None
+    settled: float = np.nan
 
 
 def _escape(bound: np.ndarray):
@@ -68,7 +78,8 @@ def tangent_run(f, jac, y0, transient: float, duration: float, dt: float, *,
                 renormalise: float | None = None, rtol: float = 1e-8,
                 atol: float | np.ndarray | None = None, bound: float | np.ndarray = np.inf,
                 method: str = "DOP853", scale: float | np.ndarray = 1.0,
-                seed: int = 0) -> TangentRun:
+                seed: int = 0, tangent: np.ndarray | None = None,
+                at_rest: float | None = None) -> TangentRun:
     """Integrate ``transient`` seconds from ``y0`` (state only), then ``duration`` seconds of
     state and tangent vector, sampled every ``dt`` (scipy ``solve_ivp``, ``method``, ``rtol``;
     ``atol`` per state, default ``rtol`` x 1e-3 x max(|y0|, 1); the tangent's atol is ``rtol`` x
@@ -81,7 +92,15 @@ def tangent_run(f, jac, y0, transient: float, duration: float, dt: float, *,
     oscillation along an orbit, which blocks of finite length see, does), and the random part of
     the first tangent vector (``seed``) is isotropic in them. Implicit methods (Radau, BDF,
     LSODA) get the Jacobian blockdiag(J, J) of the augmented system (the H v coupling left out:
-    it only slows their Newton iteration, not the accuracy)."""
+    it only slows their Newton iteration, not the accuracy). ``method`` "odeint": LSODA through
+    :func:`odeint_tangent_run` instead (the same steps at a fraction of the Python cost).
+    ``tangent``: the first tangent vector (default :func:`first_tangent`), to continue a run
+    from its end (its last state and :attr:`TangentRun.tangent`); ``at_rest``: "odeint"
+    only, see :func:`odeint_tangent_run`."""
+    if method == "odeint":
+        return odeint_tangent_run(f, jac, y0, transient, duration, dt, rtol=rtol, atol=atol,
+                                  bound=bound, scale=scale, seed=seed, renormalise=renormalise,
+                                  tangent=tangent, at_rest=at_rest)
     from scipy.integrate import solve_ivp
 
     y0 = np.asarray(y0, dtype=float)
@@ -118,14 +137,8 @@ def tangent_run(f, jac, y0, transient: float, duration: float, dt: float, *,
         return full
 
     options = {"jac": augmented_jacobian} if implicit else {}
-    flow = f(y0)
-    rng = np.random.default_rng(seed)
     unit = np.broadcast_to(np.asarray(scale, dtype=float), (n,))
-    direction = rng.standard_normal(n) * unit
-    direction /= np.linalg.norm(direction / unit)
-    speed = np.linalg.norm(flow / unit)
-    v = (flow / speed if speed > 0 else direction) + TANGENT_MIX * direction
-    v /= np.linalg.norm(v / unit)
+    v = first_tangent(f, y0, unit, seed) if tangent is None else np.asarray(tangent, float)
 
     count = int(np.floor(duration / dt + 1e-9)) + 1
     grid = np.minimum(np.arange(count) * dt, duration)
@@ -162,7 +175,123 @@ def tangent_run(f, jac, y0, transient: float, duration: float, dt: float, *,
         norm = float(np.linalg.norm(z[n:] / unit))
         offset += np.log(norm)
         z[n:] /= norm
-    return _joined(times, states, growth, n, False, "")
+    return replace(_joined(times, states, growth, n, False, ""), tangent=z[n:].copy())
+
+
+def first_tangent(f, y: np.ndarray, unit: np.ndarray, seed: int) -> np.ndarray:
+    """The first tangent vector at ``y``: the flow direction plus :data:`TANGENT_MIX` of a
+    random direction isotropic in the scales ``unit`` (``seed``), unit length in them."""
+    flow = np.asarray(f(y), dtype=float)
+    rng = np.random.default_rng(seed)
+    direction = rng.standard_normal(len(y)) * unit
+    direction /= np.linalg.norm(direction / unit)
+    speed = np.linalg.norm(flow / unit)
+    v = (flow / speed if speed > 0 else direction) + TANGENT_MIX * direction
+    return v / np.linalg.norm(v / unit)
+
+
+# ------------------------------------------------------------------------------ odeint
+def odeint_tangent_run(f, jac, y0, transient: float, duration: float, dt: float, *,
+                       rtol: float = 1e-6, atol: float | np.ndarray | None = None,
+                       bound: float | np.ndarray = np.inf, scale: float | np.ndarray = 1.0,
+                       seed: int = 0, renormalise: float | None = None,
+                       tangent: np.ndarray | None = None,
+                       at_rest: float | None = None) -> TangentRun:
+    """:func:`tangent_run` with LSODA through ``scipy.integrate.odeint`` (the Fortran driver
+    calls back only for f and the Jacobian, with far less Python per step than
+    ``solve_ivp``): the transient sampled every ``dt`` (the bound checked there), then the
+    window in chunks of ``renormalise`` seconds (default ``duration`` / 20),
+    the tangent renormalised between them; ``atol`` default ``rtol`` x 1e-3 x ``scale``, the
+    tangent's ``rtol`` x :data:`TANGENT_ATOL` x ``scale``. ``tangent``: the first tangent
+    vector (unit length in the scales; default :func:`first_tangent`), to continue a run from
+    its end (the last state and :attr:`TangentRun.tangent`). ``at_rest`` (in the scales):
+    the transient, integrated in pieces of ``duration`` / 4, ends early after a piece over
+    which no state moved by as much (peak to peak) and where the Jacobian's eigenvalues all
+    have negative real parts: the trajectory has come to rest at a linearly stable
+    equilibrium, where it stays (``TangentRun.settled``: the time it ended)."""
+    from scipy.integrate import odeint
+
+    y = np.asarray(y0, dtype=float).copy()
+    n = y.size
+    bound = np.broadcast_to(np.asarray(bound, dtype=float), (n,))
+    unit = np.broadcast_to(np.asarray(scale, dtype=float), (n,))
+    atol = np.broadcast_to(np.asarray(rtol * 1e-3 * unit if atol is None else atol,
+                                      dtype=float), (n,))
+    empty = (np.zeros(0), np.zeros((0, n)), np.zeros(0), True)
+
+    def run(field, jacobian, start, grid, tolerance):
+        with np.errstate(over="ignore", invalid="ignore"):
+            values, info = odeint(field, start, grid, Dfun=jacobian, rtol=rtol,
+                                  atol=tolerance, mxstep=1_000_000, full_output=True)
+        good = info["message"] == "Integration successful."
+        outside = ~np.all(np.isfinite(values[:, :n]), axis=1) | np.any(
+            np.abs(values[:, :n]) >= bound, axis=1)
+        return values, good and not outside.any(), (int(np.argmax(outside)) if outside.any()
+                                                    else len(grid)), info["message"]
+
+    settled = np.nan
+    if transient > 0:
+        # in pieces of a quarter window when a state at rest may end the transient early
+        pieces = max(1, int(np.ceil(transient / (0.25 * duration)))) if at_rest else 1
+        edges = np.linspace(0.0, transient, pieces + 1)
+        for a, b in zip(edges[:-1], edges[1:], strict=True):
+            grid = np.linspace(a, b, max(2, int(np.ceil((b - a) / dt)) + 1))
+            values, ok, got, why = run(lambda z, _t: f(z), lambda z, _t: jac(z), y, grid,
+                                       atol)
+            if not ok:
+                when = grid[min(got, len(grid) - 1)]
+                reason = "left the bound" if got < len(grid) else f"failed: {why}"
+                return TangentRun(*empty, f"transient {reason} at t = {when:.4g}")
+            y = values[-1]
+            if b < transient and at_rest and _at_rest(values, jac, unit, at_rest):
+                settled = float(b)
+                break
+
+    def augmented(z, _t):
+        return np.concatenate((f(z[:n]), jac(z[:n]) @ z[n:]))
+
+    def augmented_jacobian(z, _t):
+        block = jac(z[:n])
+        full = np.zeros((2 * n, 2 * n))
+        full[:n, :n] = block
+        full[n:, n:] = block
+        return full
+
+    v = first_tangent(f, y, unit, seed) if tangent is None else np.asarray(tangent, float)
+    count = int(np.floor(duration / dt + 1e-9)) + 1
+    per_chunk = max(1, int(round((renormalise or duration / 20) / dt)))
+    tolerance = np.r_[atol, rtol * TANGENT_ATOL * unit]
+    states, growth = [y[None, :]], [np.zeros(1)]
+    z, total, done = np.r_[y, v], 0.0, 1
+    while done < count:
+        take = min(per_chunk, count - done)
+        grid = (done - 1 + np.arange(take + 1)) * dt
+        values, ok, got, why = run(augmented, augmented_jacobian, z, grid, tolerance)
+        values = values[1:]
+        kept = min(take, max(got - 1, 0)) if not ok else take
+        norms = np.linalg.norm(values[:kept, n:] / unit, axis=1)
+        states.append(values[:kept, :n])
+        growth.append(total + np.log(norms))
+        done += kept
+        if not ok:
+            reason = "left the bound" if got < len(grid) else f"failed: {why}"
+            states, growth = np.concatenate(states), np.concatenate(growth)
+            return TangentRun(np.arange(done) * dt, states, growth, True,
+                              f"settled window {reason} near t = {transient + done * dt:.4g}")
+        z = values[-1].copy()
+        total += float(np.log(norms[-1]))
+        z[n:] /= norms[-1]
+    return TangentRun(np.arange(count) * dt, np.concatenate(states), np.concatenate(growth),
+                      False, "", z[n:].copy(), settled)
+
+
+def _at_rest(values: np.ndarray, jac, unit: np.ndarray, tolerance: float) -> bool:
+    """The samples ``values`` (K, n) spread less than ``tolerance`` scales in every state and
+    the Jacobian at the last one is stable (every eigenvalue's real part negative)."""
+    n = len(unit)
+    if np.max(np.ptp(values[:, :n], axis=0) / unit) >= tolerance:
+        return False
+    return bool(np.all(np.linalg.eigvals(jac(values[-1, :n])).real < 0))
 
 
 def _joined(times, states, growth, n, diverged, message) -> TangentRun:

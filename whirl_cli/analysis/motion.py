@@ -3,7 +3,9 @@ quasi-periodic, chaotic (or diverged), from three independent pieces of evidence
 
 :func:`classify` takes any ODE (``f(y) -> dy/dt``, ``jac(y) -> df/dy``, numpy); it integrates a
 transient and then the settled window with one tangent vector
-(:func:`whirl_cli.analysis.lyapunov.tangent_run`), and reads the samples three ways:
+(:func:`whirl_cli.analysis.lyapunov.tangent_run`; ``method`` "odeint", classify_model's, is
+LSODA through scipy's ``odeint``: the same steps as ``solve_ivp``'s LSODA with far less Python
+per step), and reads the samples three ways:
 
 (a) **Poincaré section**: the crossings of y_k = mean(y_k) with y_k rising (k: the state that
     moves most relative to its scale), located on a cubic through the four samples around
@@ -42,6 +44,17 @@ The class (:class:`MotionClass`), in this order:
    frequencies -> ``quasi-periodic``; else (a cloud, a broadband spectrum) -> ``chaotic``
    (weakly: lambda not resolved from zero; the evidence says so).
 
+**The window, doubled once.** Where the section does not repeat but the spectrum reads one
+fundamental (rule 4's spectrum-only ``periodic``), or lambda is not resolved and the section
+is a cloud (weakly ``chaotic``), section and spectrum disagree: near a resonance p:q of a
+torus the spectrum cannot tell f_a from q/p f_b within 1.5 bins (bin = 1 / window), while the
+section is a closed curve. With ``extend`` = 1 (``classify_model``'s default) the window is
+then continued as long again from its end (state and tangent vector, no new transient) and
+the whole is classified again: bins half as wide, twice the section points; a cycle whose
+section merely had not settled then repeats, and the evidence says so. A spectrum that still
+reads one fundamental keeps ``periodic`` (the section's interpolation noise on the fast
+harmonics of a cycle can keep it from repeating to 1e-2, the gimballed study at K1 = 0.2).
+
 threshold = ``lyapunov_tolerance`` (1/s), by default 0.01 x 2 pi f_dom (an e-fold in 16
 periods of the dominant frequency f_dom of the spectrum). Frequencies (Hz) reported: the
 fundamental 1 / (k x mean return time) of a period-k orbit, the section's 1 / mean return time
@@ -53,11 +66,11 @@ the linearisation at the start, see its docstring. Time in seconds, frequencies 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .lyapunov import exponent_between, tangent_run
+from .lyapunov import TangentRun, exponent_between, tangent_run
 
 KINDS = ("equilibrium", "periodic", "quasi-periodic", "chaotic", "diverged")
 
@@ -67,6 +80,10 @@ MAX_MULTIPLICITY = 8
 CURVE_DIMENSION = 1.5
 #: Spectral peaks kept, down to this fraction of the largest (power).
 PEAK_FLOOR = 1e-4
+#: The evidence of a cycle read from the spectrum alone, and of chaos not resolved by lambda.
+SPECTRUM_ONLY = ("the spectrum is one fundamental and its harmonics, though the section did "
+                 "not repeat")
+WEAKLY_CHAOTIC = "weakly chaotic"
 
 
 @dataclass(frozen=True, eq=False)
@@ -248,7 +265,7 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
              bound: np.ndarray | float = np.inf, method: str = "DOP853",
              renormalise: float | None = None, amplitude_tolerance: float = 1e-6,
              section_tolerance: float = 1e-2, lyapunov_tolerance: float | None = None,
-             seed: int = 0) -> MotionClass:
+             seed: int = 0, extend: int = 0) -> MotionClass:
     """The settled motion of dy/dt = ``f(y)`` from ``y0`` (see the module doc for the rule).
 
     ``transient``: seconds discarded (state only); ``duration``: seconds of settled window
@@ -259,14 +276,55 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
     beyond it is divergence (per state or one number); ``section_state``: the state whose
     mean level, crossed upwards, defines the section (default: the one with the largest
     standard deviation / scale); ``method``, ``rtol``, ``renormalise``: the integration
-    (:func:`whirl_cli.analysis.lyapunov.tangent_run`)."""
+    (:func:`whirl_cli.analysis.lyapunov.tangent_run`); ``extend``: how many times the window
+    may be doubled where section and spectrum disagree (module doc; the run continued from
+    its end)."""
     y0 = np.asarray(y0, dtype=float)
     n = y0.size
     scale = np.broadcast_to(np.asarray(1.0 if scale is None else scale, dtype=float), (n,))
     if atol is None:
         atol = rtol * 1e-3 * scale
     run = tangent_run(f, jac, y0, transient, duration, dt, renormalise=renormalise, rtol=rtol,
-                      atol=atol, bound=bound, method=method, scale=scale, seed=seed)
+                      atol=atol, bound=bound, method=method, scale=scale, seed=seed,
+                      at_rest=amplitude_tolerance)
+    motion = _classified(run, scale, amplitude_tolerance, section_state, section_tolerance,
+                         lyapunov_tolerance)
+    if np.isfinite(run.settled):
+        motion = replace(motion, evidence=f"{motion.evidence}; the transient ended at t = "
+                         f"{run.settled:.4g} s, at rest at a linearly stable point")
+    for _ in range(extend):
+        if not _undecided(motion) or run.tangent is None:
+            break
+        # the section and the spectrum disagree: a window as long again, continued (state and
+        # tangent) from its end, resolves a second frequency twice as fine
+        more = tangent_run(f, jac, run.states[-1], 0.0, run.time[-1], dt, rtol=rtol,
+                           atol=atol, bound=bound, method=method, scale=scale,
+                           renormalise=renormalise, tangent=run.tangent)
+        run = TangentRun(np.r_[run.time, run.time[-1] + more.time[1:]],
+                         np.concatenate((run.states, more.states[1:])),
+                         np.r_[run.growth, run.growth[-1] + more.growth[1:]], more.diverged,
+                         more.message, more.tangent)
+        first = motion.evidence.split(":")[0]
+        motion = _classified(run, scale, amplitude_tolerance, section_state, section_tolerance,
+                             lyapunov_tolerance)
+        motion = replace(motion, evidence=f"{motion.evidence}; window doubled to "
+                         f"{run.time[-1]:.4g} s (before: {first}, the section and the spectrum "
+                         "disagreeing)")
+    return motion
+
+
+def _undecided(motion: MotionClass) -> bool:
+    """The section did not repeat while the spectrum says periodic, or lambda is not resolved
+    from zero and the section is a cloud: what a longer window may settle."""
+    return motion.kind != "diverged" and (SPECTRUM_ONLY in motion.evidence
+                                          or WEAKLY_CHAOTIC in motion.evidence)
+
+
+def _classified(run: TangentRun, scale: np.ndarray, amplitude_tolerance: float,
+                section_state: int | None, section_tolerance: float,
+                lyapunov_tolerance: float | None) -> MotionClass:
+    """The class of a :class:`~whirl_cli.analysis.lyapunov.TangentRun` (the module doc's rule)."""
+    n = run.states.shape[1]
     empty = np.zeros((0, n))
     if run.diverged:
         return MotionClass("diverged", np.nan, np.nan, (), empty, np.nan, 0, (), np.nan,
@@ -296,7 +354,7 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
     bases = base_frequencies(peaks, 1.5 * bins)
     dominant = float(peaks[0]) if len(peaks) else 0.0
     threshold = (lyapunov_tolerance if lyapunov_tolerance is not None
-                 else 0.01 * 2 * np.pi * max(dominant, 1.0 / duration))
+                 else 0.01 * 2 * np.pi * max(dominant, 1.0 / time[-1]))
     returns = float(np.mean(np.diff(crossings))) if len(crossings) > 1 else np.nan
     evidence = [
         f"Lyapunov: lambda = {exponent:.4g} +- {error:.2g} 1/s (threshold {threshold:.3g})",
@@ -323,8 +381,7 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
                         f"{rate:.3g} per return, towards a period-{converging} orbit")
     elif len(bases) == 1 and broadband < 0.01:
         kind, found = "periodic", bases
-        evidence.append("the spectrum is one fundamental and its harmonics, though the section "
-                        f"did not repeat within {section_tolerance:g}")
+        evidence.append(f"{SPECTRUM_ONLY} within {section_tolerance:g}")
     elif (np.isfinite(dimension) and dimension < CURVE_DIMENSION) or len(bases) == 2:
         others = [p for p in peaks if abs(p * returns - round(p * returns)) > 1.5 * bins
                   * returns]
@@ -332,7 +389,7 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
                                                              else ())
     else:
         kind, found = "chaotic", strongest
-        evidence.append("weakly chaotic: lambda not resolved from zero, the section a cloud")
+        evidence.append(f"{WEAKLY_CHAOTIC}: lambda not resolved from zero, the section a cloud")
     return MotionClass(kind, exponent, error, tuple(found), section, dimension, multiplicity,
                        tuple(float(p) for p in peaks), broadband,
                        f"{kind}: " + "; ".join(evidence))
@@ -342,7 +399,8 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
 def classify_model(model, overrides: dict[str, float] | None = None, y0=None, *,
                    periods: float = 20.0, transient_periods: float = 15.0,
                    samples_per_period: int = 40, rtol: float = 1e-6,
-                   bound: float = 10.0, method: str = "LSODA", **options) -> MotionClass:
+                   bound: float = 10.0, method: str = "odeint", extend: int = 1,
+                   **options) -> MotionClass:
     """:func:`classify` for a whirl model (:class:`whirl_cli.models.Model`) at the parameter
     values ``overrides`` (study names, as :func:`whirl_cli.analysis.simulate.integrate`'s
     callers build them: defaults with these applied), from ``y0`` (SI; default: every dof at
@@ -353,16 +411,21 @@ def classify_model(model, overrides: dict[str, float] | None = None, y0=None, *,
     if the origin is not an equilibrium): T_w = 2 pi / Im(lambda) of the least damped
     oscillatory eigenvalue (the whirl mode that goes unstable; without one, the slowest decay
     time 1 / |Re lambda|); the transient is ``transient_periods`` T_w (state only), the window
-    ``periods`` T_w (state + tangent), sampled at T_w / ``samples_per_period``. LSODA
-    (``method``; it steps over the lightly excited fast gimbal modes of the gimballed model
-    where DOP853 has to resolve them: half the cost) at ``rtol`` (1e-6; atol ``rtol`` x 1e-3 x
-    the state scales, i.e. 1e-9 rad for the classical model's angles); |y_i| > ``bound`` x the
-    state scale (10 rad) is divergence. ``options``: the other keywords of :func:`classify`.
-    Cost: the gimballed model (8 states; whirl at 2.5-5 Hz, gimbal modes at ~88 Hz that set
-    LSODA's step: ~1500 steps per second simulated) takes 25 000-45 000 evaluations of f and
-    J, 1.4-2.7 s on the 2 shared cores measured (f ~25-40 us); 30 periods instead of 20 cost
-    40 % more. Fewer periods leave more orbits 'not settled' (the frequency of a gimballed LCO
-    was then 0.3 % off the settled one)."""
+    ``periods`` T_w (state + tangent), sampled at T_w / ``samples_per_period``, doubled once
+    (``extend``) where section and spectrum disagree. LSODA through ``odeint`` (``method``; it
+    steps over the lightly excited fast gimbal modes of the gimballed model where DOP853 has
+    to resolve them: half the cost) at ``rtol`` (1e-6; atol ``rtol`` x 1e-3 x the state
+    scales, i.e. 1e-9 rad for the classical model's angles), on the generated field with
+    Python-float states (the generated scalar code runs several times faster on them than on
+    numpy scalars); |y_i| > ``bound`` x the state scale (10 rad) is divergence. ``options``:
+    the other keywords of :func:`classify`. Cost: the gimballed model (8 states; whirl at
+    1.2-9 Hz, gimbal modes at up to ~88 Hz that set LSODA's step: ~2000 evaluations of f per
+    second simulated) takes 0.3-0.8 s CPU per value with the default 60-period transient of
+    ``explore`` (f ~5 us, J ~12 us), up to 2 s where the whirl mode is slow (1.2 Hz: 80
+    periods are 67 s simulated; the transient ended at rest at 17 s) and 1.1-1.5 s with the
+    window doubled, measured under a load of 8-11 on the 2 cores (README, Performance).
+    Fewer periods leave more orbits 'not settled' (the frequency of a gimballed LCO was then
+    0.3 % off the settled one)."""
     params = model.parameter_vector(overrides or {})
     field, jacobian = model.field_at(params)
     scale = np.asarray(model.state_scale, dtype=float)
@@ -378,6 +441,15 @@ def classify_model(model, overrides: dict[str, float] | None = None, y0=None, *,
         period = 2 * np.pi / abs(oscillatory[np.argmax(oscillatory.real)].imag)
     else:
         period = 1.0 / max(float(np.abs(eigenvalues.real).min()), 1e-3)
-    return classify(field, jacobian, y0, transient=transient_periods * period,
-                    duration=periods * period, dt=period / samples_per_period, scale=scale,
-                    rtol=rtol, bound=bound * scale, method=method, **options)
+    dt = period / samples_per_period
+    if method == "odeint":  # Python floats: the generated code's scalar arithmetic is faster
+        def f(y):
+            return field(y.tolist())
+
+        def jac(y):
+            return jacobian(y.tolist())
+    else:
+        f, jac = field, jacobian
+    return classify(f, jac, y0, transient=transient_periods * period,
+                    duration=periods * period, dt=dt, scale=scale,
+                    rtol=rtol, bound=bound * scale, method=method, extend=extend, **options)

@@ -7,6 +7,7 @@ they wrote (an empty branch with the run's status and message where a run failed
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
@@ -72,7 +73,8 @@ class RunSpec:
 
 
 class Engine:
-    """Runs AUTO jobs of one model: compiles once, one directory per run, ``jobs`` in parallel."""
+    """Runs AUTO jobs of one model: compiles once, one directory per run, at most ``jobs`` at
+    a time however many threads ask (independent stages of a recipe may run side by side)."""
 
     def __init__(self, model: Model, workroot: Path, jobs: int = 1, timeout: float = 120.0,
                  on_run: Callable[[runner.RunOutcome], None] | None = None) -> None:
@@ -84,6 +86,7 @@ class Engine:
         self.executable = toolchain.compile_equations(lambda: fortran_source(model), model.name,
                                                  source_key=source_key(model))
         self.outcomes: dict[str, runner.RunOutcome] = {}
+        self._slots = threading.BoundedSemaphore(self.jobs)
 
     def run_many(self, specs: Sequence[RunSpec]) -> list[runner.RunOutcome]:
         """Execute ``specs`` (independent of each other) and return outcomes in spec order;
@@ -97,9 +100,10 @@ class Engine:
             source, label = spec.restart
             restart_file = self.outcomes[source].file("s")
             constants["IRS"] = label
-        outcome = runner.run(self.executable.path, constants, self.workroot / spec.name,
-                           spec.name.replace("/", "."), restart=restart_file,
-                           timeout=self.timeout, data=spec.data)
+        with self._slots:
+            outcome = runner.run(self.executable.path, constants, self.workroot / spec.name,
+                                 spec.name.replace("/", "."), restart=restart_file,
+                                 timeout=self.timeout, data=spec.data)
         self.outcomes[outcome.name] = outcome
         if self.on_run is not None:
             self.on_run(outcome)

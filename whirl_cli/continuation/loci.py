@@ -10,6 +10,7 @@ import numpy as np
 
 from ..auto import runner
 from ..auto.constants import TORUS_ANGLE_INDEX, par_layout
+from ..interrupts import thread_map
 from ..models import Model
 from ..results import Branch, BranchKind, ContinuationResult, PointType, SpecialPoint
 from .branches import _same_point, head, join, special_points, typical_amplitudes
@@ -75,10 +76,14 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
     branches: list[Branch] = []
     points: list[SpecialPoint] = []
     starts: list[tuple[SpecialPoint, str]] = []
-    for k, value in enumerate(slices):
-        result = one_parameter(engine, f"{name}.slice_{k}", first, start, bounds[first],
-                               {**parameters, second: value}, numerics, periodic=periodic,
-                               start_orbits=slice_orbits[k] if slice_orbits else ())
+    def run_slice(k: int) -> ContinuationResult:
+        return one_parameter(engine, f"{name}.slice_{k}", first, start, bounds[first],
+                             {**parameters, second: slices[k]}, numerics, periodic=periodic,
+                             start_orbits=slice_orbits[k] if slice_orbits else ())
+
+    # the slices are independent: side by side (the engine runs at most its jobs of AUTO)
+    results = thread_map(run_slice, range(len(slices)), len(slices))
+    for k, (value, result) in enumerate(zip(slices, results, strict=True)):
         runs = {b.name: b.run for b in result.branches}
         for branch in result.branches:
             branches.append(replace(branch, name=f"slice_{k}.{branch.name}"))
@@ -117,9 +122,11 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
     Starts are taken slice by slice: a start lying on a locus of its type already traced
     from an earlier slice is the same locus and is not run again, nor is a start with the
     same type, parameters and period as another (a symmetric twin: its locus is the same
-    curve in the parameter plane). A slice's loci that repeat another locus are dropped
-    before those ending in MX are retried, so only kept loci are retried (AUTO's runs, not
-    just the results, are saved); duplicates left after the retries are dropped."""
+    curve in the parameter plane). Loci grow chunk by chunk, and after every chunk those that
+    repeat another locus are dropped and those that closed are cut (:func:`_grown`), so a
+    duplicate or a loop costs one chunk beyond where it is recognised; only kept loci ending
+    in MX are retried (AUTO's runs, not just the results, are saved); duplicates left after
+    the retries are dropped."""
     width = np.array([bounds[p][1] - bounds[p][0] for p in pair])
     numbered = list(enumerate(starts, 1))
     waves: dict[str, list] = {}
@@ -132,16 +139,20 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
                                                         width)
             for kind, curve in curves)]
         traced = _trace(engine, name, pair, bounds, numerics, _without_twins(todo, width))
-        fresh = _distinct([(kind, curve) for kind, _, curve in traced], curves, width)
-        ends = _codim2([c for _, c in curves + list(fresh.values())])
-        unclosed = [k for k, (_, curve) in fresh.items() if len(curve) == len(traced[k][2])
-                    and not _ending_at(curve.parameters[-1, :2], ends, width)]
-        for k, curve in zip(unclosed, _retried(engine, [traced[k][1] for k in unclosed],
-                                               [fresh[k][1] for k in unclosed]), strict=True):
-            fresh[k] = (fresh[k][0], curve)
-        curves += list(fresh.values())
-    kept = [curve for _, curve in _distinct(sorted(curves, key=lambda c: c[1].name), [],
-                                            width).values()]
+        fresh, uncut = _grown(engine, traced, curves, numerics, bounds, width)
+        ends = _codim2([c for _, c in curves + [(kind, c) for kind, _, c in fresh.values()]])
+        unclosed = {k: fresh[k] for k in uncut
+                    if not _ending_at(fresh[k][2].parameters[-1, :2], ends, width)}
+        retried = _retried(engine, {k: spec for k, (_, spec, _) in unclosed.items()},
+                           {k: curve for k, (_, _, curve) in unclosed.items()}, numerics)
+        again, _ = _grown(engine, {k: (fresh[k][0], *retried[k]) for k in retried}, [],
+                          numerics, bounds, width)
+        for k in retried:
+            fresh[k] = again.get(k, fresh[k])
+        curves += [(kind, curve) for kind, _, curve in fresh.values()]
+    kept = [curve for _, _, curve in _distinct(
+        {k: (kind, None, curve) for k, (kind, curve) in enumerate(
+            sorted(curves, key=lambda c: c[1].name))}, [], width).values()]
     codim2 = _codim2(kept)
     return [_locus_end(c, codim2, bounds, width) for c in kept]
 
@@ -176,29 +187,29 @@ def _without_twins(starts: list[tuple[int, SpecialPoint, str]], width: np.ndarra
     return kept
 
 
-def _distinct(curves: list[tuple[int, Branch]], known: list[tuple[int, Branch]],
-              width: np.ndarray) -> dict[int, tuple[int, Branch]]:
-    """The (point type, locus) of ``curves`` by their index, each cut where it closes,
-    without those lying on a ``known`` locus of their type or on one kept before them (their
-    first, middle and last points on it: a closed locus starts and ends at one point)."""
-    kept: dict[int, tuple[int, Branch]] = {}
-    for k, (kind, curve) in enumerate(curves):
+def _distinct(curves: dict[int, tuple[int, RunSpec | None, Branch]],
+              known: list[tuple[int, Branch]], width: np.ndarray
+              ) -> dict[int, tuple[int, RunSpec | None, Branch]]:
+    """The (point type, last run, locus) of ``curves``, each cut where it closes, without
+    those lying on a ``known`` locus of their type or on one kept before them (their first,
+    middle and last points on it: a closed locus starts and ends at one point)."""
+    kept: dict[int, tuple[int, RunSpec | None, Branch]] = {}
+    for k, (kind, spec, curve) in curves.items():
         curve = _closed(curve, width)
         probes = curve.parameters[[0, len(curve) // 2, -1]] if len(curve) else []
         if len(curve) and not any(
                 kind == other_kind and all(_on_curve(p, other.parameters, width) for p in probes)
-                for other_kind, other in known + list(kept.values())):
-            kept[k] = (kind, curve)
+                for other_kind, other in known + [(o[0], o[2]) for o in kept.values()]):
+            kept[k] = (kind, spec, curve)
     return kept
 
 
 def _trace(engine: Engine, name: str, pair: tuple[str, str],
            bounds: dict[str, tuple[float, float]], numerics: Numerics,
            starts: list[tuple[int, SpecialPoint, str]]
-           ) -> list[tuple[int, RunSpec, Branch]]:
+           ) -> dict[int, tuple[int, RunSpec, Branch]]:
     """(point type, last run, locus branch) of every start, both directions, run in
-    parallel (loci that used up their chunk of steps continued, those ending in MX not yet
-    retried)."""
+    parallel: the first chunk of steps of each (not yet continued, nor retried)."""
     model = engine.model
     specs = []
     for k, point, runs in starts:
@@ -217,51 +228,60 @@ def _trace(engine: Engine, name: str, pair: tuple[str, str],
     final: list[tuple[int, RunSpec, runner.RunOutcome]] = []
     for (kind, spec), outcome in zip(specs, outcomes, strict=True):
         if kind in CYCLE_LOCI and outcome.has_output:
-            constants = dict(spec.constants, NMX=min(LOCUS_CHUNK, numerics.max_steps))
+            constants = dict(spec.constants, NMX=min(FIRST_CHUNK, numerics.max_steps))
             second_stage.append((kind, replace(spec, name=spec.name + "2", constants=constants,
                                                restart=(outcome.name, outcome.labels[-1][1]))))
         else:
             final.append((kind, spec, outcome))
     final += [(kind, spec, outcome) for (kind, spec), outcome in zip(
         second_stage, engine.run_many([spec for _, spec in second_stage]), strict=True)]
-    curves = [_read(engine, spec, outcome) for _, spec, outcome in final]
-    width = np.array([bounds[p][1] - bounds[p][0] for p in pair])
-    curves = _extended(engine, [spec for _, spec, _ in final], curves, numerics, bounds, width)
-    return [(kind, spec, curve) for (kind, spec, _), curve in zip(final, curves, strict=True)]
+    return {k: (kind, spec, _read(engine, spec, outcome))
+            for k, (kind, spec, outcome) in enumerate(final)}
 
 
-#: Locus runs go LOCUS_CHUNK steps at a time: a closed locus is recognised after the chunk
-#: that closes it instead of being traced round and round up to the step limit.
+#: Loci of cycles (fold of cycles, torus) go FIRST_CHUNK steps, then LOCUS_CHUNK steps at a
+#: time: a closed locus, or one repeating another, is recognised after the chunk where it does so
+#: instead of being traced up to the step limit (most closed loci of the chapter-3 boundaries
+#: take under 100 steps round). Later chunks are longer: every restart begins again at the
+#: initial step DS, a hazard in a difficult stretch (a restart there has ended in MX).
+FIRST_CHUNK = 100
 LOCUS_CHUNK = 400
+CHUNKED = {BranchKind.FOLD_OF_CYCLES_LOCUS, BranchKind.TORUS_LOCUS}
 
 
-def _extended(engine: Engine, specs: list[RunSpec], curves: list[Branch], numerics: Numerics,
-              bounds: dict[str, tuple[float, float]], width: np.ndarray) -> list[Branch]:
-    """Loci that used up a chunk of steps without closing or reaching the range, continued
-    chunk by chunk from their last point (up to ``numerics.max_steps`` in all). A chunk that
-    adds no point (AUTO stops at once, e.g. restarted beyond a hard bound RL0/RL1 after
-    missing the UZSTOP edge in the first step of a restart, where AUTO locates no event) ends
-    its locus: continuing it again would repeat the same run for ever."""
-    done = list(curves)
-    stalled: set[int] = set()
+def _grown(engine: Engine, traced: dict[int, tuple[int, RunSpec, Branch]],
+           known: list[tuple[int, Branch]], numerics: Numerics,
+           bounds: dict[str, tuple[float, float]], width: np.ndarray
+           ) -> tuple[dict[int, tuple[int, RunSpec, Branch]], set[int]]:
+    """The loci ``traced`` (point type, last run, branch by index) continued chunk by chunk
+    from their last point while they use up their chunk of steps (up to
+    ``numerics.max_steps`` in all); after each chunk, those repeating a ``known`` locus or
+    one before them are dropped and those that closed are cut (:func:`_distinct`). Returns
+    the kept loci and the indices of those not cut (that ended of themselves)."""
+    grown = dict(traced)
+    cut: set[int] = set()
+    stalled: set[int] = set()  # a restart that made no step: not continued again
     chunk = 1
     while True:
-        again, where = [], []
-        for k, (spec, curve) in enumerate(zip(specs, done, strict=True)):
-            if spec.constants.get("NMX") != LOCUS_CHUNK or k in stalled or not _chunk_used(
-                    curve, width, bounds):
-                continue
-            if len(curve) >= numerics.max_steps or not curve.label[-1]:
-                continue
-            again.append(replace(spec, name=f"{spec.name}c{chunk}",
-                                 restart=(curve.run.rsplit("+", 1)[-1], int(curve.label[-1]))))
-            where.append(k)
+        kept = _distinct(grown, known, width)
+        cut |= {k for k, (_, _, curve) in kept.items() if len(curve) < len(grown[k][2])}
+        again = {k: replace(spec, name=f"{spec.name}c{chunk}",
+                            constants=dict(spec.constants, NMX=min(
+                                LOCUS_CHUNK, numerics.max_steps - len(curve) + 1)),
+                            restart=(curve.run.rsplit("+", 1)[-1], int(curve.label[-1])))
+                 for k, (_, spec, curve) in kept.items()
+                 if k not in cut | stalled and spec.kind in CHUNKED
+                 and _chunk_used(curve, width, bounds) and len(curve) < numerics.max_steps
+                 and curve.label[-1]}
         if not again:
-            return done
-        for spec, k, outcome in zip(again, where, engine.run_many(again), strict=True):
+            return kept, set(kept) - cut
+        grown = dict(kept)
+        for (k, spec), outcome in zip(again.items(), engine.run_many(list(again.values())),
+                                      strict=True):
             extra = _read(engine, spec, outcome)
+            kind, last, curve = kept[k]
             if len(extra) > 1:
-                done[k] = join(done[k], extra, done[k].name)
+                grown[k] = (kind, last, join(curve, extra, curve.name))
             else:
                 stalled.add(k)
         chunk += 1
@@ -272,26 +292,31 @@ CODIM2 = {PointType.BT, PointType.CP, PointType.ZH, PointType.GH, PointType.R1, 
           PointType.R3, PointType.R4}
 
 
-def _retried(engine: Engine, specs: list[RunSpec], curves: list[Branch]) -> list[Branch]:
+def _retried(engine: Engine, specs: dict[int, RunSpec], curves: dict[int, Branch],
+             numerics: Numerics) -> dict[int, tuple[RunSpec, Branch]]:
     """Loci that ended in MX continued once more from their last good labelled point with
-    twice the mesh and half the largest step, joined to what they had."""
+    twice the mesh and half the largest step, joined to what they had: (retry run, locus) by
+    index, for those retried."""
     again, where = [], []
-    for k, (spec, curve) in enumerate(zip(specs, curves, strict=True)):
+    for k, curve in curves.items():
+        spec = specs[k]
         labelled = [r for r in np.flatnonzero(curve.label) if curve.point_type[r] != PointType.MX]
         if curve.status != "mx" or not labelled or labelled[-1] == 0:
             continue
         row = int(labelled[-1])
         constants = dict(spec.constants, NTST=spec.constants["NTST"] * 2,
                          DSMAX=spec.constants["DSMAX"] / 2)
+        if spec.kind in CHUNKED:
+            constants["NMX"] = min(LOCUS_CHUNK, numerics.max_steps - row)
         again.append(replace(spec, name=spec.name + "r", constants=constants,
                              restart=(engine.run_with_label(curve.run, int(curve.label[row])),
                                       int(curve.label[row]))))
         where.append((k, row))
-    done = list(curves)
+    done: dict[int, tuple[RunSpec, Branch]] = {}
     for spec, (k, row), outcome in zip(again, where, engine.run_many(again), strict=True):
         extra = _read(engine, spec, outcome)
         if len(extra):
-            done[k] = join(head(curves[k], row + 1), extra, curves[k].name)
+            done[k] = (spec, join(head(curves[k], row + 1), extra, curves[k].name))
     return done
 
 

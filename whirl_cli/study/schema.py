@@ -295,7 +295,9 @@ class OneParameterContinuation(_Strict):
         EXPLORE_TRANSIENT,
         description="Periods of the least damped whirl mode (of the linearisation at the "
         "origin) simulated and discarded before the `explore` classification's window of 20 "
-        "periods, > 0 (a weakly attracting cycle needs many to settle).",
+        "periods (40 where its Poincaré section and spectrum disagree), > 0 (a weakly "
+        "attracting cycle needs many to settle; a trajectory at rest at a stable equilibrium "
+        "ends it early).",
     )
     explore_section: Text | None = Field(
         None,
