@@ -22,8 +22,9 @@ What is asserted:
 * the angle varies along the locus (it is not a frozen start value) and the locus reaches the
   edge of the range at both ends.
 
-Cost: one study, ~16 s of AUTO CPU (four periodic families, two torus loci of two stages
-each), ~30 s wall on the loaded 2-core machine; the scipy checks < 1 s.
+Cost (measured): one study (four periodic families, two torus loci, each two stages in both
+directions; ~9 s of AUTO runs), 24 s CPU for the three tests with pytest's start-up, 28-44 s
+wall on the loaded 2-core machine (load 4-10); the scipy checks < 1 s.
 """
 
 from __future__ import annotations
