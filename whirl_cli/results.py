@@ -77,6 +77,7 @@ class BranchKind:
     BRANCH_POINT_LOCUS = "branch_point_locus"
     FOLD_LOCUS = "fold_locus"
     FOLD_OF_CYCLES_LOCUS = "fold_of_cycles_locus"
+    TORUS_LOCUS = "torus_locus"
 
 
 @dataclass(frozen=True)
@@ -115,13 +116,17 @@ class Branch:
     eigenvalues : (N, n) complex: Jacobian eigenvalues in 1/s for equilibria, Floquet multipliers
         for periodic orbits (NaN where AUTO printed none).
     status, message : how the AUTO run ended (ok | mx | error | timeout | crashed).
-    orbits : stored profiles of labelled solutions.
+    orbits : stored profiles of labelled solutions (periodic branches; on torus loci the cycle,
+        the first n components of AUTO's extended solution).
     end : why the branch ends (range, amplitude bound, return to a Hopf point, period blow-up,
         step limit, no convergence).
     stability_known : (N,) bool, False where the stability is unknown: AUTO printed no (or only
         NaN) eigenvalues or Floquet multipliers there (typically the first point of a periodic
         family started at a Hopf point), and everywhere on loci, where it is undefined. None
         (the default) means known everywhere.
+    torus_angle : (N,) rad, on torus (TR) loci only (None elsewhere): the angle in [0, pi] of
+        the complex pair of Floquet multipliers exp(+-i angle) on the unit circle there, from
+        AUTO's PAR(12) (the torus's second frequency is angle / (2 pi period)).
     """
 
     name: str
@@ -146,6 +151,7 @@ class Branch:
     orbits: tuple[Orbit, ...] = field(default=())
     end: str = ""  # how the branch ends, e.g. "range", "returns to HB at K1 = 0.0807"
     stability_known: np.ndarray | None = None
+    torus_angle: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         if self.stability_known is None:  # frozen: set through object

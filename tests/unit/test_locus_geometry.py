@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from whirl_cli.continuation.geometry import _near_polyline
@@ -99,3 +101,49 @@ def test_mirror_image_starts_are_traced_once():
               (4, start(-0.0815 + 1e-4, 0.82048, 1.0), "r1")]
     kept = _without_twins(starts, np.array([0.8, 0.5]))
     assert [k for k, _, _ in kept] == [1, 3, 4]
+
+
+def test_a_locus_that_passed_the_range_edge_ends_there_and_is_not_continued():
+    """AUTO locates no UZSTOP in the first step after a restart: a locus continued chunk by
+    chunk from just inside the edge can end beyond it. That is the range's end, like one on
+    the edge; one inside is continued."""
+    from whirl_cli.continuation.geometry import _at_range_edge, _chunk_used
+    from whirl_cli.results import PointType
+
+    bounds = {"p": (0.0, 1.0), "q": (0.0, 0.5)}
+    width = np.array([1.0, 0.5])
+    for last, edge in (((0.5, 0.3), False), ((1.0, 0.3), True), ((0.5, 0.5), True),
+                       ((1.003, 0.3), True), ((0.5, 0.52), True), ((0.5, -0.01), True)):
+        points = np.array([[0.2, 0.1], [0.3, 0.2], last])
+        curve = _locus(points)
+        curve.point_type[-1] = PointType.EP
+        assert _at_range_edge(curve, bounds, width) == edge, last
+        assert _chunk_used(curve, width, bounds) == (not edge), last
+
+
+def test_a_locus_chunk_that_adds_no_point_ends_the_locus(monkeypatch):
+    """Continuing a locus chunk by chunk stops when a chunk adds no point (AUTO stopped at
+    once): continuing it again would repeat the same run for ever. (The runs are stubs: this
+    is the loop's control, not a continuation result.)"""
+    from whirl_cli.continuation import loci
+    from whirl_cli.continuation.engine import Numerics, RunSpec
+    from whirl_cli.results import PointType
+
+    curve = _locus(np.array([[0.2, 0.1], [0.3, 0.2], [0.4, 0.3]]))
+    curve.point_type[-1] = PointType.EP
+    curve.label[-1] = 7
+    curve = dataclasses.replace(curve, run="c.fold_of_cycles_1a2")
+    spec = RunSpec("c/fold_of_cycles_1a2", {"NMX": loci.LOCUS_CHUNK}, curve.kind, "", ("p", "q"))
+    calls = []
+
+    class Engine:
+        def run_many(self, specs):
+            calls.append([s.name for s in specs])
+            assert len(calls) < 3, "the same chunk run again"
+            return [None] * len(specs)
+
+    monkeypatch.setattr(loci, "_read", lambda _engine, _spec, _outcome: _locus(
+        np.array([[0.4, 0.3]])))
+    kept, _ = loci._grown(Engine(), {0: (PointType.LPC, spec, curve)}, [], Numerics(),
+                          {"p": (0.0, 1.0), "q": (0.0, 0.5)}, np.array([1.0, 0.5]))
+    assert calls == [["c/fold_of_cycles_1a2c1"]] and len(kept[0][2]) == 3

@@ -746,7 +746,8 @@ def test_boundary_plot_both_legend_and_title():
 
 def test_boundary_plot_boundary_only_legend_and_limits():
     loci = {"hopf_1": ("hopf", HOPF), "hopf_2": ("hopf", HOPF + 0.05),
-            "lpc_1": ("fold_of_cycles", LPC), "other": ("torus", np.array([[5.0, 5.0]] * 2))}
+            "lpc_1": ("fold_of_cycles", LPC),
+            "other": ("period_doubling", np.array([[5.0, 5.0]] * 2))}  # a kind not drawn
     ax = boundary_plot(make_boundary(loci=loci, polygons=()), None).axes[0]
     assert legend_labels(ax) == ["Hopf locus (flutter)", "fold of cycles locus (LPC)"]
     assert len(ax.lines) == 3 and contour_sets(ax) == []
@@ -899,3 +900,14 @@ def test_save_study_plots_boundary_ignores_grid_of_other_parameters(tmp_path, mo
     paths = save_study_plots(result, ("boundary",), tmp_path, "run", dpi=40)
     assert [p.name for p in paths] == ["run_kk_boundary.png"]
     assert seen == [(boundary, None, ())]
+
+
+def test_boundary_plot_torus_locus_carries_the_thesis_torus_mark():
+    """A torus locus: dotted green, strung with the thesis key's torus mark (hollow circle)."""
+    torus = np.array([[0.5, 0.0], [0.55, 0.25], [0.6, 0.5]])
+    ax = boundary_plot(make_boundary(loci={"hopf_1": ("hopf", HOPF),
+                                           "torus_1a": ("torus", torus)}), None).axes[0]
+    line = polyline(ax, torus)
+    assert line_style(line) == ("green", ":")
+    assert line.get_marker() == "o" and line.get_markerfacecolor() == "none"
+    assert legend_labels(ax) == ["Hopf locus (flutter)", "torus locus (TR)", "unsafe (overhang)"]

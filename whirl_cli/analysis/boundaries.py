@@ -188,6 +188,7 @@ LOCUS_NAMES = {
     BranchKind.FOLD_OF_CYCLES_LOCUS: "fold_of_cycles",
     BranchKind.BRANCH_POINT_LOCUS: "branch_point",
     BranchKind.FOLD_LOCUS: "fold",
+    BranchKind.TORUS_LOCUS: "torus",  # drawn, not used by the unsafe region
 }
 
 

@@ -18,6 +18,8 @@ from ..models import Model
 #: Free PAR slots for user parameters, in order (AUTO reserves 10..36).
 _USER_SLOTS = tuple(range(1, 10)) + tuple(range(37, 200))
 PERIOD_INDEX = 11
+#: PAR(12): the torus angle of a torus (TR) point, in (0, pi) rad; free on a torus locus.
+TORUS_ANGLE_INDEX = 12
 #: PVLS output: the largest half peak-to-peak value of any (AUTO, non-dimensional) state over
 #: the solution; 0 on equilibria. Used to stop periodic families that shrink back onto a Hopf.
 AMPLITUDE = "amplitude"

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..models import Model
 from ..results import Branch, BranchKind, Orbit, PointType
-from .constants import PERIOD_INDEX, par_layout
+from .constants import PERIOD_INDEX, TORUS_ANGLE_INDEX, par_layout
 from .runner import RunOutcome
 
 
@@ -237,6 +237,12 @@ def read_branch(outcome: RunOutcome, model: Model, *, name: str, kind: str, orig
     state_max = np.column_stack([segment.column(f"max_{s}") for s in model.state_names]) * scale
     state_min = np.column_stack([segment.column(f"min_{s}") for s in model.state_names]) * scale
     periodic = kind == BranchKind.PERIODIC
+    torus = kind == BranchKind.TORUS_LOCUS
+    angle_column = f"PAR({TORUS_ANGLE_INDEX})"
+    if torus and angle_column not in segment.columns:
+        return _unreadable_branch(outcome, model, name, kind, origin, parameter_names,
+                                  f"AUTO's b-file of a torus locus lacks {angle_column} (the "
+                                  "torus angle; ICP must list it)")
     period = (segment.column("PERIOD") / model.time_scale if "PERIOD" in segment.columns
               else np.full(len(segment.pt), np.nan))
     if kind == BranchKind.EQUILIBRIUM:
@@ -271,9 +277,17 @@ def read_branch(outcome: RunOutcome, model: Model, *, name: str, kind: str, orig
         status=outcome.status,
         message=outcome.message,
         run=outcome.name,
-        orbits=read_orbits(outcome, model, segment, parameter_names) if periodic else (),
+        orbits=read_orbits(outcome, model, segment, parameter_names) if periodic or torus
+        else (),
         stability_known=known,
+        torus_angle=_principal_angle(segment.column(angle_column)) if torus else None,
     )
+
+
+def _principal_angle(theta: np.ndarray) -> np.ndarray:
+    """AUTO's torus angle PAR(12) (any real: multipliers exp(+-i theta)) as the angle in
+    [0, pi] rad of the pair's upper member."""
+    return np.abs(np.angle(np.exp(1j * np.asarray(theta, dtype=float))))
 
 
 def _unreadable_branch(outcome: RunOutcome, model: Model, name: str, kind: str, origin: str,
@@ -288,7 +302,7 @@ def _unreadable_branch(outcome: RunOutcome, model: Model, name: str, kind: str, 
         l2_norm=np.empty(0), period=np.empty(0), stable=np.empty(0, dtype=bool),
         point_type=np.empty(0, dtype=np.int64), label=np.empty(0, dtype=np.int64),
         eigenvalues=np.empty((0, n), dtype=complex), status="error", message=message,
-        run=outcome.name)
+        run=outcome.name, torus_angle=np.empty(0) if kind == BranchKind.TORUS_LOCUS else None)
 
 
 def _hopf_periods(outcome: RunOutcome, segment: BSegment) -> np.ndarray:
@@ -305,7 +319,9 @@ def _hopf_periods(outcome: RunOutcome, segment: BSegment) -> np.ndarray:
 
 def read_orbits(outcome: RunOutcome, model: Model, segment: BSegment,
                 parameter_names: tuple[str, ...]) -> tuple[Orbit, ...]:
-    """Profiles of the labelled periodic solutions of a run, in SI units."""
+    """Profiles of the labelled periodic solutions of a run, in SI units (on a locus of
+    cycles, whose solutions extend the orbit by more components, the orbit's own first
+    ``model.n_states``)."""
     if not outcome.file("s").exists():
         return ()
     layout = par_layout(model)

@@ -11,30 +11,38 @@ import numpy as np
 from ..models import Model
 from ..results import Branch, PointType, SpecialPoint
 
-#: The per-point columns of a :class:`Branch` (one row per point).
+#: The per-point columns of a :class:`Branch` (one row per point); ``torus_angle`` is one
+#: only on torus loci (None elsewhere).
 COLUMNS = ("parameters", "state_max", "state_min", "l2_norm", "period", "stable", "point_type",
-           "label", "eigenvalues", "stability_known")
+           "label", "eigenvalues", "stability_known", "torus_angle")
+
+
+def _columns(*branches: Branch) -> tuple[str, ...]:
+    """The :data:`COLUMNS` every one of ``branches`` holds (not None)."""
+    return tuple(key for key in COLUMNS if all(getattr(b, key) is not None for b in branches))
 
 
 def head(branch: Branch, rows: int) -> Branch:
     """The first ``rows`` points of ``branch`` (with the orbits stored on them)."""
-    return replace(branch, **{key: getattr(branch, key)[:rows] for key in COLUMNS},
+    return replace(branch, **{key: getattr(branch, key)[:rows] for key in _columns(branch)},
                    orbits=tuple(o for o in branch.orbits if o.index < rows))
 
 
 def reverse(branch: Branch) -> Branch:
     """``branch`` with its points in the opposite order (its orbits re-indexed)."""
     last = len(branch) - 1
-    return replace(branch, **{key: getattr(branch, key)[::-1] for key in COLUMNS},
+    return replace(branch, **{key: getattr(branch, key)[::-1] for key in _columns(branch)},
                    orbits=tuple(replace(o, index=last - o.index) for o in branch.orbits[::-1]))
 
 
 def join(first: Branch, second: Branch, name: str) -> Branch:
     """One branch from two consecutive runs (the second restarted at the first's last point,
-    which it repeats); it ends as the second does."""
+    which it repeats); it ends as the second does. A column only one of them holds (a torus
+    angle) is dropped."""
     shift = len(first)
     stacked = {key: np.concatenate([getattr(first, key), getattr(second, key)[1:]])
-               for key in COLUMNS}
+               for key in _columns(first, second)}
+    stacked.update({key: None for key in ("torus_angle",) if key not in stacked})
     moved = tuple(replace(o, index=o.index + shift - 1) for o in second.orbits if o.index > 0)
     return replace(first, name=name, status=second.status, message=second.message,
                    end=second.end, run=f"{first.run}+{second.run}",

@@ -19,7 +19,7 @@ from ..auto.codegen import fortran_source, source_key
 from ..auto.parse import parse_s, read_branch
 from ..interrupts import thread_map
 from ..models import Model
-from ..results import Branch, PointType, RunRecord, SpecialPoint
+from ..results import Branch, BranchKind, PointType, RunRecord, SpecialPoint
 from .branches import special_points
 
 
@@ -157,7 +157,8 @@ def _failed_branch(model: Model, spec: RunSpec, outcome: runner.RunOutcome) -> B
         l2_norm=np.empty(0), period=np.empty(0), stable=np.empty(0, dtype=bool),
         point_type=np.empty(0, dtype=np.int64), label=np.empty(0, dtype=np.int64),
         eigenvalues=np.empty((0, n), dtype=complex), status=outcome.status,
-        message=outcome.message, run=outcome.name)
+        message=outcome.message, run=outcome.name,
+        torus_angle=np.empty(0) if spec.kind == BranchKind.TORUS_LOCUS else None)
 
 
 def _read(engine: Engine, spec: RunSpec, outcome: runner.RunOutcome) -> Branch:

@@ -21,10 +21,13 @@ def _chunk_used(curve: Branch, width: np.ndarray, bounds: dict[str, tuple[float,
 
 def _at_range_edge(curve: Branch, bounds: dict[str, tuple[float, float]], width: np.ndarray
                    ) -> bool:
-    """True if the locus ends on the edge of the study's range (where UZSTOP stops it)."""
+    """True if the locus ends on the edge of the study's range (where UZSTOP stops it) or
+    beyond it (AUTO locates no event in the first step after a restart, so a locus continued
+    from a point just inside the edge can pass it)."""
     last = curve.parameters[-1, :2]
     edges = np.array([bounds[p] for p in curve.parameter_names[:2]])
-    return bool(np.any(np.abs(last[:, None] - edges) < 1e-6 * width[:, None]))
+    outside = (last < edges[:, 0] - 1e-6 * width) | (last > edges[:, 1] + 1e-6 * width)
+    return bool(np.any(np.abs(last[:, None] - edges) < 1e-6 * width[:, None]) or outside.any())
 
 
 def _near_polyline(point: np.ndarray, curve: np.ndarray, width: np.ndarray,

@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..auto import runner
-from ..auto.constants import par_layout
+from ..auto.constants import TORUS_ANGLE_INDEX, par_layout
 from ..interrupts import thread_map
 from ..models import Model
 from ..results import Branch, BranchKind, ContinuationResult, PointType, SpecialPoint
@@ -26,22 +26,35 @@ LOCI = {
     PointType.BP: ("branch_point", BranchKind.BRANCH_POINT_LOCUS),
     PointType.LP: ("fold", BranchKind.FOLD_LOCUS),
     PointType.LPC: ("fold_of_cycles", BranchKind.FOLD_OF_CYCLES_LOCUS),
+    PointType.TR: ("torus", BranchKind.TORUS_LOCUS),
 }
+
+#: Loci of bifurcations of cycles: AUTO starts them in two stages (see :func:`_trace`).
+CYCLE_LOCI = (PointType.LPC, PointType.TR)
 
 
 def locus_constants(model: Model, numerics: Numerics, pair: tuple[str, str],
                     bounds: dict[str, tuple[float, float]], direction: int,
                     kind: PointType) -> dict:
     """Constants of a two-parameter locus (ISW=2) of a special point of type ``kind``.
-    Debian's AUTO 0.9.2 overruns a heap buffer on fold-of-cycles loci unless ISP=0."""
+    Debian's AUTO 0.9.2 overruns a heap buffer on fold-of-cycles loci unless ISP=0. A torus
+    locus is continued with ISP=0 and ILP=0 (AUTO's demo ``tor``) and has four free
+    parameters: the pair, the period PAR(11) and the torus angle PAR(12). AUTO (INITPS in
+    periodic.f90) frees the last two itself only when ICP has fewer than four entries; ICP
+    lists the PVLS outputs after them, so both are named here (else the angle stays frozen
+    and a PVLS output takes its place: a locus that does not move)."""
     first, second = pair
     constants = equilibrium_constants(model, numerics, first, bounds[first], direction)
-    constants.update(ISW=2, ICP=[first, second, "PERIOD", *par_layout(model).measures()])
+    angle = [TORUS_ANGLE_INDEX] if kind == PointType.TR else []
+    constants.update(ISW=2, ICP=[first, second, "PERIOD", *angle,
+                                 *par_layout(model).measures()])
     constants.pop("UZR", None)
     lower, upper = bounds[second]
     constants["UZSTOP"] = dict(constants["UZSTOP"], **{second: [lower, upper]})
     if kind == PointType.LPC:
         constants.update(IPS=2, ISP=0, ILP=1)
+    elif kind == PointType.TR:
+        constants.update(IPS=2, ISP=0, ILP=0)
     return constants
 
 
@@ -58,7 +71,7 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
     slice's run continues too (their folds of cycles start loci as a Hopf family's do)."""
     first, second = pair
     wanted = {kind for kind, (locus, _) in LOCI.items() if locus in loci}
-    periodic = PointType.LPC in wanted
+    periodic = any(kind in wanted for kind in CYCLE_LOCI)
     amplitudes = typical_amplitudes(engine.model)
     branches: list[Branch] = []
     points: list[SpecialPoint] = []
@@ -79,7 +92,7 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
                             parameters=np.array([point.parameters[0], value]))
             points.append(named)
             width = bounds[first][1] - bounds[first][0]
-            if point.point_type in wanted and point.status == "located" and not any(
+            if point.point_type in wanted and _starts_locus(point) and not any(
                     point.point_type == other.point_type
                     and _same_point(named, other, width, amplitudes)
                     for other, _ in starts):
@@ -89,6 +102,16 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
         points += special_points(curve, skip_first=True)
     return (ContinuationResult(name, "two-parameter", tuple(branches + curves), tuple(points)),
             curves)
+
+
+def _starts_locus(point: SpecialPoint) -> bool:
+    """True if the located special ``point`` starts a locus: a torus point only with its
+    pair of Floquet multipliers on the unit circle (a finite ``torus_angle``; AUTO's test
+    function also changes sign at a neutral saddle, a real pair with product 1, which is no
+    torus bifurcation, and a TR point without multipliers cannot be told apart)."""
+    if point.status != "located":
+        return False
+    return point.point_type != PointType.TR or bool(np.isfinite(point.torus_angle))
 
 
 def _loci(engine: Engine, name: str, pair: tuple[str, str],
@@ -196,7 +219,7 @@ def _trace(engine: Engine, name: str, pair: tuple[str, str],
         origin = f"{kind.name} at {pair[0]} = {point.parameters[0]:.6g} on {point.branch}"
         for direction, tag in ((1, "a"), (-1, "b")):
             constants = locus_constants(model, numerics, pair, bounds, direction, kind)
-            if kind == PointType.LPC:  # stage 1: AUTO builds the extended system (NMX 5)
+            if kind in CYCLE_LOCI:  # stage 1: AUTO builds the extended system (NMX 5)
                 constants["NMX"] = 5
             specs.append((kind, RunSpec(f"{name}/{locus}_{k}{tag}", constants, branch_kind,
                                         origin, pair, restart=(source, point.label))))
@@ -204,7 +227,7 @@ def _trace(engine: Engine, name: str, pair: tuple[str, str],
     second_stage = []
     final: list[tuple[int, RunSpec, runner.RunOutcome]] = []
     for (kind, spec), outcome in zip(specs, outcomes, strict=True):
-        if kind == PointType.LPC and outcome.has_output:
+        if kind in CYCLE_LOCI and outcome.has_output:
             constants = dict(spec.constants, NMX=min(FIRST_CHUNK, numerics.max_steps))
             second_stage.append((kind, replace(spec, name=spec.name + "2", constants=constants,
                                                restart=(outcome.name, outcome.labels[-1][1]))))
@@ -216,14 +239,14 @@ def _trace(engine: Engine, name: str, pair: tuple[str, str],
             for k, (kind, spec, outcome) in enumerate(final)}
 
 
-#: Fold-of-cycles locus runs go FIRST_CHUNK steps, then LOCUS_CHUNK steps at a time: a
-#: closed locus, or one repeating another, is recognised after the chunk where it does so
+#: Loci of cycles (fold of cycles, torus) go FIRST_CHUNK steps, then LOCUS_CHUNK steps at a
+#: time: a closed locus, or one repeating another, is recognised after the chunk where it does so
 #: instead of being traced up to the step limit (most closed loci of the chapter-3 boundaries
 #: take under 100 steps round). Later chunks are longer: every restart begins again at the
 #: initial step DS, a hazard in a difficult stretch (a restart there has ended in MX).
 FIRST_CHUNK = 100
 LOCUS_CHUNK = 400
-CHUNKED = {BranchKind.FOLD_OF_CYCLES_LOCUS}
+CHUNKED = {BranchKind.FOLD_OF_CYCLES_LOCUS, BranchKind.TORUS_LOCUS}
 
 
 def _grown(engine: Engine, traced: dict[int, tuple[int, RunSpec, Branch]],

@@ -14,6 +14,7 @@ Layout (units in a ``units`` attribute on every physical dataset)::
             point_type (N,) int (whirl PointType = AUTO TY codes) ; label (N,) int
             eigenvalues (N, n) complex [1/s]   (equilibria)  or
             floquet_multipliers (N, n) complex (periodic orbits)
+            torus_angle (N,) [rad]  (torus loci only: the Neimark-Sacker angle, AUTO's PAR(12))
             orbits/<label>/ time (K,) [s], states (K, n)  attrs: point_type, index, period,
                                                                 parameters
             freeplay_<dof>/ (periodic, freeplay law on dof) amplitude_ratio (N,) = A/delta;
@@ -133,6 +134,7 @@ BRANCH = (
     Field("eigenvalues",
           key=lambda kind: "floquet_multipliers" if kind == _PERIODIC else "eigenvalues",
           units=lambda kind: "1" if kind == _PERIODIC else "1/s"),
+    Field("torus_angle", units="rad", default=None),  # torus loci only
 )
 #: An :class:`Orbit` in ``orbits/<label>`` of its branch.
 ORBIT = (

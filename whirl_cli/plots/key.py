@@ -79,6 +79,10 @@ BOUNDARY_KEY: dict[str, dict[str, object]] = {
     "fold": {"color": "grey", "linestyle": "-.", "linewidth": 1.5, "label": "fold locus (LP)"},
     "fold_of_cycles": {"color": "orange", "linestyle": "-", "linewidth": 1.5,
                        "label": "fold of cycles locus (LPC)"},
+    # the thesis key's torus mark (a hollow circle) strung along a dotted line
+    "torus": {"color": "green", "linestyle": ":", "linewidth": 1.5, "marker": "o",
+              "markerfacecolor": "none", "markeredgecolor": "green", "markersize": 5,
+              "markevery": 0.08, "label": "torus locus (TR)"},
     # the unsafe region
     "unsafe": {"color": "red", "alpha": 0.5, "label": _UNSAFE_LABEL},
 }

@@ -19,7 +19,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-_LOCUS_KINDS = ("hopf", "branch_point", "fold", "fold_of_cycles")
+_LOCUS_KINDS = ("hopf", "branch_point", "fold", "fold_of_cycles", "torus")
 _SLICE_TOLERANCE = 1e-12  # slice values equal within this are the same slice
 _BAND_ALPHA = 0.25  # unsafe bands of overhang diagrams
 _CASE_LABEL_GAP = 0.04  # least distance of case labels, in axes fractions
@@ -40,8 +40,9 @@ def boundary_plot(boundary: Boundary | None, grid: LinearGrid | None,
       linear zero contour thin black, solid where the critical eigenvalue is complex (flutter),
       dashed where it is real (divergence);
     * from ``boundary``: its loci (Hopf solid dark blue, branch point dashed black, fold
-      dash-dot grey, fold of cycles solid orange; other kinds are not drawn) and the unsafe
-      (overhang) region, its polygons filled red;
+      dash-dot grey, fold of cycles solid orange, torus dotted green strung with the thesis
+      key's hollow circles; other kinds are not drawn) and the unsafe (overhang) region, its
+      polygons filled red;
     * a thin dotted horizontal line at each value of ``cases`` (e.g. ``boundary.slices``),
       labelled by ``case_labels`` (by default, and where a label is missing or empty, "case
       1", "case 2", ...) just right of the axes (labels only for lines within the y limits,

@@ -316,7 +316,7 @@ class OneParameterContinuation(_Strict):
         return study.parameter_values().get(name, names.defaults()[name])
 
 
-LocusKind = Literal["hopf", "branch_point", "fold", "fold_of_cycles"]
+LocusKind = Literal["hopf", "branch_point", "fold", "fold_of_cycles", "torus"]
 
 
 class Slice(_Strict):
@@ -379,7 +379,9 @@ class TwoParameterContinuation(_Strict):
     loci: tuple[LocusKind, ...] = Field(
         ("hopf", "branch_point", "fold", "fold_of_cycles"),
         description="Which loci to continue: `hopf`, `branch_point` (pitchfork), `fold` (of "
-        "equilibria), `fold_of_cycles` (needs the periodic branches, computed for it).",
+        "equilibria), `fold_of_cycles` (needs the periodic branches, computed for it), "
+        "`torus` (torus, Neimark-Sacker, bifurcations of cycles; needs the periodic branches "
+        "too; drawn, not used for the unsafe region). Default: all but `torus`.",
     )
     method: Literal["loci", "slices"] = Field(
         "loci",
