@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq
+from scipy.optimize import brentq, fsolve
 
 from whirl_cli.analysis import boundaries, simulate
 from whirl_cli.models import get_model
@@ -213,3 +213,44 @@ def test_stiff_gimbal_unsafe_interval_is_the_classical(tmp_path):
         found.append((interval.lower, interval.upper))
     print(f"\n  unsafe at K_psi = {SLICE}: stiff gimbal {found[0]}, classical {found[1]}")
     np.testing.assert_allclose(found[0], found[1], rtol=1e-3)
+
+
+def test_case5_main_family_ends_at_a_heteroclinic_approach(tmp_path):
+    """The boundary's slice K_psi = 0.037 (case 5) as a one-parameter run: the main family's
+    period grows only to 2.5 times the Hopf period before AUTO stops with MX (the saddles'
+    unstable eigenvalue, 3.2 1/s, is small), yet its end is judged a period blow-up, a
+    heteroclinic approach to the +/- pair of saddles (each, solved for by Newton's method from
+    the stored state, an equilibrium of the model with one real positive eigenvalue), not a
+    failure. By simulation, 2e-3 above the estimate p* a start
+    on AUTO's stable orbit stays on it, while 2e-3 below p* (past the end of the family) the
+    same start runs away in yaw (a dof beyond 100 typical amplitudes within 4 periods)."""
+    text = (ROOT / "studies" / "gimballed" / "combined_case2_soft.yaml").read_text()
+    text = _edit(text, "K_psi: 0.3,", "K_psi: 0.037,")
+    text = _edit(text, "cross_check: true", "cross_check: false")
+    study = validate_text(text, "case5.yaml")
+    result = run_study(study, tmp_path, jobs=2)
+    assert not verdict(result).problems, verdict(result).problems
+    (continuation,) = result.continuations
+    (family,) = [b for b in continuation.branches if b.kind == BranchKind.PERIODIC
+                 and b.origin.endswith("on main_down")]
+    assert family.end == "period blow-up: heteroclinic approach"
+    assert 2 * family.period[0] < family.period.max() < 3 * family.period[0]
+    (point,) = [p for p in continuation.special_points if p.branch == family.name
+                and p.point_type == PointType.HETEROCLINIC]
+    star = float(point.parameters[0])
+    params = MODEL.parameter_vector({**study.parameter_values(), "K_theta": star})
+    for stored in (point.state, -point.state):
+        saddle = fsolve(lambda y: MODEL.rhs_numpy(y, params), stored, xtol=1e-13,
+                        fprime=lambda y: MODEL.jacobian_numpy(y, params))
+        assert np.abs(MODEL.rhs_numpy(saddle, params)).max() < 1e-9
+        assert np.abs(saddle - stored).max() < 1e-3  # rad: the stored state interpolates
+        values = np.linalg.eigvals(MODEL.jacobian_numpy(saddle, params))
+        assert np.sum((values.real > 0) & (np.abs(values.imag) < 1e-9)) == 1
+        assert np.sum(values.real > 0) == 1
+    orbit = min(family.orbits, key=lambda o: abs(o.parameters[0] - (star + 2e-3)))
+    assert family.stable[orbit.index] and abs(orbit.parameters[0] - star - 2e-3) < 1e-3
+    assert simulate.check_orbit(MODEL, study.parameter_values(), family, orbit,
+                                periods=6).passed
+    beyond = MODEL.parameter_vector({**study.parameter_values(), "K_theta": star - 2e-3})
+    run = simulate.simulation(MODEL, beyond, orbit.states[0], 4 * orbit.period, rtol=1e-6)
+    assert run.status == 1 and "beyond" in run.message
