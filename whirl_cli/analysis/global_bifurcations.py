@@ -30,6 +30,13 @@ from ..results import Branch, BranchKind, PointType, SpecialPoint
 
 #: A family is in blow-up when its period exceeds this multiple of the reference period.
 BLOWUP_FACTOR = 3.0
+#: ... or when AUTO could not continue it (MX) after its period exceeded this multiple, with
+#: its orbit lingering near a saddle: near a saddle whose unstable eigenvalue lambda_u is small
+#: against the orbit's frequency the period grows only as -ln|p - p*| / lambda_u, and AUTO's
+#: tolerances end the family before BLOWUP_FACTOR (the gimballed hub's heteroclinic approach at
+#: K_psi = 0.037: lambda_u = 3.2 1/s, MX at 2.5 times the Hopf period, 1e-7 of the range
+#: from p*).
+STALL_FACTOR = 2.0
 #: An orbit lingers near an equilibrium it passes within this fraction of its own size.
 LINGER_FRACTION = 0.05
 
@@ -45,10 +52,16 @@ class BlowupFit:
     bracket: tuple[float, float]  # interval holding p*
 
 
-def in_blowup(family: Branch, reference_period: float) -> bool:
-    """True if the family's period has grown beyond BLOWUP_FACTOR times the reference period."""
+def in_blowup(family: Branch, reference_period: float, factor: float = BLOWUP_FACTOR) -> bool:
+    """True if the family's period has grown beyond ``factor`` times the reference period."""
     periods = family.period[np.isfinite(family.period)]
-    return bool(len(periods)) and periods.max() > BLOWUP_FACTOR * reference_period
+    return bool(len(periods)) and periods.max() > factor * reference_period
+
+
+def stalled(family: Branch, reference_period: float) -> bool:
+    """True if AUTO could not continue the family (MX) after its period had grown beyond
+    STALL_FACTOR times the reference period: a blow-up if its orbit lingers near a saddle."""
+    return family.status == "mx" and in_blowup(family, reference_period, STALL_FACTOR)
 
 
 #: A family in blow-up is continued (fold by fold) until its parameter has turned this often
@@ -203,8 +216,11 @@ def unstable_rate(model: Model, params: np.ndarray, state: np.ndarray) -> float:
 def analyse(family: Branch, model: Model, parameters: dict[str, float],
             equilibria: list[Branch], reference_period: float, width: float
             ) -> SpecialPoint | None:
-    """The global bifurcation a blowing-up family approaches, as a bracketed special point."""
-    if not in_blowup(family, reference_period):
+    """The global bifurcation a blowing-up family approaches, as a bracketed special point: one
+    whose period exceeds BLOWUP_FACTOR times ``reference_period``, or one :func:`stalled` with
+    its orbit lingering near a saddle."""
+    blown = in_blowup(family, reference_period)
+    if not blown and not stalled(family, reference_period):
         return None
     name = family.parameter_names[0]
     last = int(np.nanargmax(family.period))
@@ -216,6 +232,8 @@ def analyse(family: Branch, model: Model, parameters: dict[str, float],
         if orbit else []
     saddles = [(s, unstable_rate(model, params, s)) for s in near]
     saddles = [(s, rate) for s, rate in saddles if rate > 0]
+    if not blown and not saddles:
+        return None
     if len(saddles) >= 2:
         kind, what = PointType.HETEROCLINIC, "heteroclinic"
     else:
