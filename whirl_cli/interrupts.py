@@ -96,6 +96,9 @@ def end_processes(processes) -> None:
 
 #: Signals that arrived while :func:`catching` is in force, the first one being raised.
 _pending: list[int] = []
+#: Signals whose :class:`Interrupted` a ``__del__`` or weakref callback dropped: raised again
+#: by the next signal, at the next :func:`check`, or when the :func:`catching` block ends.
+_swallowed: list[int] = []
 
 
 @contextmanager
@@ -105,24 +108,30 @@ def catching(on_first: Callable[[], None] | None = None) -> Iterator[None]:
     processes) for the first of them; later ones do not interrupt the clean-up.
 
     Python discards an exception raised inside a weakref callback or a ``__del__`` (a signal
-    can land in one, e.g. while matplotlib draws), printing "Exception ignored". So the
-    signal is also remembered, and raised again when the block would end normally: an
-    interrupt is never lost."""
+    can land in one, e.g. while matplotlib draws or a finished process is collected), printing
+    "Exception ignored". So such a signal is remembered and raised again at the first chance:
+    the next signal, the next :func:`check` (:func:`thread_map` and :func:`forked_map` check
+    after every item, so a study stops within one item), or when the block would end
+    normally: an interrupt is never lost."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     _pending.clear()
+    _swallowed.clear()
 
     def handler(signum: int, frame: object) -> None:
         first = not _pending
         _pending.append(signum)
-        if first:
-            if on_first is not None:
-                on_first()
+        if first and on_first is not None:
+            on_first()
+        if first or _swallowed:
+            _swallowed.clear()
             raise Interrupted(signum)
 
     def unraisable(hook: sys.UnraisableHookArgs) -> None:  # the "Exception ignored" print
-        if not isinstance(hook.exc_value, Interrupted):  # ours is raised again (see above)
+        if isinstance(hook.exc_value, Interrupted):  # ours: raised again (see above)
+            _swallowed.append(hook.exc_value.signum)
+        else:
             default(hook)
 
     previous = {number: signal.signal(number, handler) for number in HELD}
@@ -131,6 +140,7 @@ def catching(on_first: Callable[[], None] | None = None) -> Iterator[None]:
         yield
     except Interrupted:
         _pending.clear()  # delivered
+        _swallowed.clear()
         raise
     finally:
         sys.unraisablehook = default
@@ -139,6 +149,16 @@ def catching(on_first: Callable[[], None] | None = None) -> Iterator[None]:
     if _pending:  # swallowed on its way (see above): raise it now
         signum = _pending[0]
         _pending.clear()
+        _swallowed.clear()
+        raise Interrupted(signum)
+
+
+def check() -> None:
+    """Raise now, in the main thread, an interrupt that a ``__del__`` or weakref callback
+    swallowed inside :func:`catching` (a no-op otherwise)."""
+    if _swallowed and threading.current_thread() is threading.main_thread():
+        signum = _swallowed[0]
+        _swallowed.clear()
         raise Interrupted(signum)
 
 
@@ -161,8 +181,11 @@ def held_signals() -> Iterator[None]:
     finally:
         for number, handler in previous.items():
             signal.signal(number, handler)
-        for number in dict.fromkeys(arrived):
-            signal.raise_signal(number)
+        for number in dict.fromkeys(arrived):  # the handler called here, not when the signal
+            if callable(previous[number]):     # is next checked for (maybe in a __del__,
+                previous[number](number, None)  # which would drop its exception)
+            else:
+                signal.raise_signal(number)
 
 
 def thread_map(function: Callable, items: Iterable, workers: int) -> list:
@@ -179,7 +202,11 @@ def thread_map(function: Callable, items: Iterable, workers: int) -> list:
     try:
         with held_signals():
             futures = [pool.submit(function, item) for item in items]
-        return [future.result() for future in futures]
+        results = []
+        for future in futures:
+            results.append(future.result())
+            check()
+        return results
     finally:
         for future in futures:
             future.cancel()
@@ -207,7 +234,11 @@ def forked_map(function: Callable[[int], object], count: int, jobs: int) -> list
     workers ignore SIGINT and die with the parent (:func:`quiet_worker`); an interrupt or an
     error here kills them at once."""
     if jobs < 2 or count < 2 or "fork" not in multiprocessing.get_all_start_methods():
-        return [function(k) for k in range(count)]
+        results = []
+        for k in range(count):
+            results.append(function(k))
+            check()
+        return results
     global _FORKED
     _FORKED = function
     try:
@@ -216,7 +247,11 @@ def forked_map(function: Callable[[int], object], count: int, jobs: int) -> list
         try:
             with forking():  # map submits every task (and forks the workers) at once
                 results = pool.map(_forked_call, range(count))
-            return list(results)
+            done = []
+            for result in results:
+                done.append(result)
+                check()
+            return done
         except BaseException:  # e.g. Ctrl-C: the workers hold nothing worth waiting for
             workers = list((getattr(pool, "_processes", None) or {}).values())
             pool.shutdown(wait=False, cancel_futures=True)

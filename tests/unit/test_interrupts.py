@@ -12,7 +12,7 @@ import weakref
 
 import pytest
 
-from whirl_cli.interrupts import Interrupted, catching
+from whirl_cli.interrupts import Interrupted, catching, check, forked_map, held_signals, thread_map
 
 
 class Thing:
@@ -38,6 +38,47 @@ def test_a_signal_swallowed_in_a_weakref_callback_is_raised_at_the_end(capfd):
             reached.append("the block went on")  # Python discarded the first raise
     assert reached and caught.value.signum == signal.SIGINT
     assert "Exception ignored" not in capfd.readouterr().err  # no traceback printed
+
+
+@pytest.mark.parametrize("mapped", ["thread_map", "forked_map"])
+def test_a_swallowed_signal_is_raised_after_the_next_item_of_a_map(mapped):
+    """A study must stop at once, not at the end of the block: a map raises the swallowed
+    interrupt after its next item (here the first), before the block goes on."""
+    reached = []
+    with pytest.raises(Interrupted):
+        with catching():
+            interrupt_inside_a_weakref_callback()
+            reached.append("the block went on")
+            if mapped == "thread_map":
+                thread_map(lambda x: x, [1, 2, 3], 1)
+            else:
+                forked_map(lambda k: k, 3, 2)
+            reached.append("after the map")
+    assert reached == ["the block went on"]
+
+
+def test_a_swallowed_signal_is_raised_by_the_next_signal_and_by_check():
+    for again in ("signal", "check"):
+        with pytest.raises(Interrupted):
+            with catching():
+                interrupt_inside_a_weakref_callback()
+                if again == "signal":
+                    os.kill(os.getpid(), signal.SIGINT)
+                else:
+                    check()
+                raise AssertionError(f"the {again} did not raise the swallowed interrupt")
+    check()  # nothing left to raise once delivered
+
+
+def test_a_held_signal_is_raised_on_leaving_by_the_handler_in_place():
+    """On leaving :func:`held_signals` the previous handler is called at once (a signal
+    raised again would wait for the next check, maybe inside a ``__del__`` that drops it)."""
+    with pytest.raises(KeyboardInterrupt):
+        with held_signals():
+            os.kill(os.getpid(), signal.SIGINT)
+    with pytest.raises(Interrupted):
+        with catching(), held_signals():
+            os.kill(os.getpid(), signal.SIGTERM)
 
 
 def test_a_delivered_signal_is_raised_once_and_calls_on_first():
