@@ -1,0 +1,78 @@
+"""whirl's freeplay law on the gimballed model (8 states; issue 16 item 2, the last to land adds
+it), on the real AUTO-07p: pitch freeplay on the nacelle of a soft gimbal; the offset
+equilibria past the origin's pitchfork (continued in K_in down to 0) checked against a Newton
+solve of the model's numpy right-hand side from a crude guess, and their eigenvalues against
+the linear model's with the pitch stiffness at K_out (beyond the gap the law is linear with
+slope K_out; at K_in = 0 the origin is inside the gap)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import fsolve
+
+from whirl_cli.analysis import linear
+from whirl_cli.models import get_model
+from whirl_cli.pipeline import run_study
+from whirl_cli.results import PointType
+from whirl_cli.study import validate_text
+
+pytestmark = pytest.mark.auto
+
+DELTA = math.radians(1.0)
+K_OUT = 0.4
+#: a soft gimbal (combined_case2_soft's); the K_in range holds the origin's pitchfork
+PARAMETERS = {"K_psi": 0.3, "K_beta": 10.0}
+
+
+def study(dof: str, k_out: float, k_in: float) -> str:
+    return f"""
+name: gimballed-freeplay-{dof}
+model: gimballed
+parameters: {{K_psi: 0.3, K_beta: 10.0}}
+nonlinearity: {{type: freeplay, dof: {dof}, delta: {DELTA!r}, K_out: {k_out}, K_in: {k_in}}}
+continuations:
+  - {{name: kin, type: one-parameter, parameter: K_in_{dof}, range: [0.0, {k_in}],
+      orbits_at: [0.0]}}
+"""
+
+
+@pytest.mark.parametrize("dof, datum", [("theta", "K_theta")])
+def test_offset_equilibria_of_freeplay_on_the_gimballed_model(tmp_path, dof, datum):
+    spec = validate_text(study(dof, K_OUT, 0.1))
+    result = run_study(spec, tmp_path, jobs=2)
+    assert [r.status for r in result.runs if ".shrink_" not in r.name] == \
+        ["ok"] * len([r for r in result.runs if ".shrink_" not in r.name]), result.runs
+    (continuation,) = result.continuations
+    pitchforks = [p for p in continuation.special_points if p.point_type == PointType.BP]
+    assert pitchforks, "no pitchfork of the origin in K_in"
+    model = spec.variant()
+    params = model.parameter_vector({**spec.parameter_values(), f"K_in_{dof}": 0.0})
+    assert params[model.parameter_names.index(datum)] == K_OUT  # K_out is the dof's datum
+    linear_model = get_model("gimballed")
+    at_k_out = linear_model.parameter_vector({**PARAMETERS, datum: K_OUT})[:, None]
+    expected = np.sort_complex(linear.analyse(linear_model, at_k_out)[0][0])
+    index = model.state_names.index(dof)
+    found = 0
+    for branch in continuation.branches:
+        if not branch.name.startswith("secondary"):
+            continue
+        (row,) = np.flatnonzero(branch.point_type == PointType.UZ)
+        assert abs(branch.parameters[row, 0]) < 1e-9
+        state = np.where(np.abs(branch.state_max[row]) >= np.abs(branch.state_min[row]),
+                         branch.state_max[row], branch.state_min[row])
+        guess = np.zeros(model.n_states)
+        guess[index] = 2 * DELTA * np.sign(state[index])  # past the gap, on AUTO's side
+        newton = fsolve(lambda y: model.rhs_numpy(y, params), guess, xtol=1e-11)
+        assert np.abs(model.rhs_numpy(newton, params)).max() < 1e-10
+        np.testing.assert_allclose(state, newton, rtol=1e-6, atol=1e-9)
+        assert abs(newton[index]) > DELTA  # beyond the gap, where the law is K_out's
+        ours = np.sort_complex(branch.eigenvalues[row])
+        np.testing.assert_allclose(ours, expected, rtol=1e-5, atol=1e-6)
+        print(f"gimballed {dof} freeplay, K_in = 0: offset equilibrium {dof} = "
+              f"{math.degrees(newton[index]):+.5f} deg (AUTO {math.degrees(state[index]):+.5f})"
+              f", stable {bool(branch.stable[row])}")
+        found += 1
+    assert found == 2
