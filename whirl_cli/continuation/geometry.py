@@ -26,8 +26,7 @@ def _at_range_edge(curve: Branch, bounds: dict[str, tuple[float, float]], width:
     from a point just inside the edge can pass it)."""
     last = curve.parameters[-1, :2]
     edges = np.array([bounds[p] for p in curve.parameter_names[:2]])
-    outside = (last < edges[:, 0] - 1e-6 * width) | (last > edges[:, 1] + 1e-6 * width)
-    return bool(np.any(np.abs(last[:, None] - edges) < 1e-6 * width[:, None]) or outside.any())
+    return bool(np.any((last < edges[:, 0] + 1e-6 * width) | (last > edges[:, 1] - 1e-6 * width)))
 
 
 def _near_polyline(point: np.ndarray, curve: np.ndarray, width: np.ndarray,

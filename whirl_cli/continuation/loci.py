@@ -76,6 +76,7 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
     branches: list[Branch] = []
     points: list[SpecialPoint] = []
     starts: list[tuple[SpecialPoint, str]] = []
+
     def run_slice(k: int) -> ContinuationResult:
         return one_parameter(engine, f"{name}.slice_{k}", first, start, bounds[first],
                              {**parameters, second: slices[k]}, numerics, periodic=periodic,
@@ -143,12 +144,9 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
         ends = _codim2([c for _, c in curves + [(kind, c) for kind, _, c in fresh.values()]])
         unclosed = {k: fresh[k] for k in uncut
                     if not _ending_at(fresh[k][2].parameters[-1, :2], ends, width)}
-        retried = _retried(engine, {k: spec for k, (_, spec, _) in unclosed.items()},
-                           {k: curve for k, (_, _, curve) in unclosed.items()}, numerics)
-        again, _ = _grown(engine, {k: (fresh[k][0], *retried[k]) for k in retried}, [],
-                          numerics, bounds, width)
-        for k in retried:
-            fresh[k] = again.get(k, fresh[k])
+        retried = _retried(engine, unclosed, numerics)
+        again, _ = _grown(engine, retried, [], numerics, bounds, width)
+        fresh.update({k: again.get(k, fresh[k]) for k in retried})
         curves += [(kind, curve) for kind, _, curve in fresh.values()]
     kept = [curve for _, _, curve in _distinct(
         {k: (kind, None, curve) for k, (kind, curve) in enumerate(
@@ -292,14 +290,13 @@ CODIM2 = {PointType.BT, PointType.CP, PointType.ZH, PointType.GH, PointType.R1, 
           PointType.R3, PointType.R4}
 
 
-def _retried(engine: Engine, specs: dict[int, RunSpec], curves: dict[int, Branch],
-             numerics: Numerics) -> dict[int, tuple[RunSpec, Branch]]:
-    """Loci that ended in MX continued once more from their last good labelled point with
-    twice the mesh and half the largest step, joined to what they had: (retry run, locus) by
-    index, for those retried."""
+def _retried(engine: Engine, loci: dict[int, tuple[int, RunSpec, Branch]], numerics: Numerics
+             ) -> dict[int, tuple[int, RunSpec, Branch]]:
+    """Loci (point type, last run, branch by index) that ended in MX continued once more from
+    their last good labelled point with twice the mesh and half the largest step, joined to
+    what they had: (point type, retry run, locus) by index, for those retried."""
     again, where = [], []
-    for k, curve in curves.items():
-        spec = specs[k]
+    for k, (_, spec, curve) in loci.items():
         labelled = [r for r in np.flatnonzero(curve.label) if curve.point_type[r] != PointType.MX]
         if curve.status != "mx" or not labelled or labelled[-1] == 0:
             continue
@@ -312,11 +309,12 @@ def _retried(engine: Engine, specs: dict[int, RunSpec], curves: dict[int, Branch
                              restart=(engine.run_with_label(curve.run, int(curve.label[row])),
                                       int(curve.label[row]))))
         where.append((k, row))
-    done: dict[int, tuple[RunSpec, Branch]] = {}
+    done: dict[int, tuple[int, RunSpec, Branch]] = {}
     for spec, (k, row), outcome in zip(again, where, engine.run_many(again), strict=True):
         extra = _read(engine, spec, outcome)
+        kind, _, curve = loci[k]
         if len(extra):
-            done[k] = (spec, join(head(curves[k], row + 1), extra, curves[k].name))
+            done[k] = (kind, spec, join(head(curve, row + 1), extra, curve.name))
     return done
 
 
