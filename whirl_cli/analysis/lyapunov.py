@@ -74,6 +74,23 @@ def _escape(bound: np.ndarray):
     return event
 
 
+def _tangent_system(f, jac, n: int):
+    """The state y (n) and a tangent vector v together, z = (y, v): its right-hand side
+    (f(y), J(y) v) and the Jacobian blockdiag(J, J) the implicit integrators get (the H v
+    coupling left out), each a function of z alone."""
+    def field(z: np.ndarray) -> np.ndarray:
+        return np.concatenate((f(z[:n]), jac(z[:n]) @ z[n:]))
+
+    def jacobian(z: np.ndarray) -> np.ndarray:
+        block = jac(z[:n])
+        full = np.zeros((2 * n, 2 * n))
+        full[:n, :n] = block
+        full[n:, n:] = block
+        return full
+
+    return field, jacobian
+
+
 def tangent_run(f, jac, y0, transient: float, duration: float, dt: float, *,
                 renormalise: float | None = None, rtol: float = 1e-8,
                 atol: float | np.ndarray | None = None, bound: float | np.ndarray = np.inf,
@@ -126,17 +143,12 @@ def tangent_run(f, jac, y0, transient: float, duration: float, dt: float, *,
                               f"transient {why} at t = {run.t[-1]:.4g}")
         y0 = run.y[:, -1]
 
+    field, field_jacobian = _tangent_system(f, jac, n)
+
     def augmented(_t, z):
-        return np.concatenate((f(z[:n]), jac(z[:n]) @ z[n:]))
+        return field(z)
 
-    def augmented_jacobian(_t, z):
-        block = jac(z[:n])
-        full = np.zeros((2 * n, 2 * n))
-        full[:n, :n] = block
-        full[n:, n:] = block
-        return full
-
-    options = {"jac": augmented_jacobian} if implicit else {}
+    options = {"jac": lambda _t, z: field_jacobian(z)} if implicit else {}
     unit = np.broadcast_to(np.asarray(scale, dtype=float), (n,))
     v = first_tangent(f, y0, unit, seed) if tangent is None else np.asarray(tangent, float)
 
@@ -247,15 +259,13 @@ def odeint_tangent_run(f, jac, y0, transient: float, duration: float, dt: float,
                 settled = float(b)
                 break
 
+    field, field_jacobian = _tangent_system(f, jac, n)
+
     def augmented(z, _t):
-        return np.concatenate((f(z[:n]), jac(z[:n]) @ z[n:]))
+        return field(z)
 
     def augmented_jacobian(z, _t):
-        block = jac(z[:n])
-        full = np.zeros((2 * n, 2 * n))
-        full[:n, :n] = block
-        full[n:, n:] = block
-        return full
+        return field_jacobian(z)
 
     v = first_tangent(f, y, unit, seed) if tangent is None else np.asarray(tangent, float)
     count = int(np.floor(duration / dt + 1e-9)) + 1
