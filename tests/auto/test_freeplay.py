@@ -125,6 +125,16 @@ continuations:
 """
 
 
+def offset_equilibria_at_zero(continuation):
+    """(branch, row) of each secondary equilibrium branch of a continuation in K_in at its
+    labelled point K_in = 0 (``orbits_at: [0.0]``)."""
+    for branch in continuation.branches:
+        if branch.name.startswith("secondary"):
+            (row,) = np.flatnonzero(branch.point_type == PointType.UZ)
+            assert abs(branch.parameters[row, 0]) < 1e-9
+            yield branch, row
+
+
 def test_offset_equilibria_of_pitch_freeplay_are_the_closed_form(run):
     """Continued in K_in from 0.1 down to 0, the origin's pitchfork (at K_in = K_div) leads to
     the offset equilibria; at K_in = 0 (AUTO's labelled point) they are theta_e = +-delta
@@ -144,11 +154,7 @@ def test_offset_equilibria_of_pitch_freeplay_are_the_closed_form(run):
     at_k_out = model.parameter_vector({"K_psi": K_PSI, "K_theta": 0.4})[:, None]
     expected = np.sort_complex(linear.analyse(model, at_k_out)[0][0])
     found = 0
-    for branch in continuation.branches:
-        if not branch.name.startswith("secondary"):
-            continue
-        (row,) = np.flatnonzero(branch.point_type == PointType.UZ)
-        assert abs(branch.parameters[row, 0]) < 1e-9
+    for branch, row in offset_equilibria_at_zero(continuation):
         theta, psi = branch.state_max[row, :2]
         sign = np.sign(theta)
         assert theta == pytest.approx(sign * theta_e, rel=1e-6)

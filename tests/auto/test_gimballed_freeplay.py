@@ -19,6 +19,8 @@ from whirl_cli.pipeline import run_study
 from whirl_cli.results import PointType
 from whirl_cli.study import validate_text
 
+from .test_freeplay import offset_equilibria_at_zero
+
 pytestmark = pytest.mark.auto
 
 DELTA = math.radians(1.0)
@@ -56,11 +58,7 @@ def test_offset_equilibria_of_freeplay_on_the_gimballed_model(tmp_path, dof, dat
     expected = np.sort_complex(linear.analyse(linear_model, at_k_out)[0][0])
     index = model.state_names.index(dof)
     found = 0
-    for branch in continuation.branches:
-        if not branch.name.startswith("secondary"):
-            continue
-        (row,) = np.flatnonzero(branch.point_type == PointType.UZ)
-        assert abs(branch.parameters[row, 0]) < 1e-9
+    for branch, row in offset_equilibria_at_zero(continuation):
         state = np.where(np.abs(branch.state_max[row]) >= np.abs(branch.state_min[row]),
                          branch.state_max[row], branch.state_min[row])
         guess = np.zeros(model.n_states)

@@ -97,10 +97,8 @@ def test_a_cycle_not_yet_reached_is_periodic_and_said_unsettled():
     assert motion.frequencies[0] == pytest.approx(1.0, rel=1e-4)  # omega / 2 pi at any radius
 
 
-def test_two_incommensurate_oscillators_are_quasi_periodic_with_both_frequencies():
-    first = hopf(1.0, 2 * np.pi, 0.5)
-    second = hopf(0.5, 2 * np.pi * np.sqrt(2.0), 0.0)
-
+def uncoupled(first, second):
+    """(field, jacobian) of two uncoupled 2-state oscillators, each a (field, jacobian) pair."""
     def field(y):
         return np.r_[first[0](y[:2]), second[0](y[2:])]
 
@@ -109,6 +107,12 @@ def test_two_incommensurate_oscillators_are_quasi_periodic_with_both_frequencies
         block[:2, :2], block[2:, 2:] = first[1](y[:2]), second[1](y[2:])
         return block
 
+    return field, jacobian
+
+
+def test_two_incommensurate_oscillators_are_quasi_periodic_with_both_frequencies():
+    field, jacobian = uncoupled(hopf(1.0, 2 * np.pi, 0.5),
+                                hopf(0.5, 2 * np.pi * np.sqrt(2.0), 0.0))
     motion = classify(field, jacobian, [0.1, 0.0, 0.1, 0.0], transient=20.0, duration=60.0,
                       dt=0.025)
     assert motion.kind == "quasi-periodic", motion.evidence
@@ -204,18 +208,7 @@ def test_odeint_path_on_a_cycle_has_a_zero_exponent_and_the_same_bits_every_run(
 def near_resonance():
     """Two uncoupled Hopf oscillators at 1 Hz and 1/12 Hz + 1.5e-3 Hz: a torus whose second
     frequency is 0.018 Hz off a 1:12 resonance (f_a - 12 f_b = -0.018 Hz)."""
-    first = hopf(1.0, 2 * np.pi, 0.0)
-    second = hopf(1.0, 2 * np.pi * (1 / 12 + 1.5e-3), 0.0)
-
-    def field(y):
-        return np.r_[first[0](y[:2]), second[0](y[2:])]
-
-    def jacobian(y):
-        block = np.zeros((4, 4))
-        block[:2, :2], block[2:, 2:] = first[1](y[:2]), second[1](y[2:])
-        return block
-
-    return field, jacobian
+    return uncoupled(hopf(1.0, 2 * np.pi, 0.0), hopf(1.0, 2 * np.pi * (1 / 12 + 1.5e-3), 0.0))
 
 
 @pytest.mark.parametrize("method", ["odeint", "DOP853"])
