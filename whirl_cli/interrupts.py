@@ -254,8 +254,11 @@ def forked_map(function: Callable[[int], object], count: int, jobs: int) -> list
             return done
         except BaseException:  # e.g. Ctrl-C: the workers hold nothing worth waiting for
             workers = list((getattr(pool, "_processes", None) or {}).values())
+            manager = getattr(pool, "_executor_manager_thread", None)
             pool.shutdown(wait=False, cancel_futures=True)
             end_processes(workers)
+            if manager is not None:  # left running, it races Python's exit hook for the
+                manager.join(5)      # pool's wakeup pipe ("Bad file descriptor" traceback)
             raise
         finally:
             pool.shutdown(wait=True)

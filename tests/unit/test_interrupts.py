@@ -8,6 +8,8 @@ import gc
 import os
 import pickle
 import signal
+import threading
+import time
 import weakref
 
 import pytest
@@ -55,6 +57,22 @@ def test_a_swallowed_signal_is_raised_after_the_next_item_of_a_map(mapped):
                 forked_map(lambda k: k, 3, 2)
             reached.append("after the map")
     assert reached == ["the block went on"]
+
+
+def test_an_interrupted_forked_map_leaves_no_pool_thread_behind():
+    """Interrupted while its workers run, forked_map kills them and joins the pool's manager
+    thread: one left running races Python's exit (it closes a pipe the exit hook writes to:
+    "Exception ignored in threading ... Bad file descriptor")."""
+    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+    started = time.monotonic()
+    with pytest.raises(Interrupted):
+        with catching():
+            timer.start()
+            forked_map(lambda k: time.sleep(30), 2, 2)
+    timer.join()
+    assert time.monotonic() - started < 10  # the workers were killed, not waited for
+    managers = [t for t in threading.enumerate() if type(t).__name__ == "_ExecutorManagerThread"]
+    assert managers == []
 
 
 def test_a_swallowed_signal_is_raised_by_the_next_signal_and_by_check():
