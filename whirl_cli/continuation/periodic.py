@@ -15,6 +15,7 @@ import numpy as np
 
 from ..analysis import global_bifurcations
 from ..auto.constants import AMPLITUDE, par_layout
+from ..interrupts import thread_map
 from ..models import Model
 from ..results import Branch, BranchKind, Orbit, PointType, SpecialPoint
 from .branches import amplitude, head, join, reverse, special_points
@@ -257,17 +258,17 @@ def orbit_data(model: Model, orbit: Orbit) -> str:
 
 def _continue(engine: Engine, families: list[_Family], hopfs: list[SpecialPoint],
               width: float) -> None:
-    """Run every family's segments, wave by wave (a wave's runs in parallel)."""
-    wave = [(family, family.spec) for family in families]
-    while wave:
-        outcomes = engine.run_many([spec for _, spec in wave])
-        following = []
-        for (family, spec), outcome in zip(wave, outcomes, strict=True):
+    """Run every family's segments: each family's one after another (a segment starts where
+    the last one ended), the families side by side, each as soon as its last segment is read
+    (no family waits for another's; the engine runs at most its ``jobs`` at once)."""
+    def grow(family: _Family) -> None:
+        spec = family.spec
+        while spec is not None:
+            outcome, = engine.run_many([spec])
             family.pieces.append(_read(engine, spec, outcome))
-            step = _next_segment(family, engine.model, hopfs, width)
-            if step is not None:
-                following.append((family, step))
-        wave = following
+            spec = _next_segment(family, engine.model, hopfs, width)
+
+    thread_map(grow, families, len(families))
 
 
 def _back_at_own_hopf(family: _Family, hopfs: list[SpecialPoint], width: float,
