@@ -43,11 +43,13 @@ def load(path: str | os.PathLike[str]) -> Study:
 
 def run(study: Study | str | os.PathLike[str], jobs: int = 1,
         on_run: Callable[[Any], None] | None = None,
-        keep_runs: str | os.PathLike[str] | None = None) -> StudyResult:
+        keep_runs: str | os.PathLike[str] | None = None,
+        preload: tuple[str, ...] = ()) -> StudyResult:
     """Run every continuation, linear analysis and cross-check of ``study`` (a Study or a
     path); ``jobs`` AUTO runs at once; ``on_run`` is called with each AUTO run's outcome as it
     ends. AUTO works in a temporary directory, removed afterwards, or kept under
-    ``keep_runs``."""
+    ``keep_runs``. ``preload``: modules needed afterwards, imported while AUTO runs (e.g.
+    :data:`whirl_cli.plots.MODULES` before :func:`save` draws plots)."""
     from .interrupts import held_signals
     from .pipeline import run_study
 
@@ -59,7 +61,7 @@ def run(study: Study | str | os.PathLike[str], jobs: int = 1,
         else:
             workroot = Path(tempfile.mkdtemp(prefix="whirl-"))
     try:
-        return run_study(study, workroot, jobs=jobs, on_run=on_run)
+        return run_study(study, workroot, jobs=jobs, on_run=on_run, preload=preload)
     finally:
         with held_signals():
             if not keep_runs:

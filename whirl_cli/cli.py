@@ -96,10 +96,12 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     console.print(f"whirl {_version()}: {study.path} -> {output}", soft_wrap=True)
     from . import api
     from .interrupts import catching
+    from .plots import MODULES as PLOT_MODULES
     from .verdict import verdict
 
     with catching():  # an interrupt while plots are drawn is never lost either
-        result = api.run(study, jobs=jobs, on_run=report, keep_runs=keep_runs)
+        result = api.run(study, jobs=jobs, on_run=report, keep_runs=keep_runs,
+                         preload=PLOT_MODULES if plots and study.plots else ())
         published = api.save(result, output, study.plots if plots else (), overwrite,
                              state=study.plot_state, jobs=jobs)
     for path in published.paths:

@@ -8,10 +8,13 @@
   ends such workers after an interrupt.
 * :func:`thread_map` maps over threads that never outlive the call, an interrupt included;
   :func:`forked_map` over forked worker processes (CPU-bound Python: simulations, plots).
+* :func:`preload` imports modules a later stage needs in a background thread (while AUTO
+  runs); every fork waits for it first.
 """
 
 from __future__ import annotations
 
+import importlib
 import multiprocessing
 import os
 import signal
@@ -55,13 +58,50 @@ def quiet_worker() -> None:
 HELD = frozenset({signal.SIGINT, signal.SIGTERM})
 
 
+#: Threads of :func:`preload` not yet joined (a fork joins them first).
+_preloading: list[threading.Thread] = []
+
+
+def preload(*modules: str) -> None:
+    """Import ``modules`` in a background thread: modules a later stage needs (matplotlib
+    for the plots, about 0.7 s; scipy's integrators for simulations, 0.5 s), imported while
+    AUTO runs instead of after it. Every fork (:func:`forking`) waits for the thread first,
+    so a forked worker inherits the modules, and never an import lock held by a thread that
+    does not exist in it. A failed import is ignored here: the stage that needs the module
+    meets the error itself."""
+    missing = [name for name in modules if name not in sys.modules]
+    if not missing:
+        return
+
+    def load() -> None:
+        for name in missing:
+            try:
+                importlib.import_module(name)
+            except Exception:  # noqa: BLE001, S110 - reported where the module is used
+                pass
+
+    thread = threading.Thread(target=load, name="whirl-preload", daemon=True)
+    with held_signals():  # an interrupt in start() would leave a thread not in the list
+        _preloading.append(thread)
+        thread.start()
+
+
+def preloaded() -> None:
+    """Wait until the modules of every :func:`preload` are imported (or failed to)."""
+    while _preloading:
+        _preloading[0].join()
+        _preloading.pop(0)
+
+
 @contextmanager
 def forking() -> Iterator[None]:
     """Fork worker processes inside this: SIGINT and SIGTERM are blocked in the calling
     thread, so a child starts with them blocked and none can arrive (and run the parent's
     inherited handler in the child, e.g. inside the interpreter's fork hooks) before
     :func:`quiet_worker` has set the child's own handlers and unblocked them. In the parent a
-    signal that arrived meanwhile is delivered once the block ends."""
+    signal that arrived meanwhile is delivered once the block ends. Modules being preloaded
+    (:func:`preload`) are imported first."""
+    preloaded()
     previous = signal.pthread_sigmask(signal.SIG_BLOCK, HELD)
     try:
         yield

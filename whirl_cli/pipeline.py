@@ -20,7 +20,7 @@ from .continuation.engine import Engine, Numerics
 from .continuation.loci import two_parameter
 from .continuation.one_parameter import one_parameter
 from .continuation.periodic import OrbitStart
-from .interrupts import forked_map, thread_map
+from .interrupts import forked_map, preload, thread_map
 from .output.provenance import provenance
 from .results import (
     Boundary,
@@ -35,20 +35,25 @@ from .study import Study
 
 
 def run_study(study: Study, workroot: Path, jobs: int = 1,
-              on_run: Callable[[RunOutcome], None] | None = None) -> StudyResult:
+              on_run: Callable[[RunOutcome], None] | None = None,
+              preload: tuple[str, ...] = ()) -> StudyResult:
     """Run every continuation, linear sweep and simulation of ``study``; AUTO works under
-    ``workroot`` (a study without continuations needs no AUTO).
+    ``workroot`` (a study without continuations needs no AUTO). ``preload``: modules the
+    caller needs afterwards (e.g. :data:`whirl_cli.plots.MODULES` to draw), imported in the
+    background once AUTO starts (:func:`whirl_cli.interrupts.preload`), with scipy's
+    integrators if the study simulates.
 
     In the main thread, SIGINT and SIGTERM kill the running AUTO processes at once and raise
     :class:`whirl_cli.interrupts.Interrupted` (a KeyboardInterrupt), see
     :func:`whirl_cli.auto.runner.interruptible`.
     """
     with interruptible():
-        return _run_study(study, workroot, jobs, on_run)
+        return _run_study(study, workroot, jobs, on_run, preload)
 
 
 def _run_study(study: Study, workroot: Path, jobs: int,
-               on_run: Callable[[RunOutcome], None] | None) -> StudyResult:
+               on_run: Callable[[RunOutcome], None] | None,
+               later: tuple[str, ...]) -> StudyResult:
     model = study.variant()
     parameters = study.parameter_values()
     numerics = Numerics.from_settings(study.auto)
@@ -57,9 +62,13 @@ def _run_study(study: Study, workroot: Path, jobs: int,
     if study.continuations:
         engine = Engine(model, workroot, jobs=jobs, timeout=numerics.timeout, on_run=on_run)
     found_boundaries = []
+    if _simulates(study, model):
+        later += simulate.MODULES
     for spec in study.continuations:
         assert engine is not None
         if spec.type == "two-parameter":
+            preload(*later)  # imported while AUTO runs
+            later = ()
             continuation, boundary = _two_parameter(engine, study, spec, parameters,
                                                     numerics)
             continuations.append(continuation)
@@ -67,6 +76,8 @@ def _run_study(study: Study, workroot: Path, jobs: int,
             continue
         starts, outcomes = seeded_orbits(model, parameters, spec.parameter, spec.start,
                                          spec.seeds, jobs)
+        preload(*later)  # imported while AUTO runs
+        later = ()
 
         def continued(name: str, values: dict[str, float], spec=spec, starts=starts):
             return one_parameter(
@@ -108,6 +119,14 @@ def _run_study(study: Study, workroot: Path, jobs: int,
         attributes=provenance(study), boundaries=tuple(found_boundaries), linear_grid=grid,
         parameters=resolved_parameters(model, parameters),
         simulations=tuple(simulations(study, model)))
+
+
+def _simulates(study: Study, model) -> bool:
+    """True if ``study`` simulates after its AUTO runs (cross-checks, ``simulations:``,
+    ``explore`` values, seeds, or a freeplay law's linear estimates, which use scipy too)."""
+    return bool(study.cross_check or study.simulations or freeplay.freeplay_dofs(model)
+                or any(getattr(spec, "explore", ()) or getattr(spec, "seeds", ())
+                       for spec in study.continuations))
 
 
 def persisted(engine: Engine, base: ContinuationResult, continued: Callable, spec,
@@ -214,6 +233,7 @@ def seeded_orbits(model, overrides: dict[str, float], parameter: str, start: flo
         initial = seeds.auto_seeds(model, values)
     else:
         initial = [seeds.seed_state(model, state) for state in given]
+    preload(*simulate.MODULES)  # imported here once (a fork waits for it), not by each worker
     settled = forked_map(lambda k: seeds.settle(model, params, initial[k]), len(initial),
                          jobs)
     kept = seeds.distinct(settled)

@@ -8,13 +8,23 @@ import gc
 import os
 import pickle
 import signal
+import sys
 import threading
 import time
 import weakref
 
 import pytest
 
-from whirl_cli.interrupts import Interrupted, catching, check, forked_map, held_signals, thread_map
+from whirl_cli.interrupts import (
+    Interrupted,
+    catching,
+    check,
+    forked_map,
+    held_signals,
+    preload,
+    preloaded,
+    thread_map,
+)
 
 
 class Thing:
@@ -178,3 +188,37 @@ def test_a_signal_during_interpreter_shutdown_ends_whirl_without_a_traceback(tmp
     _, stderr = process.communicate(timeout=10)
     assert "Traceback" not in stderr, stderr
     assert process.returncode == -signal.SIGINT
+
+
+def slow_module(tmp_path, monkeypatch, name: str, body: str = "") -> str:
+    """A module ``name`` under ``tmp_path`` (on sys.path) that takes 0.3 s to import."""
+    (tmp_path / f"{name}.py").write_text(f"import time\ntime.sleep(0.3)\n{body}\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, name, raising=False)
+    return name
+
+
+def test_preload_imports_in_the_background_and_a_fork_waits_for_it(tmp_path, monkeypatch):
+    name = slow_module(tmp_path, monkeypatch, "whirl_preload_probe", "DONE = True")
+    started = time.perf_counter()
+    preload(name)
+    assert time.perf_counter() - started < 0.2  # the caller goes on at once
+    # the forked workers see the module imported whole (forking waited for the preload
+    # thread; a module being imported is in sys.modules already, without DONE)
+    seen = forked_map(lambda _k: getattr(sys.modules.get(name), "DONE", False), 2, 2)
+    assert seen == [True, True]
+    assert not [t for t in threading.enumerate() if t.name == "whirl-preload"]
+
+
+def test_a_failed_preload_is_ignored_and_met_where_the_module_is_used(tmp_path, monkeypatch):
+    name = slow_module(tmp_path, monkeypatch, "whirl_preload_broken", "raise ValueError('no')")
+    preload(name)
+    preloaded()
+    assert name not in sys.modules
+    with pytest.raises(ValueError, match="no"):
+        __import__(name)
+
+
+def test_preload_of_imported_modules_starts_no_thread():
+    preload("os", "signal")
+    assert not [t for t in threading.enumerate() if t.name == "whirl-preload"]

@@ -25,6 +25,10 @@ from ..models import Model
 from ..results import Branch, BranchKind, CrossCheck, Orbit, PointType, Simulation
 from .global_bifurcations import BLOWUP_FACTOR
 
+#: What simulating imports (scipy's integrators, with scipy.optimize: about 0.5 s), for
+#: :func:`whirl_cli.interrupts.preload`.
+MODULES = ("scipy.integrate",)
+
 #: Relative tolerance on the amplitude for "the simulation stays on the orbit".
 ORBIT_TOLERANCE = 0.01
 

@@ -32,3 +32,7 @@ Modules, lowest first:
 * :mod:`~whirl_cli.plots.files` -- a study's figures as named PNG files (axis limits, Hz, the
   kinds a result has the data for).
 """
+
+#: The modules drawing imports (matplotlib's Figure and Agg canvas, about 0.7 s): what a caller
+#: that will draw can :func:`~whirl_cli.interrupts.preload` while AUTO runs.
+MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg")
