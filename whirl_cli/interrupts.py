@@ -64,11 +64,13 @@ _preloading: list[threading.Thread] = []
 
 def preload(*modules: str) -> None:
     """Import ``modules`` in a background thread: modules a later stage needs (matplotlib
-    for the plots, about 0.7 s; scipy's integrators for simulations, 0.5 s), imported while
-    AUTO runs instead of after it. Every fork (:func:`forking`) waits for the thread first,
-    so a forked worker inherits the modules, and never an import lock held by a thread that
-    does not exist in it. A failed import is ignored here: the stage that needs the module
-    meets the error itself."""
+    for the plots, about 0.7 s), imported while AUTO runs instead of after it. Every fork
+    (:func:`forking`) waits for the thread first, so a forked worker inherits the modules,
+    and never an import lock held by a thread that does not exist in it. A failed import is
+    ignored here: the stage that needs the module meets the error itself. Preload only
+    modules no other thread imports meanwhile (two threads importing parts of one package
+    at once can meet in its circular imports, and Python then raises its import-deadlock
+    error in one of them)."""
     missing = [name for name in modules if name not in sys.modules]
     if not missing:
         return

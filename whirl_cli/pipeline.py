@@ -7,6 +7,7 @@ directories under ``workroot`` (the caller stores the result with :mod:`whirl_cl
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
@@ -40,8 +41,10 @@ def run_study(study: Study, workroot: Path, jobs: int = 1,
     """Run every continuation, linear sweep and simulation of ``study``; AUTO works under
     ``workroot`` (a study without continuations needs no AUTO). ``preload``: modules the
     caller needs afterwards (e.g. :data:`whirl_cli.plots.MODULES` to draw), imported in the
-    background once AUTO starts (:func:`whirl_cli.interrupts.preload`), with scipy's
-    integrators if the study simulates.
+    background once AUTO starts (:func:`whirl_cli.interrupts.preload`). Only modules nothing
+    imports while AUTO runs: two threads importing parts of one package at once can meet in
+    its circular imports (Python then raises its import-deadlock error in one of them), so
+    scipy, which the AUTO stages' threads use, is not preloaded that way.
 
     In the main thread, SIGINT and SIGTERM kill the running AUTO processes at once and raise
     :class:`whirl_cli.interrupts.Interrupted` (a KeyboardInterrupt), see
@@ -62,8 +65,6 @@ def _run_study(study: Study, workroot: Path, jobs: int,
     if study.continuations:
         engine = Engine(model, workroot, jobs=jobs, timeout=numerics.timeout, on_run=on_run)
     found_boundaries = []
-    if _simulates(study, model):
-        later += simulate.MODULES
     for spec in study.continuations:
         assert engine is not None
         if spec.type == "two-parameter":
@@ -119,14 +120,6 @@ def _run_study(study: Study, workroot: Path, jobs: int,
         attributes=provenance(study), boundaries=tuple(found_boundaries), linear_grid=grid,
         parameters=resolved_parameters(model, parameters),
         simulations=tuple(simulations(study, model)))
-
-
-def _simulates(study: Study, model) -> bool:
-    """True if ``study`` simulates after its AUTO runs (cross-checks, ``simulations:``,
-    ``explore`` values, seeds, or a freeplay law's linear estimates, which use scipy too)."""
-    return bool(study.cross_check or study.simulations or freeplay.freeplay_dofs(model)
-                or any(getattr(spec, "explore", ()) or getattr(spec, "seeds", ())
-                       for spec in study.continuations))
 
 
 def persisted(engine: Engine, base: ContinuationResult, continued: Callable, spec,
@@ -233,7 +226,8 @@ def seeded_orbits(model, overrides: dict[str, float], parameter: str, start: flo
         initial = seeds.auto_seeds(model, values)
     else:
         initial = [seeds.seed_state(model, state) for state in given]
-    preload(*simulate.MODULES)  # imported here once (a fork waits for it), not by each worker
+    for module in simulate.MODULES:  # imported here, once, not by each forked worker
+        importlib.import_module(module)
     settled = forked_map(lambda k: seeds.settle(model, params, initial[k]), len(initial),
                          jobs)
     kept = seeds.distinct(settled)

@@ -25,8 +25,8 @@ from ..models import Model
 from ..results import Branch, BranchKind, CrossCheck, Orbit, PointType, Simulation
 from .global_bifurcations import BLOWUP_FACTOR
 
-#: What simulating imports (scipy's integrators, with scipy.optimize: about 0.5 s), for
-#: :func:`whirl_cli.interrupts.preload`.
+#: What simulating imports (scipy's integrators, with scipy.optimize: about 0.5 s): imported
+#: once before forking simulation workers, which then inherit it.
 MODULES = ("scipy.integrate",)
 
 #: Relative tolerance on the amplitude for "the simulation stays on the orbit".
