@@ -74,3 +74,44 @@ def test_offset_equilibria_of_freeplay_on_the_gimballed_model(tmp_path, dof, dat
               f", stable {bool(branch.stable[row])}")
         found += 1
     assert found == 2
+
+
+GIMBAL_STUDY = f"""
+name: gimballed-freeplay-gimbal
+model: gimballed
+parameters: {{K_psi: 0.3}}
+nonlinearity: {{type: freeplay, dof: beta_y, delta: {DELTA!r}, K_out: 10.0, K_in: 2.0}}
+continuations:
+  - {{name: kin, type: one-parameter, parameter: K_in_beta_y, range: [0.0, 2.0]}}
+"""
+
+
+def test_freeplay_on_a_gimbal_dof_runs_on_auto_and_its_hopf_point_is_the_jacobians(tmp_path):
+    """Freeplay on beta_y (K_out: the isotropic gimbal stiffness K_beta, which beta_z keeps):
+    the law's parameters carry the dof's name, so its smoothing width epsilon_beta_y is
+    longer than AUTO's 13 characters and reaches AUTO by a short name
+    (:func:`whirl_cli.auto.constants.auto_name`). With the origin inside the gap, the Hopf
+    point AUTO finds in K_in is where the numpy Jacobian of the model at the origin has a
+    pair crossing the imaginary axis, at AUTO's period; and it persists as epsilon shrinks."""
+    spec = validate_text(GIMBAL_STUDY)
+    result = run_study(spec, tmp_path, jobs=2)
+    assert all(r.status == "ok" for r in result.runs), result.runs
+    (continuation,) = result.continuations
+    (hopf,) = [p for p in continuation.special_points if p.point_type == PointType.HB]
+    assert not hopf.artefact
+    model = spec.variant()
+    origin = np.zeros(model.n_states)
+
+    def pair(k_in: float) -> complex:
+        params = model.parameter_vector({**spec.parameter_values(), "K_in_beta_y": k_in})
+        eigenvalues = np.linalg.eigvals(model.jacobian_numpy(origin, params))
+        return eigenvalues[np.argmax(eigenvalues.real)]
+
+    value = hopf.parameters[0]
+    below, above = pair(value - 1e-3), pair(value + 1e-3)
+    assert below.real * above.real < 0, (below, above)  # a pair crosses there
+    crossing = pair(value)
+    assert abs(crossing.real) < 1e-4 * abs(crossing.imag)
+    np.testing.assert_allclose(2 * np.pi / abs(crossing.imag), hopf.period, rtol=1e-4)
+    print(f"gimbal beta_y freeplay: Hopf at K_in = {value:.6f} N m/rad (AUTO), the Jacobian's "
+          f"pair {crossing:.3g} there, period {hopf.period:.6f} s")

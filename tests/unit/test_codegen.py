@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import shutil
 
+import numpy as np
 import pytest
 from click.testing import CliRunner
 
 from whirl_cli.auto import codegen
-from whirl_cli.auto.constants import constants_text, par_layout
+from whirl_cli.auto.constants import auto_name, constants_text, par_layout
+from whirl_cli.auto.parse import BSegment
 from whirl_cli.cli import cli
 from whirl_cli.errors import CodegenError
 from whirl_cli.models import get_model
@@ -53,7 +55,22 @@ def test_constants_text_format_and_limits(model):
     assert text == ("NDIM = 4\nDS = -0.01\nICP = ['K1', 'PERIOD']\n"
                     "UZSTOP = {'K1': [-0.3, 0.5]}\ne = 'x'\n")
     with pytest.raises(CodegenError, match="<= 13 characters"):
-        constants_text({"parnames": {1: "a_name_longer_than_13"}})
+        constants_text({"parnames": {1: "not-a-name"}})
+
+
+def test_names_longer_than_auto_reads_reach_it_shortened_everywhere():
+    """A name over AUTO's 13 characters (freeplay's epsilon_beta_y on the gimballed model) is
+    written as its auto_name in parnames, ICP and every mapping's keys, and a b-file column of
+    that name is read back by whirl's name."""
+    long = "epsilon_beta_y"
+    short = auto_name(long)
+    assert len(short) <= 13 and short != long and auto_name("K_in_beta_y") == "K_in_beta_y"
+    text = constants_text({"parnames": {43: long, 1: "V"}, "ICP": [long, "V", 11],
+                           "UZR": {long: [1.0]}, "PAR": {long: 2.0, "V": 7.0}})
+    assert long not in text and text.count(f"'{short}'") == 4, text
+    segment = BSegment(columns=("V", short), active=(), br=np.ones(1), pt=np.ones(1),
+                       ty=np.zeros(1), lab=np.zeros(1), values=np.array([[7.0, 2.0]]))
+    assert segment.has(long) and segment.column(long)[0] == 2.0
     with pytest.raises(CodegenError, match="cannot hold"):
         constants_text({"e": "x'; rm"})
     with pytest.raises(CodegenError, match="2048"):

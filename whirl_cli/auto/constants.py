@@ -9,11 +9,13 @@ that could break a line.
 
 from __future__ import annotations
 
+import hashlib
 import re
 from dataclasses import dataclass
 
 from ..errors import CodegenError
 from ..models import Model
+from ..models.declaration import AUTO_NAME_LENGTH
 
 #: Free PAR slots for user parameters, in order (AUTO reserves 10..36).
 _USER_SLOTS = tuple(range(1, 10)) + tuple(range(37, 200))
@@ -99,11 +101,41 @@ _AUTO_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,12}")
 _CONSTANT_KEY = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
 
 
+def auto_name(name: str) -> str:
+    """The name AUTO knows a whirl parameter or state by: the name itself if it fits AUTO's
+    13 characters, else its first 8 characters, "_" and 4 hex digits of its SHA-1 (e.g. a
+    law's ``epsilon_beta_y``; deterministic, and unique among a model's names in practice:
+    :func:`constants_text` refuses a clash)."""
+    if len(name) <= AUTO_NAME_LENGTH:
+        return name
+    return f"{name[:8]}_{hashlib.sha1(name.encode()).hexdigest()[:4]}"
+
+
+def _auto_names(constants: dict) -> dict:
+    """``constants`` with every whirl name AUTO reads as its :func:`auto_name`: the values of
+    ``parnames`` and ``unames``, the names in ``ICP`` and the keys of every other mapping
+    (``PAR``, ``UZSTOP``, ``UZR``, ...)."""
+    renamed = {}
+    for key, value in constants.items():
+        if key in ("parnames", "unames"):
+            value = {i: auto_name(n) for i, n in value.items()}
+            if len(set(value.values())) != len(value):
+                raise CodegenError(f"AUTO {key} clash once shortened: {sorted(value.values())}")
+        elif key == "ICP":
+            value = [auto_name(n) if isinstance(n, str) else n for n in value]
+        elif isinstance(value, dict):
+            value = {auto_name(k) if isinstance(k, str) else k: v for k, v in value.items()}
+        renamed[key] = value
+    return renamed
+
+
 def constants_text(constants: dict) -> str:
-    """AUTO's keyword-style constants file, one ``KEY = value`` per line.
+    """AUTO's keyword-style constants file, one ``KEY = value`` per line, whirl's names as
+    AUTO knows them (:func:`auto_name`).
 
     Enforces AUTO's reader limits: names <= 13 characters, lines <= 2048 characters.
     """
+    constants = _auto_names(constants)
     for key in ("parnames", "unames"):
         for name in constants.get(key, {}).values():
             if not _AUTO_NAME.fullmatch(name):

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..models import Model
 from ..results import Branch, BranchKind, Orbit, PointType
-from .constants import PERIOD_INDEX, TORUS_ANGLE_INDEX, par_layout
+from .constants import PERIOD_INDEX, TORUS_ANGLE_INDEX, auto_name, par_layout
 from .runner import RunOutcome
 
 
@@ -54,8 +54,14 @@ class BSegment:
     lab: np.ndarray
     values: np.ndarray  # (N, len(columns))
 
+    def has(self, name: str) -> bool:
+        """True if the segment has the column of ``name`` (whirl's name or AUTO's)."""
+        return name in self.columns or auto_name(name) in self.columns
+
     def column(self, name: str) -> np.ndarray:
-        return self.values[:, self.columns.index(name)]
+        """The column of ``name`` (whirl's name of a parameter, or AUTO's)."""
+        return self.values[:, self.columns.index(
+            name if name in self.columns else auto_name(name))]
 
 
 def _column_names(title: str, n_columns: int) -> tuple[str, ...]:
@@ -226,7 +232,7 @@ def read_branch(outcome: RunOutcome, model: Model, *, name: str, kind: str, orig
     segment = segments[0] if len(segments) == 1 else _concatenate(segments)
     needed = [*parameter_names, "L2-NORM",
               *(f"{m}_{s}" for m in ("max", "min") for s in model.state_names)]
-    missing = [c for c in needed if c not in segment.columns]
+    missing = [c for c in needed if not segment.has(c)]
     if missing:
         return _unreadable_branch(outcome, model, name, kind, origin, parameter_names,
                                   f"AUTO's b-file lacks column(s) {', '.join(missing)}"
