@@ -60,6 +60,8 @@ HELD = frozenset({signal.SIGINT, signal.SIGTERM})
 
 #: Threads of :func:`preload` not yet joined (a fork joins them first).
 _preloading: list[threading.Thread] = []
+#: Every module :func:`preload` was asked for (each is imported by one thread only).
+_requested: set[str] = set()
 
 
 def preload(*modules: str) -> None:
@@ -70,10 +72,11 @@ def preload(*modules: str) -> None:
     ignored here: the stage that needs the module meets the error itself. Preload only
     modules no other thread imports meanwhile (two threads importing parts of one package
     at once can meet in its circular imports, and Python then raises its import-deadlock
-    error in one of them)."""
-    missing = [name for name in modules if name not in sys.modules]
+    error in one of them). Asking again for a module asked for before does nothing."""
+    missing = [name for name in modules if name not in sys.modules and name not in _requested]
     if not missing:
         return
+    _requested.update(missing)
 
     def load() -> None:
         for name in missing:

@@ -69,7 +69,6 @@ def _run_study(study: Study, workroot: Path, jobs: int,
         assert engine is not None
         if spec.type == "two-parameter":
             preload(*later)  # imported while AUTO runs
-            later = ()
             continuation, boundary = _two_parameter(engine, study, spec, parameters,
                                                     numerics)
             continuations.append(continuation)
@@ -77,8 +76,7 @@ def _run_study(study: Study, workroot: Path, jobs: int,
             continue
         starts, outcomes = seeded_orbits(model, parameters, spec.parameter, spec.start,
                                          spec.seeds, jobs)
-        preload(*later)  # imported while AUTO runs
-        later = ()
+        preload(*later)  # imported while AUTO runs (after the seeds' fork)
 
         def continued(name: str, values: dict[str, float], spec=spec, starts=starts):
             return one_parameter(
