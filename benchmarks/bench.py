@@ -83,22 +83,23 @@ class Timed:
     cpu: float = float("nan")  # user + sys of the command and its children [s]
 
 
-def children_cpu() -> float:
-    """User + sys time [s] of this process's waited-for children so far."""
-    used = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return used.ru_utime + used.ru_stime
+def cpu_seconds(children: bool = False) -> float:
+    """User + system CPU seconds of this process (``children``: of its finished children)."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN if children else resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
 
 
 def run(arguments: Sequence[str], env: dict[str, str]) -> Timed:
     """Run a command (output discarded) and time it (wall and CPU)."""
-    start, cpu = time.perf_counter(), children_cpu()
+    start, cpu = time.perf_counter(), cpu_seconds(children=True)
     done = subprocess.run(list(arguments), cwd=ROOT, env=env, stdout=subprocess.DEVNULL,
                           stderr=subprocess.PIPE, text=True, check=False)
     seconds = time.perf_counter() - start
     if done.returncode not in (0, 1):
         raise RuntimeError(f"{' '.join(arguments)} failed ({done.returncode}):\n"
                            f"{done.stderr[-2000:]}")
-    return Timed(" ".join(arguments[2:]), seconds, done.returncode, children_cpu() - cpu)
+    return Timed(" ".join(arguments[2:]), seconds, done.returncode,
+                 cpu_seconds(children=True) - cpu)
 
 
 def launched(path: Path) -> tuple[float, int, int, int]:
@@ -598,14 +599,6 @@ def airspeed_figures(scratch: Path, env: dict[str, str], step: float = 0.025,
 # ------------------------------------------------------------------------------ (j)
 #: The gimballed studies whose ``explore`` values (j) classifies.
 EXPLORED = ("explore_combined_case2_soft.yaml", "torus_airspeed.yaml")
-
-
-def cpu_seconds(children: bool = False) -> float:
-    """User + system CPU seconds of this process (``children``: of its finished children)."""
-    import resource
-
-    usage = resource.getrusage(resource.RUSAGE_CHILDREN if children else resource.RUSAGE_SELF)
-    return usage.ru_utime + usage.ru_stime
 
 
 def classifier_figures() -> None:
