@@ -147,3 +147,58 @@ def test_a_locus_chunk_that_adds_no_point_ends_the_locus(monkeypatch):
     kept, _ = loci._grown(Engine(), {0: (PointType.LPC, spec, curve)}, [], Numerics(),
                           {"p": (0.0, 1.0), "q": (0.0, 0.5)}, np.array([1.0, 0.5]))
     assert calls == [["c/fold_of_cycles_1a2c1"]] and len(kept[0][2]) == 3
+
+
+def test_a_locus_wholly_on_others_is_dropped_later_one_first():
+    """A locus lying, point by point, within 1e-3 of the ranges of the other kept loci of its
+    type (here: two halves of its path traced from two other starts) is dropped; of two equal
+    ones the later goes; a locus of another type or elsewhere stays."""
+    from whirl_cli.continuation.loci import _distinct
+
+    width = np.ones(2)
+    path = np.column_stack([np.linspace(0.1, 0.9, 161), 0.3 + 0.1 * np.sin(np.linspace(0, 3, 161))])
+    whole = _locus(path)
+    left, right = _locus(path[:90]), _locus(path[80:])
+    offset = _locus(path + [0.0, 0.004])  # drawn beside the others: kept
+    curves = {1: (13, None, left), 2: (13, None, right), 3: (13, None, whole),
+              4: (13, None, offset), 5: (2, None, whole)}
+    kept, _ = _distinct(curves, [], width)
+    assert sorted(kept) == [1, 2, 4, 5]
+    kept, _ = _distinct({1: (13, None, whole), 2: (13, None, whole)}, [], width)
+    assert sorted(kept) == [1]
+    kept, _ = _distinct({1: (13, None, left)}, [(13, whole)], width)  # on a known locus
+    assert kept == {}
+
+
+def test_a_locus_that_runs_onto_another_stops_where_both_are_kept():
+    """A locus whose last points lie on another locus of its type (parameters and orbits) has
+    run onto it and is not continued; both stay (each holds a part the other lacks). Near its
+    start a locus lies on its twin traced the other way: that is no merge; nor is running
+    onto the parameters of a locus whose orbits differ."""
+    from whirl_cli.continuation.loci import _distinct
+
+    width = np.ones(2)
+    path = np.column_stack([np.linspace(0.1, 0.9, 161), np.full(161, 0.3)])
+    first = _locus(path[:100])        # 0.1 .. 0.595
+    second = _locus(path[150:60:-1])  # 0.85 back to 0.4: ends on the first
+    kept, merged = _distinct({1: (13, None, first), 2: (13, None, second)}, [], width)
+    assert sorted(kept) == [1, 2] and merged == {1, 2}  # head-on: both stop, nothing lost
+    ahead = _locus(path[40:120])      # 0.3 .. 0.695
+    behind = _locus(path[:60])        # 0.1 .. 0.395: its end lies on the one ahead
+    kept, merged = _distinct({1: (13, None, ahead), 2: (13, None, behind)}, [], width)
+    assert merged == {2}
+    twins = {1: (13, None, _locus(path[80:84])), 2: (13, None, _locus(path[80:76:-1]))}
+    assert _distinct(twins, [], width)[1] == set()
+    other = _locus(path[150:60:-1], extremes=np.full(90, 0.5))  # other orbits, same parameters
+    kept, merged = _distinct({1: (13, None, first), 2: (13, None, other)}, [], width)
+    assert merged == set()
+
+
+def test_points_on_paths_are_measured_to_segments():
+    from whirl_cli.continuation.geometry import _on_paths
+
+    path = np.array([[0.0, 0.0], [0.1, 0.0], [0.1, 0.2]])
+    points = np.array([[0.05, 0.0009], [0.05, 0.0011], [0.1009, 0.1], [0.3, 0.3]])
+    assert _on_paths(points, [path]).tolist() == [True, False, True, False]
+    assert _on_paths(points, [np.array([[0.3, 0.3]])]).tolist() == [False, False, False, True]
+    assert not _on_paths(points, []).any()

@@ -27,31 +27,61 @@ Interval = tuple[float, float]
 
 
 def stable_intervals(model: Model, overrides: dict[str, float], first: str, second: str,
-                     value: float, bounds: Interval, points: int = 4001) -> list[Interval]:
-    """Intervals of ``first`` where y = 0 is linearly stable at ``second`` = ``value``."""
-    from scipy.optimize import brentq
-
+                     values: list[float], bounds: Interval, points: int = 4001,
+                     within: list[list[Interval]] | None = None, xtol: float = 1e-12
+                     ) -> list[list[Interval]]:
+    """Intervals of ``first`` where y = 0 is linearly stable, one list per value of ``second``
+    in ``values``: the largest real part of the eigenvalues on a grid of ``points`` across
+    ``bounds``, each change of sign then bisected to ``xtol`` (every row at once: one batched
+    eigenvalue computation per step). ``within`` (per row): only the grid cells meeting these
+    intervals are examined (the stable parts inside them are the same; outside, partial)."""
     grid = np.linspace(bounds[0], bounds[1], points)
-    fixed = {**overrides, second: value}
+    values = np.asarray(values, dtype=float)
+    base = model.parameter_vector(overrides)
+    at = [model.parameter_names.index(model.canonical(p)) for p in (first, second)]
 
-    def growth(values: np.ndarray) -> np.ndarray:
-        params = linear.parameter_matrix(model, fixed, first, values)
+    def stable_at(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        params = np.repeat(base[:, None], len(x), axis=1)
+        params[at[0]], params[at[1]] = x, y
         eigenvalues = linear.batched_eigenvalues(np.ascontiguousarray(
             linear.jacobians(model, params)))
-        return eigenvalues.real.max(axis=1)
+        return eigenvalues.real.max(axis=1) < 0
 
-    rates = growth(grid)
-    stable = rates < 0
-    edges = {}  # grid index k -> exact crossing between grid[k] and grid[k + 1]
-    for k in np.flatnonzero(stable[:-1] != stable[1:]):
-        edges[k] = brentq(lambda v: float(growth(np.array([v]))[0]), grid[k], grid[k + 1],
-                          xtol=1e-12)
-    intervals = []
-    for lo, hi in _runs(grid, stable):
-        lo_index = int(np.searchsorted(grid, lo)) - 1
-        hi_index = int(np.searchsorted(grid, hi)) - 1
-        intervals.append((edges.get(lo_index, lo), edges.get(hi_index, hi)))
-    return intervals
+    examined = np.array([_cells(grid, None if within is None else within[r])
+                         for r in range(len(values))]).reshape(len(values), points)
+    stable = np.zeros(examined.shape, dtype=bool)
+    row, column = np.nonzero(examined)
+    stable[row, column] = stable_at(grid[column], values[row])
+    row, k = np.nonzero(examined[:, :-1] & examined[:, 1:] & (stable[:, :-1] != stable[:, 1:]))
+    lower, upper, lower_stable = grid[k], grid[k + 1], stable[row, k]
+    while len(k) and np.max(upper - lower) > xtol:
+        middle = 0.5 * (lower + upper)
+        same = stable_at(middle, values[row]) == lower_stable
+        lower, upper = np.where(same, middle, lower), np.where(same, upper, middle)
+    crossing = {(int(r), int(c)): float(0.5 * (a + b))
+                for r, c, a, b in zip(row, k, lower, upper, strict=True)}
+    found = []
+    for r in range(len(values)):
+        intervals = []
+        for lo, hi in _runs(grid, stable[r]):
+            lo_cell = int(np.searchsorted(grid, lo)) - 1
+            hi_cell = int(np.searchsorted(grid, hi)) - 1
+            intervals.append((crossing.get((r, lo_cell), lo), crossing.get((r, hi_cell), hi)))
+        found.append(intervals)
+    return found
+
+
+def _cells(grid: np.ndarray, within: list[Interval] | None) -> np.ndarray:
+    """(K,) which points of ``grid`` bound a cell meeting one of the intervals ``within``
+    (all of them for None)."""
+    if within is None:
+        return np.ones(len(grid), dtype=bool)
+    examined = np.zeros(len(grid), dtype=bool)
+    for lo, hi in within:
+        first = max(int(np.searchsorted(grid, lo, side="right")) - 1, 0)
+        last = min(int(np.searchsorted(grid, hi, side="left")), len(grid) - 1)
+        examined[first:last + 1] = True
+    return examined
 
 
 def _runs(grid: np.ndarray, flag: np.ndarray) -> list[Interval]:
@@ -110,39 +140,57 @@ def _paired(folds: list[float], anchors: list[float]) -> list[Interval]:
     return [tuple(sorted((f, min(anchors, key=lambda a: abs(a - f))))) for f in folds]
 
 
-def unsafe_from_loci(loci: dict[str, list[np.ndarray]], stable: list[Interval], value: float,
-                     minimum: float = 0.0) -> list[UnsafeInterval]:
-    """Unsafe intervals of the slice second = ``value`` from the locus curves (keys: hopf,
-    fold_of_cycles, branch_point, fold)."""
+def loci_candidates(loci: dict[str, list[np.ndarray]], value: float
+                    ) -> dict[str, list[Interval]]:
+    """Where the slice second = ``value`` may be unsafe, from the locus curves (keys: hopf,
+    fold_of_cycles, branch_point, fold), by cause: every fold-of-cycles crossing with the
+    nearest Hopf crossing (flutter), every fold crossing with the nearest pitchfork crossing
+    (divergence), before intersecting with the linearly stable part."""
     def at(kind: str) -> list[float]:
         return [x for curve in loci.get(kind, []) for x in crossings(curve, value)]
 
-    flutter = intersect(_paired(at("fold_of_cycles"), at("hopf")), stable, minimum)
-    divergence = intersect(_paired(at("fold"), at("branch_point")), stable, minimum)
-    return ([UnsafeInterval(value, lo, hi, "flutter") for lo, hi in flutter]
-            + [UnsafeInterval(value, lo, hi, "divergence") for lo, hi in divergence])
+    return {"flutter": _paired(at("fold_of_cycles"), at("hopf")),
+            "divergence": _paired(at("fold"), at("branch_point"))}
 
 
-def unsafe_from_branches(branches: tuple[Branch, ...], stable: list[Interval], value: float,
-                         minimum: float = 0.0) -> list[UnsafeInterval]:
-    """Unsafe intervals of one slice from its one-parameter branches: the extent of every
-    periodic family with a stable part, and of every secondary equilibrium branch with a fold,
-    intersected with the linearly stable part of the slice."""
-    flutter, divergence = [], []
+def unsafe_from_loci(loci: dict[str, list[np.ndarray]], stable: list[Interval], value: float,
+                     minimum: float = 0.0) -> list[UnsafeInterval]:
+    """Unsafe intervals of the slice second = ``value`` from the locus curves
+    (:func:`loci_candidates` inside the ``stable`` intervals)."""
+    return _unsafe(loci_candidates(loci, value), stable, value, minimum)
+
+
+def branch_candidates(branches: tuple[Branch, ...]) -> dict[str, list[Interval]]:
+    """Where one slice may be unsafe, from its one-parameter branches, by cause: the extent of
+    every periodic family with a stable part (flutter) and of every secondary equilibrium
+    branch with a fold (divergence)."""
+    found: dict[str, list[Interval]] = {"flutter": [], "divergence": []}
     for branch in branches:
         if not len(branch):
             continue
         extent = (float(branch.parameters[:, 0].min()), float(branch.parameters[:, 0].max()))
         if branch.kind == BranchKind.PERIODIC and (branch.stable
                                                    & branch.stability_known)[1:-1].any():
-            flutter.append(extent)
+            found["flutter"].append(extent)
         elif (branch.kind == BranchKind.EQUILIBRIUM and branch.origin.startswith("BP at")
               and np.any(branch.point_type == 2)):
-            divergence.append(extent)
-    return ([UnsafeInterval(value, lo, hi, "flutter")
-             for lo, hi in intersect(flutter, stable, minimum)]
-            + [UnsafeInterval(value, lo, hi, "divergence")
-               for lo, hi in intersect(divergence, stable, minimum)])
+            found["divergence"].append(extent)
+    return found
+
+
+def unsafe_from_branches(branches: tuple[Branch, ...], stable: list[Interval], value: float,
+                         minimum: float = 0.0) -> list[UnsafeInterval]:
+    """Unsafe intervals of one slice from its one-parameter branches
+    (:func:`branch_candidates` inside the ``stable`` intervals)."""
+    return _unsafe(branch_candidates(branches), stable, value, minimum)
+
+
+def _unsafe(candidates: dict[str, list[Interval]], stable: list[Interval], value: float,
+            minimum: float) -> list[UnsafeInterval]:
+    """The ``candidates`` (cause -> intervals) inside the ``stable`` intervals, pieces longer
+    than ``minimum``, flutter first."""
+    return [UnsafeInterval(value, lo, hi, cause) for cause in ("flutter", "divergence")
+            for lo, hi in intersect(candidates[cause], stable, minimum)]
 
 
 def polygons(intervals: list[UnsafeInterval], values: list[float],
@@ -222,22 +270,21 @@ def boundary(name: str, model: Model, overrides: dict[str, float], pair: tuple[s
     slices, from their one-parameter branches)."""
     first, second = pair
     minimum = 1e-3 * (bounds[first][1] - bounds[first][0])  # narrower pieces are round-off
-
-    def stable(value: float) -> list[Interval]:
-        return stable_intervals(model, overrides, first, second, value, bounds[first], 4001)
-
-    intervals: list[UnsafeInterval] = []
     if method == "loci":
         curves_by_name = loci_curves(curves, np.tile([d.amplitude for d in model.dofs], 2))
         rows = sorted(set(np.linspace(*bounds[second], resolution).tolist()) | set(slices))
-        for value in rows:
-            intervals += unsafe_from_loci(curves_by_name, stable(value), value, minimum)
+        candidates = [loci_candidates(curves_by_name, value) for value in rows]
     else:
         rows = list(slices)
-        for value, branches in zip(slices, slice_branches, strict=True):
-            main = tuple(b for b in branches if b.kind != BranchKind.PERIODIC
-                         or b.origin.endswith(("main_down", "main_up")))
-            intervals += unsafe_from_branches(main, stable(value), value, minimum)
+        candidates = [branch_candidates(tuple(
+            b for b in branches if b.kind != BranchKind.PERIODIC
+            or b.origin.endswith(("main_down", "main_up")))) for branches in slice_branches]
+    # the stable part of each row, examined only where a candidate lies
+    where = [merge([i for found in row.values() for i in found]) for row in candidates]
+    stable = stable_intervals(model, overrides, first, second, rows, bounds[first], 4001,
+                              within=where)
+    intervals = [interval for value, row, part in zip(rows, candidates, stable, strict=True)
+                 for interval in _unsafe(row, part, value, minimum)]
     loci = {c.name: (LOCUS_NAMES[c.kind], c.parameters[:, :2]) for c in curves}
     return Boundary(name, pair, tuple(model.parameter(p).unit for p in pair), method, loci,
                     tuple(intervals), tuple(polygons(intervals, rows)), tuple(slices))

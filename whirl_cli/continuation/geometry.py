@@ -47,9 +47,52 @@ def _near_polyline(point: np.ndarray, curve: np.ndarray, width: np.ndarray,
     return bool(np.linalg.norm(nearest - target, axis=1).min() < tolerance)
 
 
-def _on_curve(point: np.ndarray, curve: np.ndarray, width: np.ndarray) -> bool:
-    """True if ``point`` lies on the polyline ``curve`` (within 1e-3 of the ranges)."""
-    return bool(len(curve)) and float(np.min(np.abs((curve - point) / width).max(axis=1))) < 1e-3
+def locus_coordinates(curve: Branch, width: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """(K, 2 + 2n) a locus's points in the coordinates loci are compared in: the two
+    parameters scaled by the ranges ``width``, the orbit extremes (state_max, state_min) by
+    20 ``scale`` (their spread over the loci compared), so that 1e-3 there is 2 % of the spread
+    (the parameter projections of two different loci may touch; their orbits differ)."""
+    extremes = np.hstack([curve.state_max, curve.state_min])
+    return np.hstack([curve.parameters[:, :2] / width, extremes / (20 * scale)])
+
+
+def extreme_scale(curves: list[Branch]) -> np.ndarray:
+    """(2n,) the spread of every orbit extreme over ``curves`` (1 where it does not vary: the
+    loci of equilibria)."""
+    extremes = np.vstack([np.hstack([c.state_max, c.state_min]) for c in curves])
+    spread = np.ptp(extremes, axis=0)
+    return np.where(spread > 0, spread, 1.0)
+
+
+def _on_paths(points: np.ndarray, paths: list[np.ndarray], tolerance: float = 1e-3
+              ) -> np.ndarray:
+    """(K,) True where a row of ``points`` (K, D) lies within ``tolerance`` (Euclidean) of a
+    segment of one of the polylines ``paths`` (each (M, D), in the same coordinates)."""
+    near = np.zeros(len(points), dtype=bool)
+    for path in paths:
+        if len(path) == 1:
+            near |= np.linalg.norm(points - path[0], axis=1) < tolerance
+        if len(path) < 2:
+            continue
+        start, step = path[:-1], np.diff(path, axis=0)
+        length = np.einsum("md,md->m", step, step)
+        offset = points[:, None, :] - start[None]
+        along = np.clip(np.einsum("kmd,md->km", offset, step)
+                        / np.where(length > 0, length, 1.0), 0.0, 1.0)
+        gap = offset - along[..., None] * step[None]
+        near |= np.einsum("kmd,kmd->km", gap, gap).min(axis=1) < tolerance ** 2
+    return near
+
+
+def _merged(points: np.ndarray, others: list[np.ndarray], follow: int = 5) -> bool:
+    """True if a locus (``points`` in :func:`locus_coordinates`) has run onto one of the
+    ``others``: its last ``follow`` points lie on them, after it had left its start by more
+    than 0.02 of the ranges (near its start a locus lies on its twin traced the other way).
+    Continued, it would retrace them."""
+    if len(points) < follow + 1:
+        return False
+    left = np.abs(points[:, :2] - points[0, :2]).max(axis=1) > 0.02
+    return bool(left.any() and _on_paths(points[-follow:], others).all())
 
 
 def _closed(curve: Branch, width: np.ndarray, follow: int = 5) -> Branch:

@@ -16,7 +16,16 @@ from ..results import Branch, BranchKind, ContinuationResult, PointType, Special
 from .branches import _same_point, head, join, special_points, typical_amplitudes
 from .engine import Engine, Numerics, RunSpec, _read
 from .equilibria import equilibrium_constants
-from .geometry import _at_range_edge, _chunk_used, _closed, _near_polyline, _on_curve
+from .geometry import (
+    _at_range_edge,
+    _chunk_used,
+    _closed,
+    _merged,
+    _near_polyline,
+    _on_paths,
+    extreme_scale,
+    locus_coordinates,
+)
 from .one_parameter import one_parameter
 from .periodic import OrbitStart
 
@@ -145,12 +154,13 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
         unclosed = {k: fresh[k] for k in uncut
                     if not _ending_at(fresh[k][2].parameters[-1, :2], ends, width)}
         retried = _retried(engine, unclosed, numerics)
-        again, _ = _grown(engine, retried, [], numerics, bounds, width)
+        others = curves + [(kind, c) for k, (kind, _, c) in fresh.items() if k not in retried]
+        again, _ = _grown(engine, retried, others, numerics, bounds, width)
         fresh.update({k: again.get(k, fresh[k]) for k in retried})
         curves += [(kind, curve) for kind, _, curve in fresh.values()]
     kept = [curve for _, _, curve in _distinct(
         {k: (kind, None, curve) for k, (kind, curve) in enumerate(
-            sorted(curves, key=lambda c: c[1].name))}, [], width).values()]
+            sorted(curves, key=lambda c: c[1].name))}, [], width)[0].values()]
     codim2 = _codim2(kept)
     return [_locus_end(c, codim2, bounds, width) for c in kept]
 
@@ -187,19 +197,38 @@ def _without_twins(starts: list[tuple[int, SpecialPoint, str]], width: np.ndarra
 
 def _distinct(curves: dict[int, tuple[int, RunSpec | None, Branch]],
               known: list[tuple[int, Branch]], width: np.ndarray
-              ) -> dict[int, tuple[int, RunSpec | None, Branch]]:
+              ) -> tuple[dict[int, tuple[int, RunSpec | None, Branch]], set[int]]:
     """The (point type, last run, locus) of ``curves``, each cut where it closes, without
-    those lying on a ``known`` locus of their type or on one kept before them (their first,
-    middle and last points on it: a closed locus starts and ends at one point)."""
-    kept: dict[int, tuple[int, RunSpec | None, Branch]] = {}
-    for k, (kind, spec, curve) in curves.items():
-        curve = _closed(curve, width)
-        probes = curve.parameters[[0, len(curve) // 2, -1]] if len(curve) else []
-        if len(curve) and not any(
-                kind == other_kind and all(_on_curve(p, other.parameters, width) for p in probes)
-                for other_kind, other in known + [(o[0], o[2]) for o in kept.values()]):
-            kept[k] = (kind, spec, curve)
-    return kept
+    those lying wholly (every point within 1e-3 of the ranges) on the ``known`` loci and the
+    other kept ones of their type, later ones dropped first (a mirror image, or a locus drawn
+    within a line's width of others, adds nothing to the picture); and the indices of the
+    kept loci that have run onto another of their type (:func:`_merged`, where orbits are
+    compared too: continued, they would retrace it)."""
+    closed = {k: (kind, spec, _closed(curve, width)) for k, (kind, spec, curve) in curves.items()
+              if len(curve)}
+    kept = set(closed)
+
+    def others(k: int, points: dict[int, np.ndarray], fixed) -> list[np.ndarray]:
+        kind = closed[k][0]
+        return [p for other, p in fixed if other == kind] + [
+            points[j] for j in kept if j != k and closed[j][0] == kind]
+
+    plane = {k: c.parameters[:, :2] / width for k, (_, _, c) in closed.items()}
+    known_plane = [(kind, c.parameters[:, :2] / width) for kind, c in known if len(c)]
+    for k in sorted(closed, reverse=True):
+        if _on_paths(plane[k], others(k, plane, known_plane)).all():
+            kept.discard(k)
+    merged = set()
+    for kind in {closed[k][0] for k in kept}:
+        group = [closed[k][2] for k in kept if closed[k][0] == kind] + [
+            c for other, c in known if other == kind and len(c)]
+        scale = extreme_scale(group)
+        full = {k: locus_coordinates(closed[k][2], width, scale) for k in kept
+                if closed[k][0] == kind}
+        known_full = [(kind, locus_coordinates(c, width, scale)) for other, c in known
+                      if other == kind and len(c)]
+        merged |= {k for k in full if _merged(full[k], others(k, full, known_full))}
+    return {k: closed[k] for k in sorted(kept)}, merged
 
 
 def _trace(engine: Engine, name: str, pair: tuple[str, str],
@@ -261,8 +290,8 @@ def _grown(engine: Engine, traced: dict[int, tuple[int, RunSpec, Branch]],
     stalled: set[int] = set()  # a restart that made no step: not continued again
     chunk = 1
     while True:
-        kept = _distinct(grown, known, width)
-        cut |= {k for k, (_, _, curve) in kept.items() if len(curve) < len(grown[k][2])}
+        kept, merged = _distinct(grown, known, width)
+        cut |= merged | {k for k, (_, _, curve) in kept.items() if len(curve) < len(grown[k][2])}
         again = {k: replace(spec, name=f"{spec.name}c{chunk}",
                             constants=dict(spec.constants, NMX=min(
                                 LOCUS_CHUNK, numerics.max_steps - len(curve) + 1)),
