@@ -149,6 +149,40 @@ def test_a_locus_chunk_that_adds_no_point_ends_the_locus(monkeypatch):
     assert calls == [["c/fold_of_cycles_1a2c1"]] and len(kept[0][2]) == 3
 
 
+def test_a_locus_chunk_drawn_over_its_own_path_ends_the_locus(monkeypatch):
+    """A chunk whose every point lies within 1e-3 of the ranges of the locus's earlier path in
+    the parameter plane (AUTO wandering to and fro over it, its orbits changing) adds nothing
+    to the picture: the locus is not continued. A chunk reaching new ground is continued.
+    (Stub runs: the loop's control, not a continuation result.)"""
+    from whirl_cli.continuation import loci
+    from whirl_cli.continuation.engine import Numerics, RunSpec
+    from whirl_cli.results import PointType
+
+    def ending(points):
+        curve = _locus(points)
+        curve.point_type[-1] = PointType.EP
+        curve.label[-1] = 7
+        return curve
+
+    path = np.column_stack([np.linspace(0.2, 0.6, 41), np.full(41, 0.2)])
+    curve = dataclasses.replace(ending(path), run="c.fold_of_cycles_1a2")
+    spec = RunSpec("c/fold_of_cycles_1a2", {"NMX": loci.LOCUS_CHUNK}, curve.kind, "", ("p", "q"))
+    for chunk, continued in ((path[::-1][:30], False),  # back over its path
+                             (np.vstack([path[-1], path[-1] + [[0.01, 0.01]]]), True)):
+        calls = []
+
+        class Engine:
+            def run_many(self, specs, calls=calls):
+                calls.append([s.name for s in specs])
+                return [None] * len(specs)
+
+        monkeypatch.setattr(loci, "_read", lambda _engine, s, _outcome, chunk=chunk: (
+            ending(chunk) if s.name.endswith("c1") else ending(chunk[-1:])))
+        loci._grown(Engine(), {0: (PointType.LPC, spec, curve)}, [], Numerics(),
+                    {"p": (0.0, 1.0), "q": (0.0, 0.5)}, np.array([1.0, 0.5]))
+        assert (len(calls) > 1) == continued, calls
+
+
 def test_a_locus_wholly_on_others_is_dropped_later_one_first():
     """A locus lying, point by point, within 1e-3 of the ranges of the other kept loci of its
     type (here: two halves of its path traced from two other starts) is dropped; of two equal

@@ -287,7 +287,9 @@ def _grown(engine: Engine, traced: dict[int, tuple[int, RunSpec, Branch]],
     the kept loci and the indices of those not cut (that ended of themselves)."""
     grown = dict(traced)
     cut: set[int] = set()
-    stalled: set[int] = set()  # a restart that made no step: not continued again
+    # not continued again: a restart that made no step, or a chunk drawn over the locus's
+    # own path (in the parameter plane: it wanders to and fro over what it has drawn)
+    stalled: set[int] = set()
     chunk = 1
     while True:
         kept, merged = _distinct(grown, known, width)
@@ -309,7 +311,8 @@ def _grown(engine: Engine, traced: dict[int, tuple[int, RunSpec, Branch]],
             kind, last, curve = kept[k]
             if len(extra) > 1:
                 grown[k] = (kind, last, join(curve, extra, curve.name))
-            else:
+            if len(extra) <= 1 or _on_paths(extra.parameters[1:, :2] / width,
+                                            [curve.parameters[:, :2] / width]).all():
                 stalled.add(k)
         chunk += 1
 
