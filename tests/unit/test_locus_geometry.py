@@ -236,3 +236,30 @@ def test_points_on_paths_are_measured_to_segments():
     assert _on_paths(points, [path]).tolist() == [True, False, True, False]
     assert _on_paths(points, [np.array([[0.3, 0.3]])]).tolist() == [False, False, False, True]
     assert not _on_paths(points, []).any()
+
+
+def test_a_locus_back_at_its_start_with_another_orbit_reached_the_next_fold():
+    """Back within 0.005 of the ranges of its start's parameters, a locus has closed, unless
+    its period there is nearer that of another start point of its type there (the folds of
+    cycles of a family snaking toward a homoclinic orbit: one locus leads to the next)."""
+    from whirl_cli.continuation.loci import _locus_end
+    from whirl_cli.results import PointType, SpecialPoint
+
+    width = np.array([0.8, 0.5])
+    bounds = {"p": (-0.3, 0.5), "q": (0.0, 0.5)}
+    loop = np.vstack([_circle(1.0, centre=(0.1, 0.25))[:-1], [[0.3, 0.2501]]])
+    curve = dataclasses.replace(_locus(loop), period=np.linspace(0.525, 0.6136, len(loop)))
+
+    def fold(k1: float, period: float) -> SpecialPoint:
+        return SpecialPoint("slice_2.periodic_2", 3, int(PointType.LPC), ("p", "q"),
+                            np.array([k1, 0.25]), np.array([0.1, 0.0]), period, False)
+
+    own, next_fold = fold(0.3, 0.5248), fold(0.3001, 0.6136)
+    ended = _locus_end(curve, [], bounds, width, (own, next_fold))
+    assert ended.end == "at the LPC of slice_2.periodic_2 at p = 0.3001 (period 0.6136 s)"
+    alone = _locus_end(curve, [], bounds, width, (own,)).end
+    assert alone.startswith("back at its start's parameters with another orbit (period 0.6136")
+    # round the loop and back to about its start's period (a step's change away): closed
+    round_trip = 0.525 + 0.05 * np.sin(np.linspace(0, 2 * np.pi, len(loop) + 1)[:-1])
+    near_own = dataclasses.replace(curve, period=round_trip)
+    assert _locus_end(near_own, [], bounds, width, (own, next_fold)).end == "closed"

@@ -48,12 +48,18 @@ def _near_polyline(point: np.ndarray, curve: np.ndarray, width: np.ndarray,
 
 
 def locus_coordinates(curve: Branch, width: np.ndarray, scale: np.ndarray) -> np.ndarray:
-    """(K, 2 + 2n) a locus's points in the coordinates loci are compared in: the two
+    """(K, 3 + 2n) a locus's points in the coordinates loci are compared in: the two
     parameters scaled by the ranges ``width``, the orbit extremes (state_max, state_min) by
-    20 ``scale`` (their spread over the loci compared), so that 1e-3 there is 2 % of the spread
-    (the parameter projections of two different loci may touch; their orbits differ)."""
+    20 ``scale`` (their spread over the loci compared), so that 1e-3 there is 2 % of the
+    spread, and the logarithm of the period by 10 (1e-3 there: 1 %; 0 on loci of equilibria
+    without one). The parameter projections of two different loci may touch; their orbits
+    differ (near a homoclinic orbit, mostly in period)."""
     extremes = np.hstack([curve.state_max, curve.state_min])
-    return np.hstack([curve.parameters[:, :2] / width, extremes / (20 * scale)])
+    period = np.asarray(curve.period, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        logarithm = np.where(np.isfinite(period) & (period > 0), np.log(period) / 10, 0.0)
+    return np.hstack([curve.parameters[:, :2] / width, extremes / (20 * scale),
+                      logarithm[:, None]])
 
 
 def extreme_scale(curves: list[Branch]) -> np.ndarray:
@@ -100,8 +106,12 @@ def _closed(curve: Branch, width: np.ndarray, follow: int = 5) -> Branch:
     and follows it the same way for ``follow`` more points: AUTO goes round a closed locus
     until its step limit, also one it has run onto from elsewhere. Coming back means within
     0.005 of the ranges of a point it had since left by more than 0.02: for the start in the
-    two parameters, elsewhere also in the orbit's extremes (scaled by their spread along the
-    locus; the parameter projection of a locus may pass over itself)."""
+    two parameters (a locus of the folds of cycles of a family snaking toward a homoclinic
+    orbit goes from one of them to the next, at nearly the same parameters but another
+    period: it is cut there too, the next one's own locus going on; :func:`whirl_cli.
+    continuation.loci._locus_end` tells the two ends apart), elsewhere also in the orbit's
+    extremes (scaled by their spread along the locus; the parameter projection of a locus
+    may pass over itself)."""
     if len(curve) < 10:
         return curve
     scaled = curve.parameters[:, :2] / width

@@ -132,9 +132,10 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
     Starts are taken slice by slice: a start lying on a locus of its type already traced
     from an earlier slice is the same locus and is not run again, nor is a start with the
     same type, parameters and period as another (a symmetric twin: its locus is the same
-    curve in the parameter plane). Loci grow chunk by chunk, and after every chunk those that
-    repeat another locus are dropped and those that closed are cut (:func:`_grown`), so a
-    duplicate or a loop costs one chunk beyond where it is recognised; only kept loci ending
+    curve in the parameter plane). Loci grow chunk by chunk,
+    and after every chunk those that repeat others are dropped, those that closed are cut
+    and those that ran onto another stop (:func:`_grown`), so a duplicate or a loop costs one
+    chunk beyond where it is recognised; only kept loci ending
     in MX are retried (AUTO's runs, not just the results, are saved); duplicates left after
     the retries are dropped."""
     width = np.array([bounds[p][1] - bounds[p][0] for p in pair])
@@ -148,21 +149,33 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
             kind == point.point_type and _near_polyline(point.parameters[:2], curve.parameters,
                                                         width)
             for kind, curve in curves)]
-        traced = _trace(engine, name, pair, bounds, numerics, _without_twins(todo, width))
-        fresh, uncut = _grown(engine, traced, curves, numerics, bounds, width)
-        ends = _codim2([c for _, c in curves + [(kind, c) for kind, _, c in fresh.values()]])
-        unclosed = {k: fresh[k] for k in uncut
-                    if not _ending_at(fresh[k][2].parameters[-1, :2], ends, width)}
-        retried = _retried(engine, unclosed, numerics)
-        others = curves + [(kind, c) for k, (kind, _, c) in fresh.items() if k not in retried]
-        again, _ = _grown(engine, retried, others, numerics, bounds, width)
-        fresh.update({k: again.get(k, fresh[k]) for k in retried})
-        curves += [(kind, curve) for kind, _, curve in fresh.values()]
+        curves += _wave(engine, name, pair, bounds, numerics, _without_twins(todo, width),
+                        curves, width)
     kept = [curve for _, _, curve in _distinct(
         {k: (kind, None, curve) for k, (kind, curve) in enumerate(
             sorted(curves, key=lambda c: c[1].name))}, [], width)[0].values()]
     codim2 = _codim2(kept)
-    return [_locus_end(c, codim2, bounds, width) for c in kept]
+    points = tuple(point for point, _ in starts)
+    return [_locus_end(c, codim2, bounds, width, points) for c in kept]
+
+
+def _wave(engine: Engine, name: str, pair: tuple[str, str],
+          bounds: dict[str, tuple[float, float]], numerics: Numerics,
+          starts: list[tuple[int, SpecialPoint, str]], curves: list[tuple[int, Branch]],
+          width: np.ndarray) -> list[tuple[int, Branch]]:
+    """(point type, locus) of every one of ``starts``, traced side by side and grown chunk by
+    chunk beside the ``curves`` known (:func:`_grown`); those ending in MX away from a known
+    codimension-2 point retried once (:func:`_retried`)."""
+    traced = _trace(engine, name, pair, bounds, numerics, starts)
+    fresh, uncut = _grown(engine, traced, curves, numerics, bounds, width)
+    ends = _codim2([c for _, c in curves + [(kind, c) for kind, _, c in fresh.values()]])
+    unclosed = {k: fresh[k] for k in uncut
+                if not _ending_at(fresh[k][2].parameters[-1, :2], ends, width)}
+    retried = _retried(engine, unclosed, numerics)
+    others = curves + [(kind, c) for k, (kind, _, c) in fresh.items() if k not in retried]
+    again, _ = _grown(engine, retried, others, numerics, bounds, width)
+    fresh.update({k: again.get(k, fresh[k]) for k in retried})
+    return [(kind, curve) for kind, _, curve in fresh.values()]
 
 
 def _codim2(curves: list[Branch]) -> list[SpecialPoint]:
@@ -350,15 +363,53 @@ def _retried(engine: Engine, loci: dict[int, tuple[int, RunSpec, Branch]], numer
     return done
 
 
+def _other_orbit(curve: Branch) -> bool:
+    """True if a locus back at its start's parameters has another orbit there: its period
+    differs from its first by more than three times what it changes in a step at either end
+    (a closing locus differs by about one step's change)."""
+    period = np.asarray(curve.period, dtype=float)
+    if len(period) < 3 or not np.all(np.isfinite(period[[0, 1, -2, -1]])):
+        return False
+    step = max(abs(period[-1] - period[-2]), abs(period[1] - period[0]))
+    return bool(abs(period[-1] - period[0]) > 3 * step)
+
+
+def _reached(curve: Branch, starts: tuple[SpecialPoint, ...], width: np.ndarray
+             ) -> SpecialPoint | None:
+    """The start point of the locus's type, other than its own, at the end of a locus back
+    at its start's parameters with another orbit: within 0.005 of the ranges of the end, its
+    period within three steps' change of the end's (None if there is none)."""
+    period = np.asarray(curve.period, dtype=float)
+    step = 3 * max(abs(period[-1] - period[-2]), abs(period[1] - period[0]))
+    kind = {locus_kind: point_type for point_type, (_, locus_kind) in LOCI.items()}[curve.kind]
+    near = [p for p in starts if p.point_type == kind and np.isfinite(p.period)
+            and np.abs((p.parameters[:2] - curve.parameters[-1, :2]) / width).max() < 0.005
+            and abs(p.period - period[-1]) <= step and abs(p.period - period[0]) > step]
+    return min(near, key=lambda p: abs(period[-1] - p.period), default=None)
+
+
 def _locus_end(curve: Branch, codim2: list[SpecialPoint], bounds: dict[str, tuple[float, float]],
-               width: np.ndarray) -> Branch:
-    """The locus with its end classified: range edge, closed, or a codimension-2 point (where
-    AUTO typically stops with MX: that is the locus' natural end, not a failure)."""
+               width: np.ndarray, starts: tuple[SpecialPoint, ...] = ()) -> Branch:
+    """The locus with its end classified: range edge, closed (or back at its start's
+    parameters with another orbit: at another of the ``starts`` of its type, if one is
+    there), or a codimension-2 point (where AUTO typically stops with MX: that is the locus'
+    natural end, not a failure)."""
     last = curve.parameters[-1, :2]
     if _at_range_edge(curve, bounds, width):
         return replace(curve, end="range")
     if len(curve) > 2 and np.abs((last - curve.parameters[0, :2]) / width).max() < 0.005:
-        return replace(curve, end="closed")
+        if not _other_orbit(curve):
+            return replace(curve, end="closed")
+        # e.g. the folds of cycles of a family snaking toward a homoclinic orbit: the locus
+        # of one leads to the next, whose own locus goes on
+        reached = _reached(curve, starts, width)
+        if reached is not None:
+            return replace(curve, end=(
+                f"at the {reached.type_name} of {reached.branch} at {curve.parameter_names[0]}"
+                f" = {reached.parameters[0]:.6g} (period {reached.period:.4g} s)"))
+        return replace(curve, end=(f"back at its start's parameters with another orbit (period"
+                                   f" {curve.period[-1]:.4g} s; {curve.period[0]:.4g} s at "
+                                   "its start)"))
     point = _ending_at(last, codim2, width)
     if point is not None:
         where = ", ".join(f"{v:.5g}" for v in point.parameters[:2])
