@@ -442,14 +442,6 @@ def classify_model(model, overrides: dict[str, float] | None = None, y0=None, *,
     else:
         period = 1.0 / max(float(np.abs(eigenvalues.real).min()), 1e-3)
     dt = period / samples_per_period
-    if method == "odeint":  # Python floats: the generated code's scalar arithmetic is faster
-        def f(y):
-            return field(y.tolist())
-
-        def jac(y):
-            return jacobian(y.tolist())
-    else:
-        f, jac = field, jacobian
-    return classify(f, jac, y0, transient=transient_periods * period,
+    return classify(field, jacobian, y0, transient=transient_periods * period,
                     duration=periods * period, dt=dt, scale=scale,
                     rtol=rtol, bound=bound * scale, method=method, extend=extend, **options)
