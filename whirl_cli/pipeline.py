@@ -43,8 +43,9 @@ def run_study(study: Study, workroot: Path, jobs: int = 1,
     caller needs afterwards (e.g. :data:`whirl_cli.plots.MODULES` to draw), imported in the
     background once AUTO starts (:func:`whirl_cli.interrupts.preload`). Only modules nothing
     imports while AUTO runs: two threads importing parts of one package at once can meet in
-    its circular imports (Python then raises its import-deadlock error in one of them), so
-    scipy, which the AUTO stages' threads use, is not preloaded that way.
+    its circular imports (Python then raises its import-deadlock error in one of them): scipy's
+    integrators are added only where the cross-checks are the first to use scipy
+    (:func:`_only_checks_simulate`), and they join the import before using it.
 
     In the main thread, SIGINT and SIGTERM kill the running AUTO processes at once and raise
     :class:`whirl_cli.interrupts.Interrupted` (a KeyboardInterrupt), see
@@ -60,6 +61,8 @@ def _run_study(study: Study, workroot: Path, jobs: int,
     model = study.variant()
     parameters = study.parameter_values()
     numerics = Numerics.from_settings(study.auto)
+    if _only_checks_simulate(study, model):  # scipy's integrators too, while AUTO runs
+        later = (*later, *simulate.MODULES)
     continuations: list[ContinuationResult] = []
     engine = None
     if study.continuations:
@@ -118,6 +121,16 @@ def _run_study(study: Study, workroot: Path, jobs: int,
         attributes=provenance(study), boundaries=tuple(found_boundaries), linear_grid=grid,
         parameters=resolved_parameters(model, parameters),
         simulations=tuple(simulations(study, model)))
+
+
+def _only_checks_simulate(study: Study, model) -> bool:
+    """True if the cross-checks are the first stage of ``study`` to import scipy: they are
+    asked for, and no freeplay amplitudes or explorations follow a continuation (those import
+    scipy in this thread while the next continuation's AUTO runs; two threads importing parts
+    of one package at once can meet in its circular imports)."""
+    return bool(study.cross_check and study.continuations
+                and not freeplay.freeplay_dofs(model)
+                and not any(getattr(spec, "explore", None) for spec in study.continuations))
 
 
 def persisted(engine: Engine, base: ContinuationResult, continued: Callable, spec,

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..interrupts import forked_map
+from ..interrupts import forked_map, preloaded
 from ..models import Model
 from ..results import Branch, BranchKind, CrossCheck, Orbit, PointType, Simulation
 from .global_bifurcations import BLOWUP_FACTOR
@@ -314,6 +314,7 @@ def cross_check(model: Model, overrides: dict[str, float], branches: tuple[Branc
     or too stiff to simulate in bounded time. ``jobs`` > 1 simulates in that many forked
     processes (:func:`whirl_cli.interrupts.forked_map`: results identical, in the same
     order; an interrupt of the parent kills them at once)."""
+    preloaded()  # scipy may be being imported in the background (it is then used here)
     tasks = planned_checks(branches, per_branch)
     return tuple(forked_map(lambda k: _check(model, overrides, branches, tasks[k]), len(tasks),
                             jobs))
