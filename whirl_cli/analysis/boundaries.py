@@ -37,12 +37,9 @@ def stable_intervals(model: Model, overrides: dict[str, float], first: str, seco
     intervals are examined (the stable parts inside them are the same; outside, partial)."""
     grid = np.linspace(bounds[0], bounds[1], points)
     values = np.asarray(values, dtype=float)
-    base = model.parameter_vector(overrides)
-    at = [model.parameter_names.index(model.canonical(p)) for p in (first, second)]
 
     def stable_at(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        params = np.repeat(base[:, None], len(x), axis=1)
-        params[at[0]], params[at[1]] = x, y
+        params = linear.plane_matrix(model, overrides, first, x, second, y)
         eigenvalues = linear.batched_eigenvalues(np.ascontiguousarray(
             linear.jacobians(model, params)))
         return eigenvalues.real.max(axis=1) < 0

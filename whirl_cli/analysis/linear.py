@@ -53,6 +53,16 @@ def parameter_matrix(model: Model, overrides: dict[str, float], parameter: str,
     return params
 
 
+def plane_matrix(model: Model, overrides: dict[str, float], x_parameter: str,
+                 x_values: np.ndarray, y_parameter: str, y_values: np.ndarray) -> np.ndarray:
+    """(P, M) parameter array: ``overrides`` on the defaults, the two parameters set to the
+    points (``x_values``, ``y_values``), each (M,)."""
+    params = np.repeat(model.parameter_vector(overrides)[:, None], len(x_values), axis=1)
+    params[model.parameter_names.index(model.canonical(x_parameter))] = x_values
+    params[model.parameter_names.index(model.canonical(y_parameter))] = y_values
+    return params
+
+
 def jacobians(model: Model, params: np.ndarray, equilibrium: np.ndarray | None = None
               ) -> np.ndarray:
     """Stacked Jacobians (M, n, n) at ``equilibrium`` (default: y = 0) for params (P, M)."""
@@ -215,10 +225,8 @@ def grid(model: Model, overrides: dict[str, float], x_parameter: str, x_values: 
     x_name, y_name = model.canonical(x_parameter), model.canonical(y_parameter)
     x_values, y_values = np.asarray(x_values, float), np.asarray(y_values, float)
     xx, yy = np.meshgrid(x_values, y_values)
-    params = np.repeat(model.parameter_vector(overrides)[:, None], xx.size, axis=1)
-    params[model.parameter_names.index(x_name)] = xx.ravel()
-    params[model.parameter_names.index(y_name)] = yy.ravel()
-    real, oscillatory = _critical(model, params)
+    real, oscillatory = _critical(model, plane_matrix(model, overrides, x_name, xx.ravel(),
+                                                      y_name, yy.ravel()))
     max_real = real.reshape(xx.shape)
     lines = contourpy.contour_generator(x_values, y_values, max_real).lines(0.0)
     flutter, divergence = _split_by_kind(model, overrides, x_name, y_name, lines)
@@ -235,10 +243,8 @@ def _split_by_kind(model: Model, overrides: dict[str, float], x_name: str, y_nam
     for line in lines:
         if len(line) < 2:
             continue
-        params = np.repeat(model.parameter_vector(overrides)[:, None], len(line), axis=1)
-        params[model.parameter_names.index(x_name)] = line[:, 0]
-        params[model.parameter_names.index(y_name)] = line[:, 1]
-        _, kind = _critical(model, params)
+        _, kind = _critical(model, plane_matrix(model, overrides, x_name, line[:, 0],
+                                                y_name, line[:, 1]))
         cuts = np.flatnonzero(kind[1:] != kind[:-1]) + 1
         for part, flag in zip(np.split(np.arange(len(line)), cuts),
                               kind[np.r_[0, cuts]], strict=True):

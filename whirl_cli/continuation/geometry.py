@@ -33,18 +33,8 @@ def _near_polyline(point: np.ndarray, curve: np.ndarray, width: np.ndarray,
                    tolerance: float = 1e-3) -> bool:
     """True if ``point`` lies within ``tolerance`` of the polyline ``curve`` (K, >= 2), in
     axes scaled by the ranges ``width`` (Euclidean distance to the nearest segment)."""
-    if len(curve) == 0:
-        return False
-    scaled = curve[:, :2] / width
-    target = np.asarray(point[:2]) / width
-    if len(scaled) == 1:
-        return bool(np.linalg.norm(scaled[0] - target) < tolerance)
-    start, step = scaled[:-1], np.diff(scaled, axis=0)
-    length = np.einsum("ij,ij->i", step, step)
-    along = np.clip(np.einsum("ij,ij->i", target - start, step) / np.where(length > 0, length, 1),
-                    0.0, 1.0)
-    nearest = start + along[:, None] * step
-    return bool(np.linalg.norm(nearest - target, axis=1).min() < tolerance)
+    target = np.asarray(point[:2], dtype=float)[None] / width
+    return bool(_on_paths(target, [curve[:, :2] / width], tolerance)[0])
 
 
 def locus_coordinates(curve: Branch, width: np.ndarray, scale: np.ndarray) -> np.ndarray:

@@ -363,29 +363,33 @@ def _retried(engine: Engine, loci: dict[int, tuple[int, RunSpec, Branch]], numer
     return done
 
 
+def _period_tolerance(curve: Branch) -> float:
+    """Three times what the period of a locus changes in a step at either end (NaN without
+    a period there)."""
+    period = np.asarray(curve.period, dtype=float)
+    return 3 * max(abs(period[-1] - period[-2]), abs(period[1] - period[0]))
+
+
 def _other_orbit(curve: Branch) -> bool:
     """True if a locus back at its start's parameters has another orbit there: its period
-    differs from its first by more than three times what it changes in a step at either end
-    (a closing locus differs by about one step's change)."""
-    period = np.asarray(curve.period, dtype=float)
-    if len(period) < 3 or not np.all(np.isfinite(period[[0, 1, -2, -1]])):
+    differs from its first by more than :func:`_period_tolerance` (a closing locus differs by
+    about one step's change)."""
+    if len(curve) < 3 or not np.all(np.isfinite(curve.period[[0, 1, -2, -1]])):
         return False
-    step = max(abs(period[-1] - period[-2]), abs(period[1] - period[0]))
-    return bool(abs(period[-1] - period[0]) > 3 * step)
+    return bool(abs(curve.period[-1] - curve.period[0]) > _period_tolerance(curve))
 
 
 def _reached(curve: Branch, starts: tuple[SpecialPoint, ...], width: np.ndarray
              ) -> SpecialPoint | None:
     """The start point of the locus's type, other than its own, at the end of a locus back
     at its start's parameters with another orbit: within 0.005 of the ranges of the end, its
-    period within three steps' change of the end's (None if there is none)."""
-    period = np.asarray(curve.period, dtype=float)
-    step = 3 * max(abs(period[-1] - period[-2]), abs(period[1] - period[0]))
+    period within :func:`_period_tolerance` of the end's (None if there is none)."""
+    first, last, tolerance = curve.period[0], curve.period[-1], _period_tolerance(curve)
     kind = {locus_kind: point_type for point_type, (_, locus_kind) in LOCI.items()}[curve.kind]
     near = [p for p in starts if p.point_type == kind and np.isfinite(p.period)
             and np.abs((p.parameters[:2] - curve.parameters[-1, :2]) / width).max() < 0.005
-            and abs(p.period - period[-1]) <= step and abs(p.period - period[0]) > step]
-    return min(near, key=lambda p: abs(period[-1] - p.period), default=None)
+            and abs(p.period - last) <= tolerance and abs(p.period - first) > tolerance]
+    return min(near, key=lambda p: abs(last - p.period), default=None)
 
 
 def _locus_end(curve: Branch, codim2: list[SpecialPoint], bounds: dict[str, tuple[float, float]],
