@@ -8,7 +8,8 @@ they wrote (an empty branch with the run's status and message where a run failed
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
@@ -72,9 +73,37 @@ class RunSpec:
     data: str | None = None
 
 
+class _Slots:
+    """At most ``jobs`` holders at a time; a background request waits while any foreground
+    one does (background work fills a core the foreground leaves idle, never delays it)."""
+
+    def __init__(self, jobs: int) -> None:
+        self._free = jobs
+        self._waiting = 0  # foreground requests waiting
+        self._changed = threading.Condition()
+
+    @contextmanager
+    def held(self, background: bool = False) -> Iterator[None]:
+        with self._changed:
+            self._waiting += not background
+            try:
+                self._changed.wait_for(lambda: self._free > 0
+                                       and not (background and self._waiting))
+            finally:
+                self._waiting -= not background
+            self._free -= 1
+        try:
+            yield
+        finally:
+            with self._changed:
+                self._free += 1
+                self._changed.notify_all()
+
+
 class Engine:
     """Runs AUTO jobs of one model: compiles once, one directory per run, at most ``jobs`` at
-    a time however many threads ask (independent stages of a recipe may run side by side)."""
+    a time however many threads ask (independent stages of a recipe may run side by side;
+    background runs only on slots no foreground run waits for)."""
 
     def __init__(self, model: Model, workroot: Path, jobs: int = 1, timeout: float = 120.0,
                  on_run: Callable[[runner.RunOutcome], None] | None = None) -> None:
@@ -86,23 +115,25 @@ class Engine:
         self.executable = toolchain.compile_equations(lambda: fortran_source(model), model.name,
                                                  source_key=source_key(model))
         self.outcomes: dict[str, runner.RunOutcome] = {}
-        self._slots = threading.BoundedSemaphore(self.jobs)
+        self._slots = _Slots(self.jobs)
         #: the specification of every run made, by AUTO name (as ``outcomes``)
         self.specs: dict[str, RunSpec] = {}
 
-    def run_many(self, specs: Sequence[RunSpec]) -> list[runner.RunOutcome]:
+    def run_many(self, specs: Sequence[RunSpec], background: bool = False
+                 ) -> list[runner.RunOutcome]:
         """Execute ``specs`` (independent of each other) and return outcomes in spec order;
-        every run has ended when this returns or raises."""
-        return thread_map(self._execute, specs, self.jobs)
+        every run has ended when this returns or raises. ``background``: each run waits
+        while a foreground run waits for a slot (work ahead of need)."""
+        return thread_map(lambda spec: self._execute(spec, background), specs, self.jobs)
 
-    def _execute(self, spec: RunSpec) -> runner.RunOutcome:
+    def _execute(self, spec: RunSpec, background: bool = False) -> runner.RunOutcome:
         constants = dict(spec.constants)
         restart_file = None
         if spec.restart is not None:
             source, label = spec.restart
             restart_file = self.outcomes[source].file("s")
             constants["IRS"] = label
-        with self._slots:
+        with self._slots.held(background):
             outcome = runner.run(self.executable.path, constants, self.workroot / spec.name,
                                  spec.name.replace("/", "."), restart=restart_file,
                                  timeout=self.timeout, data=spec.data)

@@ -5,6 +5,7 @@ points (Hopf, branch point, fold, fold of cycles), each traced once, chunk by ch
 from __future__ import annotations
 
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 
@@ -129,28 +130,61 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
           starts: list[tuple[SpecialPoint, str]]) -> list[Branch]:
     """Locus branches from the start points, both directions, each locus once.
 
-    Starts are taken slice by slice: a start lying on a locus of its type already traced
-    from an earlier slice is the same locus and is not run again, nor is a start with the
-    same type, parameters and period as another (a symmetric twin: its locus is the same
-    curve in the parameter plane). Loci grow chunk by chunk,
+    Starts are taken slice by slice (a wave per slice): a start lying on a locus of its type
+    already traced from an earlier slice is the same locus and is not run again, nor is a
+    start with the same type, parameters and period as another (a symmetric twin: its locus
+    is the same curve in the parameter plane). Loci grow chunk by chunk,
     and after every chunk those that repeat others are dropped, those that closed are cut
     and those that ran onto another stop (:func:`_grown`), so a duplicate or a loop costs one
     chunk beyond where it is recognised; only kept loci ending
     in MX are retried (AUTO's runs, not just the results, are saved); duplicates left after
-    the retries are dropped."""
+    the retries are dropped. While a wave grows, the first chunks of the next wave's starts
+    not on the loci known before it (nor on its own first chunks) are traced on the cores it
+    leaves idle; those then found on its loci are set aside (the others are traced then), so
+    the loci are those of tracing wave after wave."""
     width = np.array([bounds[p][1] - bounds[p][0] for p in pair])
     numbered = list(enumerate(starts, 1))
     waves: dict[str, list] = {}
     for k, (point, runs) in numbered:
         waves.setdefault(point.branch.split(".", 1)[0], []).append((k, point, runs))
     curves: list[tuple[int, Branch]] = []
-    for wave in waves.values():
-        todo = [(k, point, runs) for k, point, runs in wave if not any(
+
+    def todo(wave: list, also: list[tuple[int, Branch]] = ()
+             ) -> list[tuple[int, SpecialPoint, str]]:
+        return _without_twins([(k, point, runs) for k, point, runs in wave if not any(
             kind == point.point_type and _near_polyline(point.parameters[:2], curve.parameters,
                                                         width)
-            for kind, curve in curves)]
-        curves += _wave(engine, name, pair, bounds, numerics, _without_twins(todo, width),
-                        curves, width)
+            for kind, curve in [*curves, *also])], width)
+
+    def following(waves: list[list]) -> tuple[list | None, list]:
+        """The next wave with starts still to trace (one without any stays so: more loci
+        only set more aside), and those after it."""
+        for j, wave in enumerate(waves):
+            if todo(wave):
+                return wave, waves[j + 1:]
+        return None, []
+
+    now, later = following(list(waves.values()))
+    ahead = _trace(engine, name, pair, bounds, numerics, todo(now)) if now else []
+    while now is not None:
+        wanted = todo(now)
+        late = [start for start in wanted if start[0] not in {k for k, *_ in ahead}]
+        if late:  # a twin set aside ahead, whose other has since been set aside
+            ahead += _trace(engine, name, pair, bounds, numerics, late)
+        position = {k: j for j, (k, _, _) in enumerate(wanted)}
+        # in the order of tracing them now: equilibria's loci and cycles' first stages
+        # (those that ended there), then cycles' second stages; start by start, a then b
+        traced = dict(enumerate((kind, spec, branch) for _, kind, spec, branch in sorted(
+            (row for row in ahead if row[0] in position),
+            key=lambda row: (row[2].name.endswith("2"), position[row[0]], row[2].name))))
+        tasks = [partial(_wave, engine, pair, bounds, numerics, traced, list(curves), width)]
+        now, later = following(later)
+        if now is not None:  # not those on this wave's first chunks either
+            tasks.append(partial(_trace, engine, name, pair, bounds, numerics, todo(
+                now, [(kind, curve) for kind, _, curve in traced.values()]), background=True))
+        done = thread_map(lambda task: task(), tasks, len(tasks))
+        curves += done[0]
+        ahead = done[1] if now is not None else []
     kept = [curve for _, _, curve in _distinct(
         {k: (kind, None, curve) for k, (kind, curve) in enumerate(
             sorted(curves, key=lambda c: c[1].name))}, [], width)[0].values()]
@@ -159,14 +193,13 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
     return [_locus_end(c, codim2, bounds, width, points) for c in kept]
 
 
-def _wave(engine: Engine, name: str, pair: tuple[str, str],
-          bounds: dict[str, tuple[float, float]], numerics: Numerics,
-          starts: list[tuple[int, SpecialPoint, str]], curves: list[tuple[int, Branch]],
-          width: np.ndarray) -> list[tuple[int, Branch]]:
-    """(point type, locus) of every one of ``starts``, traced side by side and grown chunk by
-    chunk beside the ``curves`` known (:func:`_grown`); those ending in MX away from a known
-    codimension-2 point retried once (:func:`_retried`)."""
-    traced = _trace(engine, name, pair, bounds, numerics, starts)
+def _wave(engine: Engine, pair: tuple[str, str], bounds: dict[str, tuple[float, float]],
+          numerics: Numerics, traced: dict[int, tuple[int, RunSpec, Branch]],
+          curves: list[tuple[int, Branch]], width: np.ndarray) -> list[tuple[int, Branch]]:
+    """(point type, locus) of every one of the loci ``traced`` (their first chunks, by
+    index), grown chunk by chunk side by side beside the ``curves`` known (:func:`_grown`);
+    those ending in MX away from a known codimension-2 point retried once
+    (:func:`_retried`)."""
     fresh, uncut = _grown(engine, traced, curves, numerics, bounds, width)
     ends = _codim2([c for _, c in curves + [(kind, c) for kind, _, c in fresh.values()]])
     unclosed = {k: fresh[k] for k in uncut
@@ -246,10 +279,12 @@ def _distinct(curves: dict[int, tuple[int, RunSpec | None, Branch]],
 
 def _trace(engine: Engine, name: str, pair: tuple[str, str],
            bounds: dict[str, tuple[float, float]], numerics: Numerics,
-           starts: list[tuple[int, SpecialPoint, str]]
-           ) -> dict[int, tuple[int, RunSpec, Branch]]:
-    """(point type, last run, locus branch) of every start, both directions, run in
-    parallel: the first chunk of steps of each (not yet continued, nor retried)."""
+           starts: list[tuple[int, SpecialPoint, str]], background: bool = False
+           ) -> list[tuple[int, int, RunSpec, Branch]]:
+    """(start number, point type, last run, locus branch) of every start, both directions,
+    run in parallel (``background``: see :meth:`Engine.run_many`): the first chunk of steps
+    of each (not yet continued, nor retried); loci of equilibria first, then those of
+    cycles (their second stage)."""
     model = engine.model
     specs = []
     for k, point, runs in starts:
@@ -261,22 +296,23 @@ def _trace(engine: Engine, name: str, pair: tuple[str, str],
             constants = locus_constants(model, numerics, pair, bounds, direction, kind)
             if kind in CYCLE_LOCI:  # stage 1: AUTO builds the extended system (NMX 5)
                 constants["NMX"] = 5
-            specs.append((kind, RunSpec(f"{name}/{locus}_{k}{tag}", constants, branch_kind,
-                                        origin, pair, restart=(source, point.label))))
-    outcomes = engine.run_many([spec for _, spec in specs])
+            specs.append((k, kind, RunSpec(f"{name}/{locus}_{k}{tag}", constants, branch_kind,
+                                           origin, pair, restart=(source, point.label))))
+    outcomes = engine.run_many([spec for _, _, spec in specs], background)
     second_stage = []
-    final: list[tuple[int, RunSpec, runner.RunOutcome]] = []
-    for (kind, spec), outcome in zip(specs, outcomes, strict=True):
+    final: list[tuple[int, int, RunSpec, runner.RunOutcome]] = []
+    for (k, kind, spec), outcome in zip(specs, outcomes, strict=True):
         if kind in CYCLE_LOCI and outcome.has_output:
             constants = dict(spec.constants, NMX=min(FIRST_CHUNK, numerics.max_steps))
-            second_stage.append((kind, replace(spec, name=spec.name + "2", constants=constants,
-                                               restart=(outcome.name, outcome.labels[-1][1]))))
+            second_stage.append((k, kind, replace(
+                spec, name=spec.name + "2", constants=constants,
+                restart=(outcome.name, outcome.labels[-1][1]))))
         else:
-            final.append((kind, spec, outcome))
-    final += [(kind, spec, outcome) for (kind, spec), outcome in zip(
-        second_stage, engine.run_many([spec for _, spec in second_stage]), strict=True)]
-    return {k: (kind, spec, _read(engine, spec, outcome))
-            for k, (kind, spec, outcome) in enumerate(final)}
+            final.append((k, kind, spec, outcome))
+    final += [(k, kind, spec, outcome) for (k, kind, spec), outcome in zip(
+        second_stage, engine.run_many([spec for _, _, spec in second_stage], background),
+        strict=True)]
+    return [(k, kind, spec, _read(engine, spec, outcome)) for k, kind, spec, outcome in final]
 
 
 #: Loci of cycles (fold of cycles, torus) go FIRST_CHUNK steps, then LOCUS_CHUNK steps at a
