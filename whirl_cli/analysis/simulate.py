@@ -78,6 +78,17 @@ def _piece(breakpoints: tuple[float, ...], x: float, rate: float) -> int:
     return below + 1 if at and rate > 0 else below
 
 
+def _inside(breakpoint: float, step: int, scale: float) -> float:
+    """Where a dof that has just passed ``breakpoint`` going ``step`` (+1 up, -1 down)
+    restarts: a few units of round-off beyond it (``scale``: its typical amplitude), on the
+    side of the piece it enters. On the breakpoint itself, or a round-off on the wrong side,
+    the event of coming back would start at zero or on its far side, and a return within the
+    first step (a short excursion) would go unseen: the motion then continues on the wrong
+    piece."""
+    unit = np.spacing(max(abs(breakpoint), 1e-3 * scale))
+    return float(breakpoint + step * 16 * unit)
+
+
 def integrate_exact(model: Model, params: np.ndarray, y0: np.ndarray, duration: float,
                     samples: int = 4000, rtol: float = 1e-10) -> ExactTrajectory:
     """The trajectory from ``y0`` over ``duration`` seconds with every piecewise law (the
@@ -87,7 +98,8 @@ def integrate_exact(model: Model, params: np.ndarray, y0: np.ndarray, duration: 
     The exact law is smooth on each piece, so each piece is integrated on its own (scipy
     ``solve_ivp``, DOP853, atol ``rtol`` x 1e-3 typical amplitudes) up to the event where a
     piecewise dof reaches a breakpoint of its piece in the direction that leaves it (located
-    on the dense output, to round-off); the integration restarts there on the next piece.
+    on the dense output, to round-off); the integration restarts there on the next piece
+    (:func:`_inside`: a few units of round-off into it).
     The right-hand side of each piece is the model's exact numeric module
     (:attr:`whirl_cli.models.Model.exact_numeric`), generated from the same symbolic model as
     the smoothed one."""
@@ -137,6 +149,7 @@ def integrate_exact(model: Model, params: np.ndarray, y0: np.ndarray, duration: 
         event_time.append(start)
         event_state.append(state.copy())
         event_dof.append(dofs[k])
+        state[dofs[k]] = _inside(breakpoints[k][pieces[k] - (step > 0)], step, scale[dofs[k]])
         if len(event_time) > MAX_EVENTS:
             raise RuntimeError(f"exact time integration: more than {MAX_EVENTS} piece changes "
                                "(chattering at a breakpoint)")
