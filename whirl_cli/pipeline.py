@@ -137,19 +137,19 @@ def persisted(engine: Engine, base: ContinuationResult, continued: Callable, spe
               parameters: dict[str, float], numerics: Numerics) -> ContinuationResult:
     """``base`` (a continuation of a model that smooths a law) with its special points
     recomputed as the smoothing shrinks (:mod:`whirl_cli.continuation.persistence`): by short
-    runs near each point (:func:`whirl_cli.continuation.shrinking.recompute`), and, only if
-    one is left that they did not recompute, by the continuation ``continued`` repeated at
-    every factor (runs ``<name>_eps<k>``). If a point is of a type no short run recomputes
-    (a period blow-up), the continuation is repeated for all of them at once."""
+    runs near each point of a type they recompute (folds, Hopf and branch points:
+    :func:`whirl_cli.continuation.shrinking.recompute`), and, only if one is left that they
+    did not recompute (another type, such as a period blow-up, or one they did not confirm),
+    by the continuation ``continued`` repeated at every factor (runs ``<name>_eps<k>``),
+    which then gives those points' values. Points the short runs confirm keep their values:
+    a repetition may miss a fold its branch does not reach at a smaller width (it would call
+    it an artefact) or pick another point of the type nearby."""
     smoothing = engine.model.smoothing_parameters
     bounds = tuple(spec.range)
-    recomputed = {}
-    if all(p.point_type in shrinking.STOP_CODES for p in base.special_points
-           if p.point_type in persistence.CHECKED):
-        recomputed = shrinking.recompute(
-            engine, spec.name, base, parameters, smoothing, persistence.FACTORS,
-            persistence.CHECKED, bounds, numerics,
-            reach=persistence.TOLERANCE * (bounds[1] - bounds[0]))
+    recomputed = shrinking.recompute(
+        engine, spec.name, base, parameters, smoothing, persistence.FACTORS,
+        persistence.CHECKED, bounds, numerics,
+        reach=persistence.TOLERANCE * (bounds[1] - bounds[0]))
     refined = repeated(continued, spec.name, parameters, smoothing) \
         if persistence.needs_repetition(base, recomputed) else []
     return persistence.annotate(base, refined, bounds[1] - bounds[0], recomputed=recomputed)

@@ -249,11 +249,14 @@ def _collect(engine: Engine, name: str, bounds: tuple[float, float],
 
 def orbit_data(model: Model, orbit: Orbit) -> str:
     """One period of ``orbit`` as an AUTO data file: rows ``tau u1 .. un`` in AUTO's
-    non-dimensional units (see :mod:`whirl_cli.models.variant`)."""
+    non-dimensional units (see :mod:`whirl_cli.models.variant`), to 12 significant digits: a
+    simulated orbit is good to about 1e-9, and the digits beyond are round-off that differs
+    between machines (their BLAS kernels), which AUTO's path through a difficult stretch of
+    the family can follow."""
     scale = np.asarray(model.state_scale, dtype=float)
     rows = np.column_stack([np.asarray(orbit.time) * model.time_scale,
                             np.asarray(orbit.states) / scale])
-    return "".join(" ".join(f"{x:.17g}" for x in row) + "\n" for row in rows)
+    return "".join(" ".join(f"{x:.12g}" for x in row) + "\n" for row in rows)
 
 
 def _continue(engine: Engine, families: list[_Family], hopfs: list[SpecialPoint],
