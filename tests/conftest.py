@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import signal
 from pathlib import Path
 
 import pytest
@@ -17,6 +18,15 @@ def _private_cache(tmp_path_factory):
     if "WHIRL_CACHE_DIR" not in os.environ:
         os.environ["WHIRL_CACHE_DIR"] = str(tmp_path_factory.mktemp("whirl-cache"))
     yield
+
+
+def pytest_configure(config):
+    """Python's own Ctrl-C handler, as in an interactive start: a shell without job control
+    starts a background command (``make test &``, ``nohup``) with SIGINT ignored, and Python
+    then keeps ignoring it, so the tests of how whirl holds and raises interrupts would see
+    none."""
+    if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def pytest_collection_modifyitems(items):
