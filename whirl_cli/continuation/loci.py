@@ -168,7 +168,8 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
     ahead = _trace(engine, name, pair, bounds, numerics, todo(now)) if now else []
     while now is not None:
         wanted = todo(now)
-        late = [start for start in wanted if start[0] not in {k for k, *_ in ahead}]
+        done_ahead = {k for k, *_ in ahead}
+        late = [start for start in wanted if start[0] not in done_ahead]
         if late:  # a twin set aside ahead, whose other has since been set aside
             ahead += _trace(engine, name, pair, bounds, numerics, late)
         position = {k: j for j, (k, _, _) in enumerate(wanted)}
