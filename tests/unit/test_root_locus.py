@@ -31,7 +31,9 @@ def test_the_root_locus_crosses_the_imaginary_axis_at_the_hopf_point():
             re, v = xy[branch, 0], np.asarray(values)[branch]
             order = np.argsort(v)
             re, v = re[order], v[order]
-            for k in np.flatnonzero(np.sign(re[:-1]) != np.sign(re[1:])):
+            # a crossing once, also where a sweep point lies on Re = 0 (the sweep's middle
+            # point is the Hopf point itself: its real part may round to exactly 0)
+            for k in np.flatnonzero((re[:-1] < 0) != (re[1:] < 0)):
                 crossings.append(v[k] - re[k] * (v[k + 1] - v[k]) / (re[k + 1] - re[k]))
     assert len(crossings) == 2  # the conjugate pair
     np.testing.assert_allclose(crossings, hopf, atol=1e-6)
