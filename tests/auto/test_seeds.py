@@ -164,7 +164,9 @@ def test_the_short_persistence_runs_agree_with_the_repeated_continuation():
     epsilon/2 and epsilon/4 by short runs near them (the one near 8.65 m/s along its locus in
     (V, epsilon), the one near 6.67 m/s by a restart before it); the continuation is repeated
     only for points no short run recomputed (the family may end in a period blow-up, a
-    homoclinic approach, depending on the round-off of its seed). An independent computation,
+    homoclinic approach, depending on the round-off of its seed; on some CPUs the family
+    zig-zags at the lowest fold, two more folds within the tolerance of it that the
+    repetition judges). An independent computation,
     the whole continuation repeated at both widths (whirl's fallback, made here on purpose),
     finds the two folds within the persistence tolerance (2e-3 of the range)."""
     from whirl_cli.continuation.engine import Engine, Numerics
@@ -175,10 +177,16 @@ def test_the_short_persistence_runs_agree_with_the_repeated_continuation():
     continuation = result.continuations[0]
     folds = sorted((p for p in continuation.special_points
                     if p.type_name == "LPC" and not p.artefact), key=lambda p: p.parameters[0])
-    lowest, high = folds[0], next(p for p in folds if 8.6 < p.parameters[0] < 8.7)
-    assert 6.6 < lowest.parameters[0] < 6.7 and lowest.refined_by == "restart"
+    tolerance, short = 2e-3 * 3.0, ("restart", "epsilon locus")
+    lowest = next(p for p in folds if p.refined_by == "restart")
+    high = next(p for p in folds if 8.6 < p.parameters[0] < 8.7)
+    assert 6.6 < lowest.parameters[0] < 6.7
+    assert lowest.parameters[0] - folds[0].parameters[0] < tolerance
     assert high.refined_by == "epsilon locus"
-    assert all(p.refined_by in ("restart", "epsilon locus") for p in folds)
+    for fold in folds:  # round-off can add a zig-zag of folds closer than the tolerance
+        assert fold.refined_by in short or any(  # (AMD EPYC: 6.66615, 6.66683 beside 6.66618)
+            other.refined_by in short and abs(other.parameters[0] - fold.parameters[0])
+            < tolerance for other in folds), fold
     others = [p for p in continuation.special_points if p.refined_by == "repetition"]
     assert any(r.name.startswith("v_eps") for r in result.runs) == bool(others)
 
