@@ -251,3 +251,20 @@ def test_dask_cluster_gives_the_same_results_as_the_local_pool(tmp_path):
         compared = runner.invoke(cli, ["compare", str(tmp_path / "local" / name),
                                        str(tmp_path / "dask" / name)])
         assert compared.exit_code == 0, compared.output
+
+
+def test_each_outcome_says_how_many_studies_are_still_to_finish(tmp_path):
+    """``run_sweep``'s ``on_outcome`` (what ``whirl figures`` draws by): after each study,
+    how many are still running or waiting; up-to-date studies leave nothing to wait for."""
+    from whirl_cli.sweep.run import run_sweep
+
+    studies = tmp_path / "studies"
+    copy_studies(studies)
+    seen: list[tuple[str, int]] = []
+    run_sweep([studies], tmp_path / "out", jobs=2, plots=False,
+              on_outcome=lambda outcome, left: seen.append((outcome.status, left)))
+    assert seen == [("ok", left) for left in range(len(SMALL) - 1, -1, -1)]
+    seen.clear()
+    run_sweep([studies], tmp_path / "out", jobs=2, plots=False,
+              on_outcome=lambda outcome, left: seen.append((outcome.status, left)))
+    assert seen == [("skipped", 0)] * len(SMALL)

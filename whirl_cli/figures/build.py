@@ -5,7 +5,8 @@ index (:func:`make_figures`).
 2. the studies they name are run as one sweep into the results folder
    (:func:`whirl_cli.sweep.run.run_sweep`: up-to-date results are reused, studies run in
    parallel, without their own plots);
-3. each sheet is drawn from the stored results and published as ``<out>/fig<n>.png``
+3. each sheet is drawn from the stored results and published as ``<out>/fig<n>.png``,
+   during the sweep as soon as its studies are stored and a worker is idle
    (complete or not at all); a sheet whose study failed, or whose panel cannot be drawn, is
    reported and left out, the others are drawn. A figure is not redrawn when its PNG holds the
    same key (:func:`figure_key`: the sheet's text, whirl's code, the resolution and the result
@@ -66,53 +67,89 @@ def load_sheets(paths: Sequence[str | os.PathLike[str]]) -> list[Sheet]:
 def make_figures(paths: Sequence[str | os.PathLike[str]], out_dir: Path, results_dir: Path,
                  jobs: int = 1, force: bool = False, console=None, dpi: int = 150
                  ) -> list[FigureOutcome]:
-    """Run, draw and index (module docstring); the outcome of every sheet, in figure order."""
-    from ..output import store
+    """Run, draw and index (module docstring); the outcome of every sheet, in figure order.
+
+    A sheet is drawn as soon as its studies are stored and a worker is idle (no study left
+    waiting for one), so the sheets of the short studies are drawn while the long ones still
+    run (what a sheet shows does not depend on when it is drawn)."""
     from ..output.atomic import publish
     from ..sweep.run import run_sweep
-    from .draw import draw_sheet
 
-    sheets = load_sheets(paths)
+    sheets = sorted(load_sheets(paths), key=lambda s: figure_order(s.figure))
     studies = list(dict.fromkeys(p for s in sheets for p in s.studies()))
-    tally = run_sweep(studies, results_dir, jobs=jobs, force=force, plots=False,
-                      console=console)
-    outputs, failed = {}, {}
-    for outcome in tally.outcomes:
-        source = Path(os.path.normpath(outcome.item.source))
-        if outcome.status in ("ok", "failed", "skipped") and outcome.item.output is not None:
-            outputs[source] = outcome.item.output
-        else:
-            failed[source] = "; ".join(outcome.problems) or outcome.status
+    artist = _Artist(out_dir, force, dpi)
+
+    def stored(outcome, pending: int) -> None:
+        artist.record(outcome)
+        if pending < jobs:  # a worker is idle: draw what is ready on its core
+            for sheet in sheets:
+                artist.draw_when_ready(sheet)
+
+    run_sweep(studies, results_dir, jobs=jobs, force=force, plots=False, console=console,
+              on_outcome=stored)
+    _make_folder(out_dir)
+    outcomes = [artist.outcome(sheet) for sheet in sheets]
+    page = index_html([_entry(o, out_dir) for o in outcomes], "whirl figures")
+    publish(page.encode("utf-8"), out_dir / "index.html", overwrite=True, what="the index")
+    return outcomes
+
+
+def _make_folder(out_dir: Path) -> None:
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise WhirlError(f"cannot create figure folder {out_dir}: {exc}") from exc
-    read: dict[Path, StudyResult] = {}
-    outcomes = []
-    for sheet in sorted(sheets, key=lambda s: figure_order(s.figure)):
-        missing = [f"{p}: {failed.get(p, 'no result')}" for p in sheet.studies()
-                   if p not in outputs]
-        if missing:
-            outcomes.append(FigureOutcome(sheet, None, "; ".join(missing)))
-            continue
-        target = out_dir / f"{sheet.stem}.png"
-        key = figure_key(sheet, [outputs[p] for p in sheet.studies()], dpi)
-        if not force and stored_key(target) == key:
-            outcomes.append(FigureOutcome(sheet, target, reused=True))
-            continue
+
+
+class _Artist:
+    """Draws sheets from stored results as they arrive: :meth:`record` each sweep outcome,
+    :meth:`draw_when_ready` a sheet whose studies are all stored, :meth:`outcome` of every
+    sheet at the end (a sheet not drawn yet is drawn then, or said why not)."""
+
+    def __init__(self, out_dir: Path, force: bool, dpi: int) -> None:
+        self.out_dir, self.force, self.dpi = out_dir, force, dpi
+        self.outputs: dict[Path, Path] = {}
+        self.failed: dict[Path, str] = {}
+        self.read: dict[Path, StudyResult] = {}
+        self.done: dict[Path, FigureOutcome] = {}
+
+    def record(self, outcome) -> None:
+        source = Path(os.path.normpath(outcome.item.source))
+        if outcome.status in ("ok", "failed", "skipped") and outcome.item.output is not None:
+            self.outputs[source] = outcome.item.output
+        else:
+            self.failed[source] = "; ".join(outcome.problems) or outcome.status
+
+    def draw_when_ready(self, sheet: Sheet) -> None:
+        if sheet.path not in self.done and all(p in self.outputs for p in sheet.studies()):
+            self.done[sheet.path] = self._draw(sheet)
+
+    def outcome(self, sheet: Sheet) -> FigureOutcome:
+        self.draw_when_ready(sheet)
+        if sheet.path in self.done:
+            return self.done[sheet.path]
+        missing = [f"{p}: {self.failed.get(p, 'no result')}" for p in sheet.studies()
+                   if p not in self.outputs]
+        return FigureOutcome(sheet, None, "; ".join(missing))
+
+    def _draw(self, sheet: Sheet) -> FigureOutcome:
+        from ..output import store
+        from ..output.atomic import publish
+        from .draw import draw_sheet
+
+        target = self.out_dir / f"{sheet.stem}.png"
+        key = figure_key(sheet, [self.outputs[p] for p in sheet.studies()], self.dpi)
+        if not self.force and stored_key(target) == key:
+            return FigureOutcome(sheet, target, reused=True)
         try:
             for path in sheet.studies():
-                if path not in read:
-                    read[path] = store.read(outputs[path])
-            image = _render(draw_sheet(sheet, read), dpi, {KEY: key})
+                if path not in self.read:
+                    self.read[path] = store.read(self.outputs[path])
+            image = _render(draw_sheet(sheet, self.read), self.dpi, {KEY: key})
         except WhirlError as error:
-            outcomes.append(FigureOutcome(sheet, None, str(error)))
-            continue
-        written = publish(image, target, overwrite=True, what="the figure")
-        outcomes.append(FigureOutcome(sheet, written))
-    page = index_html([_entry(o, out_dir) for o in outcomes], "whirl figures")
-    publish(page.encode("utf-8"), out_dir / "index.html", overwrite=True, what="the index")
-    return outcomes
+            return FigureOutcome(sheet, None, str(error))
+        _make_folder(self.out_dir)
+        return FigureOutcome(sheet, publish(image, target, overwrite=True, what="the figure"))
 
 
 def _render(figure, dpi: int, metadata: dict[str, str]) -> bytes:

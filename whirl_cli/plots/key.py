@@ -134,10 +134,18 @@ def stability_segments(x: np.ndarray, y: np.ndarray, stable: np.ndarray,
 
 
 def _new_figure(**kwargs) -> Figure:
-    """A Figure on an Agg canvas, outside pyplot (needs no display, no closing)."""
+    """A Figure on an Agg canvas, outside pyplot (needs no display, no closing), drawn with
+    fresh font objects: matplotlib's cached ones keep state between texts, so an axes edge
+    could move by a pixel after other figures were drawn in the process. A figure's pixels
+    then depend only on what it shows, not on the figures before it (the order in which
+    ``whirl figures`` draws its sheets, or the ``--jobs`` that spread plots over processes)."""
+    from matplotlib import font_manager
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    fresh = getattr(getattr(font_manager, "_get_font", None), "cache_clear", None)
+    if fresh is not None:  # a private cache (matplotlib 3.8-3.11): absent, nothing to reset
+        fresh()
     figure = Figure(**{"layout": "constrained", **kwargs})  # no clipped labels, no bbox pass
     FigureCanvasAgg(figure)
     return figure

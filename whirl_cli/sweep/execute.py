@@ -97,8 +97,9 @@ def execute(items: Sequence[SweepItem], executor: Executor, plots: bool = True,
             on_submitted: Callable[[int], None] | None = None) -> list[Outcome]:
     """Run the ``run`` items on ``executor``; write each result and its plots as it arrives.
 
-    Skipped and invalid items become outcomes at once. ``report`` is called with every
-    outcome, in completion order; ``on_submitted`` with the number of studies submitted.
+    Skipped and invalid items become outcomes once the studies to run are submitted (the
+    workers start first). ``report`` is called with every outcome, in completion order;
+    ``on_submitted`` with the number of studies submitted.
     A KeyboardInterrupt cancels the futures not started yet and propagates.
     """
     outcomes: list[Outcome] = []
@@ -108,11 +109,6 @@ def execute(items: Sequence[SweepItem], executor: Executor, plots: bool = True,
         if report is not None:
             report(outcome)
 
-    for item in items:
-        if item.action == SKIP:
-            done(Outcome(item, "skipped", item.stored_problems))
-        elif item.action == INVALID:
-            done(Outcome(item, "invalid", (item.reason,)))
     queue = sorted((item for item in items if item.action == RUN), key=expected_cost,
                    reverse=True)  # longest first: less idle time at the end of a sweep
     futures: dict[Future, SweepItem] = {executor.submit(compute, item.study): item
@@ -121,6 +117,11 @@ def execute(items: Sequence[SweepItem], executor: Executor, plots: bool = True,
         on_submitted(len(futures))
     try:
         for item in items:  # while the workers compute
+            if item.action == SKIP:
+                done(Outcome(item, "skipped", item.stored_problems))
+            elif item.action == INVALID:
+                done(Outcome(item, "invalid", (item.reason,)))
+        for item in items:
             if item.action == PLOT:
                 done(_complete_plots(item))
         for future in as_completed(futures):

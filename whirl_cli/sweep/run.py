@@ -4,11 +4,11 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from ..auto.runner import interruptible
-from .execute import execute
+from .execute import Outcome, execute
 from .executors import dask_pool, local_pool, prepare_workers
 from .plan import RUN, plan
 from .report import Reporter, Tally
@@ -16,15 +16,27 @@ from .report import Reporter, Tally
 
 def run_sweep(paths: Sequence[str | os.PathLike[str]], out_dir: Path, jobs: int = 1,
               dask_address: str | None = None, force: bool = False, plots: bool = True,
-              console=None) -> Tally:
+              console=None, on_outcome: Callable[[Outcome, int], None] | None = None
+              ) -> Tally:
     """Plan, execute and report a sweep (what ``whirl sweep`` does): the tally of outcomes.
 
+    ``on_outcome`` is called in this process after each outcome is reported, with the number
+    of studies still running or waiting for a worker (fewer than ``jobs``: a worker is idle).
     The summary is printed in every case; a KeyboardInterrupt propagates after it.
     """
     items = plan(paths, out_dir, force, plots)
-    if any(item.action == RUN for item in items):
+    pending = sum(item.action == RUN for item in items)
+    if pending:
         Path(out_dir).mkdir(parents=True, exist_ok=True)
     reporter = Reporter(len(items), console)
+
+    def report(outcome: Outcome) -> None:
+        nonlocal pending
+        reporter(outcome)
+        pending -= outcome.item.action == RUN
+        if on_outcome is not None:
+            on_outcome(outcome, pending)
+
     interrupted = False
     try:
         with interruptible():  # SIGTERM (a batch system's cancel) stops a sweep like Ctrl-C
@@ -34,7 +46,7 @@ def run_sweep(paths: Sequence[str | os.PathLike[str]], out_dir: Path, jobs: int 
                 prepare_workers(items)
                 pool = local_pool(jobs)
             with pool as executor, reporter:
-                execute(items, executor, plots=plots, report=reporter)
+                execute(items, executor, plots=plots, report=report)
     except KeyboardInterrupt:
         interrupted = True
         raise
