@@ -6,7 +6,8 @@ index (:func:`make_figures`).
    (:func:`whirl_cli.sweep.run.run_sweep`: up-to-date results are reused, studies run in
    parallel, without their own plots);
 3. each sheet is drawn from the stored results and published as ``<out>/fig<n>.png``,
-   during the sweep as soon as its studies are stored and a worker is idle
+   during the sweep as soon as its studies are stored and a worker is idle, the rest after
+   it in parallel
    (complete or not at all); a sheet whose study failed, or whose panel cannot be drawn, is
    reported and left out, the others are drawn. A figure is not redrawn when its PNG holds the
    same key (:func:`figure_key`: the sheet's text, whirl's code, the resolution and the result
@@ -69,9 +70,10 @@ def make_figures(paths: Sequence[str | os.PathLike[str]], out_dir: Path, results
                  ) -> list[FigureOutcome]:
     """Run, draw and index (module docstring); the outcome of every sheet, in figure order.
 
-    A sheet is drawn as soon as its studies are stored and a worker is idle (no study left
-    waiting for one), so the sheets of the short studies are drawn while the long ones still
-    run (what a sheet shows does not depend on when it is drawn)."""
+    While a worker is idle (no study left waiting for one), each study stored lets one sheet
+    whose studies are all stored be drawn, so sheets of the short studies are drawn while the
+    long ones still run; those left after the sweep are drawn ``jobs`` at a time (what a
+    sheet shows does not depend on when or where it is drawn)."""
     from ..output.atomic import publish
     from ..sweep.run import run_sweep
 
@@ -81,12 +83,16 @@ def make_figures(paths: Sequence[str | os.PathLike[str]], out_dir: Path, results
 
     def stored(outcome, pending: int) -> None:
         artist.record(outcome)
-        if pending < jobs:  # a worker is idle: draw what is ready on its core
-            for sheet in sheets:
-                artist.draw_when_ready(sheet)
+        if 0 < pending < jobs:  # a worker is idle: draw one sheet that is ready on its core
+            # (the smallest: the next study's result waits for it); at the end, every sheet
+            # left is drawn in parallel (draw_ready)
+            ready = [s for s in sheets if artist.ready(s)]
+            if ready:
+                artist.draw(min(ready, key=lambda s: len(s.panels)))
 
     run_sweep(studies, results_dir, jobs=jobs, force=force, plots=False, console=console,
               on_outcome=stored)
+    artist.draw_ready(sheets, jobs)
     _make_folder(out_dir)
     outcomes = [artist.outcome(sheet) for sheet in sheets]
     page = index_html([_entry(o, out_dir) for o in outcomes], "whirl figures")
@@ -103,8 +109,8 @@ def _make_folder(out_dir: Path) -> None:
 
 class _Artist:
     """Draws sheets from stored results as they arrive: :meth:`record` each sweep outcome,
-    :meth:`draw_when_ready` a sheet whose studies are all stored, :meth:`outcome` of every
-    sheet at the end (a sheet not drawn yet is drawn then, or said why not)."""
+    :meth:`draw` a sheet that is :meth:`ready` (its studies all stored), :meth:`draw_ready`
+    every one left, :meth:`outcome` of every sheet at the end (why a sheet was not drawn)."""
 
     def __init__(self, out_dir: Path, force: bool, dpi: int) -> None:
         self.out_dir, self.force, self.dpi = out_dir, force, dpi
@@ -120,35 +126,73 @@ class _Artist:
         else:
             self.failed[source] = "; ".join(outcome.problems) or outcome.status
 
-    def draw_when_ready(self, sheet: Sheet) -> None:
-        if sheet.path not in self.done and all(p in self.outputs for p in sheet.studies()):
-            self.done[sheet.path] = self._draw(sheet)
+    def draw(self, sheet: Sheet) -> None:
+        """Draw ``sheet`` (:meth:`ready`) here."""
+        self.done[sheet.path] = self._draw(sheet)
+
+    def draw_ready(self, sheets: Sequence[Sheet], jobs: int) -> None:
+        """Every sheet ready and not drawn yet, ``jobs`` at a time in forked processes (the
+        largest first; each returns its PNG, published here)."""
+        todo = [s for s in sheets if self.ready(s)]
+        keys = {}
+        for sheet in todo:
+            keys[sheet.path], reused = self._reused(sheet)
+            if reused is not None:
+                self.done[sheet.path] = reused
+        todo = sorted((s for s in todo if s.path not in self.done),
+                      key=lambda s: len(s.panels), reverse=True)
+        from ..interrupts import forked_map
+
+        images = forked_map(lambda k: self._image(todo[k], keys[todo[k].path]), len(todo),
+                            jobs)
+        for sheet, (image, problem) in zip(todo, images, strict=True):
+            self.done[sheet.path] = self._published(sheet, image, problem)
 
     def outcome(self, sheet: Sheet) -> FigureOutcome:
-        self.draw_when_ready(sheet)
+        if self.ready(sheet):
+            self.draw(sheet)
         if sheet.path in self.done:
             return self.done[sheet.path]
         missing = [f"{p}: {self.failed.get(p, 'no result')}" for p in sheet.studies()
                    if p not in self.outputs]
         return FigureOutcome(sheet, None, "; ".join(missing))
 
-    def _draw(self, sheet: Sheet) -> FigureOutcome:
-        from ..output import store
-        from ..output.atomic import publish
-        from .draw import draw_sheet
+    def ready(self, sheet: Sheet) -> bool:
+        """Not drawn yet, and every study it draws is stored."""
+        return sheet.path not in self.done and all(p in self.outputs for p in sheet.studies())
 
+    def _draw(self, sheet: Sheet) -> FigureOutcome:
+        key, reused = self._reused(sheet)
+        return reused or self._published(sheet, *self._image(sheet, key))
+
+    def _reused(self, sheet: Sheet) -> tuple[str, FigureOutcome | None]:
+        """The sheet's :func:`figure_key`, and its outcome if its PNG has that key."""
         target = self.out_dir / f"{sheet.stem}.png"
         key = figure_key(sheet, [self.outputs[p] for p in sheet.studies()], self.dpi)
         if not self.force and stored_key(target) == key:
-            return FigureOutcome(sheet, target, reused=True)
+            return key, FigureOutcome(sheet, target, reused=True)
+        return key, None
+
+    def _image(self, sheet: Sheet, key: str) -> tuple[bytes | None, str]:
+        """The sheet's PNG (carrying ``key``), or None and why it cannot be drawn."""
+        from ..output import store
+        from .draw import draw_sheet
+
         try:
             for path in sheet.studies():
                 if path not in self.read:
                     self.read[path] = store.read(self.outputs[path])
-            image = _render(draw_sheet(sheet, self.read), self.dpi, {KEY: key})
+            return _render(draw_sheet(sheet, self.read), self.dpi, {KEY: key}), ""
         except WhirlError as error:
-            return FigureOutcome(sheet, None, str(error))
+            return None, str(error)
+
+    def _published(self, sheet: Sheet, image: bytes | None, problem: str) -> FigureOutcome:
+        from ..output.atomic import publish
+
+        if image is None:
+            return FigureOutcome(sheet, None, problem)
         _make_folder(self.out_dir)
+        target = self.out_dir / f"{sheet.stem}.png"
         return FigureOutcome(sheet, publish(image, target, overwrite=True, what="the figure"))
 
 

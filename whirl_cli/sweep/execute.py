@@ -148,12 +148,22 @@ def _stop_running(executor: Executor, futures: Iterable[Future], grace: float = 
 
 def expected_cost(item: SweepItem) -> int:
     """A rough relative cost of a study, to start the long ones first: periodic families and
-    time-simulation cross-checks dominate."""
+    time-simulation cross-checks dominate a one-parameter continuation; a two-parameter one
+    is one such continuation per slice and then its loci per slice (loci of folds of cycles
+    are periodic problems: the most expensive by far, e.g. boundary_combined's 175 runs);
+    a time simulation costs about what a periodic family does."""
     study = item.study
     if study is None:
         return 0
-    periodic = sum(bool(getattr(c, "periodic", False)) for c in study.continuations)
-    return 1 + len(study.continuations) + 2 * periodic + 2 * periodic * bool(study.cross_check)
+    cost = 1 + 3 * len(study.simulations)
+    for spec in study.continuations:
+        if spec.type == "two-parameter":
+            cost += len(spec.slices) * (3 + 2 * len(spec.loci)
+                                        + 6 * ("fold_of_cycles" in spec.loci))
+        else:
+            periodic = bool(getattr(spec, "periodic", False))
+            cost += 1 + 2 * periodic + 2 * periodic * bool(study.cross_check)
+    return cost
 
 
 def _store(item: SweepItem, future: Future, plots: bool) -> Outcome:
