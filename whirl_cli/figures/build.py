@@ -88,7 +88,7 @@ def make_figures(paths: Sequence[str | os.PathLike[str]], out_dir: Path, results
             # left is drawn in parallel (draw_ready)
             ready = [s for s in sheets if artist.ready(s)]
             if ready:
-                artist.draw(min(ready, key=lambda s: len(s.panels)))
+                artist.draw_ready([min(ready, key=lambda s: len(s.panels))], jobs=1)
 
     run_sweep(studies, results_dir, jobs=jobs, force=force, plots=False, console=console,
               on_outcome=stored)
@@ -109,8 +109,8 @@ def _make_folder(out_dir: Path) -> None:
 
 class _Artist:
     """Draws sheets from stored results as they arrive: :meth:`record` each sweep outcome,
-    :meth:`draw` a sheet that is :meth:`ready` (its studies all stored), :meth:`draw_ready`
-    every one left, :meth:`outcome` of every sheet at the end (why a sheet was not drawn)."""
+    :meth:`draw_ready` sheets that are :meth:`ready` (their studies all stored),
+    :meth:`outcome` of every sheet at the end (why a sheet was not drawn)."""
 
     def __init__(self, out_dir: Path, force: bool, dpi: int) -> None:
         self.out_dir, self.force, self.dpi = out_dir, force, dpi
@@ -126,13 +126,10 @@ class _Artist:
         else:
             self.failed[source] = "; ".join(outcome.problems) or outcome.status
 
-    def draw(self, sheet: Sheet) -> None:
-        """Draw ``sheet`` (:meth:`ready`) here."""
-        self.done[sheet.path] = self._draw(sheet)
-
     def draw_ready(self, sheets: Sequence[Sheet], jobs: int) -> None:
-        """Every sheet ready and not drawn yet, ``jobs`` at a time in forked processes (the
-        largest first; each returns its PNG, published here)."""
+        """Every sheet of ``sheets`` that is ready, ``jobs`` at a time in forked processes
+        (in this one if ``jobs`` < 2; the largest first; each returns its PNG, published
+        here)."""
         todo = [s for s in sheets if self.ready(s)]
         keys = {}
         for sheet in todo:
@@ -149,8 +146,7 @@ class _Artist:
             self.done[sheet.path] = self._published(sheet, image, problem)
 
     def outcome(self, sheet: Sheet) -> FigureOutcome:
-        if self.ready(sheet):
-            self.draw(sheet)
+        """``sheet``'s outcome once every ready sheet is drawn (:meth:`draw_ready`)."""
         if sheet.path in self.done:
             return self.done[sheet.path]
         missing = [f"{p}: {self.failed.get(p, 'no result')}" for p in sheet.studies()
@@ -160,10 +156,6 @@ class _Artist:
     def ready(self, sheet: Sheet) -> bool:
         """Not drawn yet, and every study it draws is stored."""
         return sheet.path not in self.done and all(p in self.outputs for p in sheet.studies())
-
-    def _draw(self, sheet: Sheet) -> FigureOutcome:
-        key, reused = self._reused(sheet)
-        return reused or self._published(sheet, *self._image(sheet, key))
 
     def _reused(self, sheet: Sheet) -> tuple[str, FigureOutcome | None]:
         """The sheet's :func:`figure_key`, and its outcome if its PNG has that key."""
