@@ -290,7 +290,8 @@ def _two_parameter(engine: Engine, study: Study, spec, parameters: dict[str, flo
     orbits, outcomes = slice_seeds(model, parameters, spec, engine.jobs)
     continuation, curves = two_parameter(engine, spec.name, pair, bounds, spec.start,
                                          spec.slice_values, tuple(spec.loci), parameters,
-                                         numerics, slice_orbits=orbits)
+                                         numerics, slice_orbits=orbits,
+                                         snaking_folds=spec.snaking_folds)
     continuation = replace(continuation, seeds=outcomes)
     per_slice = [tuple(b for b in continuation.branches if b.name.startswith(f"slice_{k}."))
                  for k in range(len(spec.slices))]

@@ -163,3 +163,42 @@ def test_loci_and_slices_methods_agree(results, name):
         assert a.lower == pytest.approx(b.lower, abs=2e-3)
         assert a.upper == pytest.approx(b.upper, abs=2e-3)
     assert all(b.kind != BranchKind.PERIODIC or len(b) for b in per_slice[0])
+
+
+def test_the_outermost_folds_of_snaking_families_draw_the_same_boundary(tmp_path):
+    """Hardening at K_psi = 0.2, where two families snake toward a homoclinic orbit (six and
+    eight folds of cycles at one point of the slice): with ``snaking_folds: outermost`` every
+    point of the loci traced with ``all`` lies within 3e-3 of the ranges of the loci drawn
+    (and the other way round within 1e-3), the unsafe intervals are the same, and fewer AUTO
+    runs are made."""
+    from whirl_cli.continuation.geometry import _on_paths
+
+    found = {}
+    for mode in ("all", "outermost"):
+        text = (STUDIES / "boundary_hardening.yaml").read_text()
+        assert "snaking_folds: outermost" in text
+        text = text.replace("snaking_folds: outermost", f"snaking_folds: {mode}")
+        text = text.replace("slices: [0.4, 0.3, 0.2, 0.05, 0.037]", "slices: [0.2]")
+        text = text.replace("points: 321", "points: 81").replace("points: 201", "points: 81")
+        study = validate_text(text, "boundary_hardening.yaml")
+        found[mode] = run_study(study, tmp_path / mode, jobs=2)
+    (spec,) = study.continuations
+    bounds = spec.bounds(study.names())
+    width = np.array([bounds[p][1] - bounds[p][0] for p in spec.parameters])
+
+    def picture(result):
+        return [b.parameters[:, :2] / width for b in result.continuations[0].branches
+                if b.kind.endswith("_locus")]
+
+    every, outer = picture(found["all"]), picture(found["outermost"])
+    assert all(_on_paths(curve, outer, 3e-3).all() for curve in every)
+    assert all(_on_paths(curve, every, 1e-3).all() for curve in outer)
+
+    def intervals(result):
+        return sorted((i.cause, i.lower, i.upper) for i in result.boundaries[0].intervals)
+
+    assert intervals(found["all"]) and len(intervals(found["all"])) == len(
+        intervals(found["outermost"]))
+    for a, b in zip(intervals(found["all"]), intervals(found["outermost"]), strict=True):
+        assert a[0] == b[0] and a[1:] == pytest.approx(b[1:], abs=1e-6)
+    assert len(found["outermost"].runs) < len(found["all"].runs) - 20

@@ -103,6 +103,33 @@ def test_mirror_image_starts_are_traced_once():
     assert [k for k, _, _ in kept] == [1, 3, 4]
 
 
+def test_of_a_snaking_familys_folds_only_the_outermost_start_loci():
+    """Three or more folds of cycles of one family at one point of a slice (to 1e-3 of the
+    ranges; periods growing along a family snaking toward a homoclinic orbit): only the lowest-
+    and highest-period ones start loci. Two folds, another family's, a fold elsewhere on the
+    slice and other point types are kept."""
+    from whirl_cli.continuation.loci import _outermost_folds
+    from whirl_cli.results import PointType, SpecialPoint
+
+    def start(kind: PointType, branch: str, k1: float, period: float) -> SpecialPoint:
+        return SpecialPoint(branch, 3, int(kind), ("K1", "K_psi"), np.array([k1, 0.2]),
+                            np.array([0.1, 0.0]), period, False)
+
+    snake, other = "slice_2.periodic_1", "slice_2.periodic_2"
+    starts = [(1, start(PointType.LPC, snake, -0.0813, 0.75), "r1"),
+              (2, start(PointType.LPC, snake, -0.0807, 1.64), "r1"),   # 6e-4 away (width 0.8)
+              (3, start(PointType.LPC, snake, -0.0817, 1.08), "r1"),
+              (4, start(PointType.LPC, snake, -0.0815, 0.87), "r1"),
+              (5, start(PointType.LPC, snake, -0.0408, 0.33), "r1"),   # elsewhere on it
+              (6, start(PointType.LPC, other, -0.0815, 0.38), "r2"),   # two of another family
+              (7, start(PointType.LPC, other, -0.0816, 0.44), "r2"),
+              (8, start(PointType.HB, snake, -0.0814, 0.26), "r1"),
+              (9, start(PointType.HB, snake, -0.0814, 0.27), "r1"),
+              (10, start(PointType.HB, snake, -0.0814, 0.28), "r1")]
+    kept = _outermost_folds(starts, np.array([0.8, 0.5]))
+    assert [k for k, _, _ in kept] == [1, 2, 5, 6, 7, 8, 9, 10]
+
+
 def test_a_locus_that_passed_the_range_edge_ends_there_and_is_not_continued():
     """AUTO locates no UZSTOP in the first step after a restart: a locus continued chunk by
     chunk from just inside the edge can end beyond it. That is the range's end, like one on

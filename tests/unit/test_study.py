@@ -413,7 +413,7 @@ def test_continuation_keys():
     assert problems(HEAD + item.format("k", "two-parameter", "K1")) == [
         "s.yaml:4: continuations[0].parameters: required key is missing",
         "s.yaml:6: continuations[0].parameter: unknown key (allowed: name, type, parameters, "
-        "range, start, slices, seeds, loci, method, resolution)",
+        "range, start, slices, seeds, loci, snaking_folds, method, resolution)",
         "s.yaml:7: continuations[0].range: expected a mapping, got a list",
     ]
     assert problems(HEAD + item.format("k", "one-parameter", "K_phi")) == [

@@ -72,13 +72,14 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
                   bounds: dict[str, tuple[float, float]], start: float,
                   slices: tuple[float, ...], loci: tuple[str, ...],
                   parameters: dict[str, float], numerics: Numerics,
-                  slice_orbits: tuple[tuple[OrbitStart, ...], ...] = ()
-                  ) -> tuple[ContinuationResult, list[Branch]]:
+                  slice_orbits: tuple[tuple[OrbitStart, ...], ...] = (),
+                  snaking_folds: str = "all") -> tuple[ContinuationResult, list[Branch]]:
     """One-parameter runs at every slice of the second parameter, then the loci of their
     special points (both directions, each locus once). Returns the continuation (slice branches
     named ``slice_<k>.<branch>`` and the locus branches) and the locus branches.
     ``slice_orbits``: per slice, orbits (e.g. settled seeds) whose periodic families that
-    slice's run continues too (their folds of cycles start loci as a Hopf family's do)."""
+    slice's run continues too (their folds of cycles start loci as a Hopf family's do).
+    ``snaking_folds``: "all", or "outermost" (:func:`_outermost_folds`)."""
     first, second = pair
     wanted = {kind for kind, (locus, _) in LOCI.items() if locus in loci}
     periodic = any(kind in wanted for kind in CYCLE_LOCI)
@@ -108,7 +109,8 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
                     and _same_point(named, other, width, amplitudes)
                     for other, _ in starts):
                 starts.append((named, runs[point.branch]))
-    curves = _loci(engine, name, pair, bounds, numerics, starts)
+    curves = _loci(engine, name, pair, bounds, numerics, starts,
+                   outermost=snaking_folds == "outermost")
     for curve in curves:
         points += special_points(curve, skip_first=True)
     return (ContinuationResult(name, "two-parameter", tuple(branches + curves), tuple(points)),
@@ -127,8 +129,9 @@ def _starts_locus(point: SpecialPoint) -> bool:
 
 def _loci(engine: Engine, name: str, pair: tuple[str, str],
           bounds: dict[str, tuple[float, float]], numerics: Numerics,
-          starts: list[tuple[SpecialPoint, str]]) -> list[Branch]:
-    """Locus branches from the start points, both directions, each locus once.
+          starts: list[tuple[SpecialPoint, str]], outermost: bool = False) -> list[Branch]:
+    """Locus branches from the start points, both directions, each locus once (``outermost``:
+    of the folds of cycles of a snaking family only the outermost, :func:`_outermost_folds`).
 
     Starts are taken slice by slice (a wave per slice): a start lying on a locus of its type
     already traced from an earlier slice is the same locus and is not run again, nor is a
@@ -151,10 +154,11 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
 
     def todo(wave: list, also: list[tuple[int, Branch]] = ()
              ) -> list[tuple[int, SpecialPoint, str]]:
-        return _without_twins([(k, point, runs) for k, point, runs in wave if not any(
+        distinct = _without_twins([(k, point, runs) for k, point, runs in wave if not any(
             kind == point.point_type and _near_polyline(point.parameters[:2], curve.parameters,
                                                         width)
             for kind, curve in [*curves, *also])], width)
+        return _outermost_folds(distinct, width) if outermost else distinct
 
     def following(waves: list[list]) -> tuple[list | None, list]:
         """The next wave with starts still to trace (one without any stays so: more loci
@@ -240,6 +244,30 @@ def _without_twins(starts: list[tuple[int, SpecialPoint, str]], width: np.ndarra
                    for _, other, _ in kept):
             kept.append((k, point, runs))
     return kept
+
+
+def _outermost_folds(starts: list[tuple[int, SpecialPoint, str]], width: np.ndarray
+                     ) -> list[tuple[int, SpecialPoint, str]]:
+    """``starts`` without the inner folds of cycles of every bundle: three or more folds of
+    cycles of one family (branch) within 1e-3 of the ranges of the bundle's first, as the folds
+    of a family snaking toward a homoclinic orbit are (nearly the same parameters, periods
+    growing along it); of those only the lowest- and highest-period ones are kept. Their loci
+    run along the homoclinic locus and the inner ones' lie along theirs."""
+    bundles: list[list[tuple[int, SpecialPoint, str]]] = []
+    for start in starts:
+        point = start[1]
+        bundle = next((b for b in bundles if point.point_type == PointType.LPC
+                       and b[0][1].point_type == PointType.LPC
+                       and b[0][1].branch == point.branch
+                       and np.all(np.abs(point.parameters[:2] - b[0][1].parameters[:2])
+                                  <= 1e-3 * width)), None)
+        if bundle is None:
+            bundles.append([start])
+        else:
+            bundle.append(start)
+    inner = {k for bundle in bundles if len(bundle) >= 3
+             for k, _, _ in sorted(bundle, key=lambda start: start[1].period)[1:-1]}
+    return [start for start in starts if start[0] not in inner]
 
 
 def _distinct(curves: dict[int, tuple[int, RunSpec | None, Branch]],
