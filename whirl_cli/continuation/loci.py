@@ -256,9 +256,9 @@ def _outermost_folds(starts: list[tuple[int, SpecialPoint, str]], width: np.ndar
     bundles: list[list[tuple[int, SpecialPoint, str]]] = []
     for start in starts:
         point = start[1]
-        bundle = next((b for b in bundles if point.point_type == PointType.LPC
-                       and b[0][1].point_type == PointType.LPC
-                       and b[0][1].branch == point.branch
+        if point.point_type != PointType.LPC:
+            continue
+        bundle = next((b for b in bundles if b[0][1].branch == point.branch
                        and np.all(np.abs(point.parameters[:2] - b[0][1].parameters[:2])
                                   <= 1e-3 * width)), None)
         if bundle is None:
