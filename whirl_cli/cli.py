@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
 import sys
 from pathlib import Path
 
@@ -26,6 +27,11 @@ def _console():
     from rich.console import Console
 
     return Console(stderr=True, highlight=False)
+
+
+def _say(text: str, end: str = "\n") -> None:
+    """A line of ``whirl run``'s report on stderr, as written (no markup, no wrapping)."""
+    click.echo(text + end, err=True, nl=False)
 
 
 def _show_version(ctx: click.Context, _param: click.Parameter, value: bool) -> None:
@@ -83,55 +89,51 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     except OSError as error:
         raise OutputError(f"{output}: cannot create the output directory "
                           f"({error.strerror or error})") from None
-    console = _console()
 
     def report(outcome) -> None:
         # an MX is only said to be a problem at the end: at a period blow-up it is expected
         mark = "ok" if outcome.success else outcome.status.upper()
         detail = {"ok": "", "mx": "  no convergence (MX)"}.get(outcome.status,
                                                                f"  {outcome.message}")
-        console.print(f"  {outcome.name:<32} {mark:<8} {outcome.n_points:>6} points "
-                      f"{outcome.wall_seconds:7.3f} s{detail}", soft_wrap=True)
+        _say(f"  {outcome.name:<32} {mark:<8} {outcome.n_points:>6} points "
+             f"{outcome.wall_seconds:7.3f} s{detail}")
 
-    console.print(f"whirl {_version()}: {study.path} -> {output}", soft_wrap=True)
+    _say(f"whirl {_version()}: {study.path} -> {output}")
     from . import api
-    from .interrupts import catching
+    from .interrupts import catching, preloaded
+    from .output.summary import MODULES as TABLE_MODULES
+    from .output.summary import render
     from .plots import MODULES as PLOT_MODULES
     from .verdict import verdict
 
     with catching():  # an interrupt while plots are drawn is never lost either
-        result = api.run(study, jobs=jobs, on_run=report, keep_runs=keep_runs,
-                         preload=PLOT_MODULES if plots and study.plots else ())
+        later = (*TABLE_MODULES, *(PLOT_MODULES if plots and study.plots else ()))
+        result = api.run(study, jobs=jobs, on_run=report, keep_runs=keep_runs, preload=later)
         published = api.save(result, output, study.plots if plots else (), overwrite,
                              state=study.plot_state, jobs=jobs)
     for path in published.paths:
-        console.print(f"wrote {path}", soft_wrap=True)
+        _say(f"wrote {path}")
     found = verdict(result, published.plot_error)
     for note in found.notes:
-        console.print(f"note: {note}", soft_wrap=True)
-    from .output.summary import render
-
-    console.print(render(result, "table", study.variant().family.dof_names,
-                         console.width if console.is_terminal else None),
-                  end="", soft_wrap=True, markup=False)
+        _say(f"note: {note}")
+    width = shutil.get_terminal_size().columns if sys.stderr.isatty() else None
+    preloaded()  # rich's modules, imported while AUTO ran: never by two threads at once
+    _say(render(result, "table", study.variant().family.dof_names, width), end="")
     checks = [x for c in result.continuations for x in c.cross_checks]
     if checks:
-        console.print(f"cross-checks by time simulation: {sum(x.passed for x in checks)} of "
-                      f"{len(checks)} passed")
+        _say(f"cross-checks by time simulation: {sum(x.passed for x in checks)} of "
+             f"{len(checks)} passed")
     for continuation in result.continuations:
         for explored in continuation.explorations:
             frequencies = ", ".join(f"{f:.4g}" for f in explored.frequencies)
-            console.print(
-                f"{continuation.name} explore {explored.parameter} = {explored.value:g}: "
-                f"{explored.kind}" + (f" at {frequencies} Hz" if frequencies else "")
-                + f", lambda = {explored.lyapunov:.3g} +- {explored.lyapunov_error:.2g} 1/s",
-                soft_wrap=True, markup=False)
+            _say(f"{continuation.name} explore {explored.parameter} = {explored.value:g}: "
+                 f"{explored.kind}" + (f" at {frequencies} Hz" if frequencies else "")
+                 + f", lambda = {explored.lyapunov:.3g} +- {explored.lyapunov_error:.2g} 1/s")
     for sim in result.simulations:
         state = "ok" if sim.status == 0 else ("stopped" if sim.status > 0 else "FAILED")
-        console.print(f"simulation {sim.name}: {len(sim.time)} samples to "
-                      f"{sim.time[-1] if len(sim.time) else 0:.6g} s, {state}"
-                      + ("" if sim.status == 0 else f": {sim.message}"), soft_wrap=True,
-                      markup=False)
+        _say(f"simulation {sim.name}: {len(sim.time)} samples to "
+             f"{sim.time[-1] if len(sim.time) else 0:.6g} s, {state}"
+             + ("" if sim.status == 0 else f": {sim.message}"))
     if found.problems:
         raise WhirlError(f"{len(found.problems)} problem(s); the results are stored with "
                          "their status: " + "; ".join(found.problems))
@@ -157,7 +159,6 @@ def summary(result_file: Path, output_format: str) -> None:
     result = api.read(result_file)
     study = _stored_study(result)
     dofs = study.variant().family.dof_names if study is not None else None
-    import shutil
 
     width = shutil.get_terminal_size().columns if sys.stdout.isatty() else None
     click.echo(render(result, output_format, dofs, width), nl=False)

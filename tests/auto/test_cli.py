@@ -65,6 +65,20 @@ def test_store_round_trip(tmp_path):
         "copy_damping_multiples.png", "copy_linear_V.png", "copy_root_locus_V.png"]
 
 
+def test_run_reports_paths_as_written(tmp_path):
+    """Brackets in a path are text, not console markup ("[b]" once vanished as "bold")."""
+    folder = tmp_path / "[b] draft"
+    folder.mkdir()
+    study = folder / "airspeed.yaml"
+    study.write_text((STUDIES / "linear_datum_airspeed.yaml").read_text())
+    output = folder / "[v2].h5"
+    ran = CliRunner().invoke(cli, ["run", str(study), "-o", str(output), "--no-plots"])
+    assert ran.exit_code == 0, ran.output
+    lines = ran.stderr.splitlines()
+    assert lines[0].endswith(f": {study} -> {output}")
+    assert f"wrote {output}" in lines
+
+
 def test_validate_models_and_doctor():
     runner = CliRunner()
     ok = runner.invoke(cli, ["validate", str(STUDIES / "combined_case3.yaml")])

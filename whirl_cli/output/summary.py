@@ -28,6 +28,10 @@ import numpy as np
 from ..results import Branch, ContinuationResult, PointType, SpecialPoint, StudyResult
 from ..units import axis_label, display_unit
 
+#: The modules a table imports (rich's, about 0.03 s): what ``whirl run`` preloads while AUTO
+#: runs (:func:`whirl_cli.interrupts.preload`).
+MODULES = ("rich.console", "rich.table", "rich.markup")
+
 FORMATS = ("table", "csv", "json")
 """Formats of ``whirl summary --format``."""
 
