@@ -68,6 +68,25 @@ def test_a_locus_that_runs_onto_a_closed_loop_is_cut_after_one_turn_of_it():
     assert len(lead) + 200 <= len(cut) <= len(lead) + 210
 
 
+def test_a_locus_round_a_loop_whose_sampled_extremes_jitter_is_cut_after_one_lap():
+    """The extremes are maxima over AUTO's mesh: round a closed locus they differ by a few per
+    cent from lap to lap (the gimballed hub's rates), so the extremes never match; the period
+    does. Cut where the second lap begins, once it has retraced the whole first one. A loop
+    whose period changes from lap to lap (another orbit each time) goes on."""
+    from dataclasses import replace
+
+    from whirl_cli.continuation.geometry import _closed
+
+    lead = np.column_stack([np.linspace(0.9, 0.7, 41), np.full(41, 0.5)])[:-1]
+    curve = np.vstack([lead, _circle(4.0, centre=(0.5, 0.5))])
+    jitter = 0.1 * (1 + 0.03 * np.sin(np.arange(len(curve)) * 2.7))  # 3 %, no lap alike
+    locus = _locus(curve, jitter)
+    cut = _closed(replace(locus, period=np.full(len(curve), 0.5)), np.ones(2))
+    assert len(lead) + 200 <= len(cut) <= len(lead) + 210
+    growing = np.linspace(0.5, 0.9, len(curve))  # 0.1 of its spread per lap
+    assert len(_closed(replace(locus, period=growing), np.ones(2))) == len(curve)
+
+
 def test_a_hairpin_or_a_crossing_of_the_projection_is_not_cut():
     """At a cusp a locus comes back along itself the other way; elsewhere its projection on
     the parameters may pass over an earlier stretch where the orbit differs: neither is a

@@ -55,9 +55,7 @@ def locus_coordinates(curve: Branch, width: np.ndarray, scale: np.ndarray) -> np
 def extreme_scale(curves: list[Branch]) -> np.ndarray:
     """(2n,) the spread of every orbit extreme over ``curves`` (1 where it does not vary: the
     loci of equilibria)."""
-    extremes = np.vstack([np.hstack([c.state_max, c.state_min]) for c in curves])
-    spread = np.ptp(extremes, axis=0)
-    return np.where(spread > 0, spread, 1.0)
+    return _spread(np.vstack([np.hstack([c.state_max, c.state_min]) for c in curves]))
 
 
 def _on_paths(points: np.ndarray, paths: list[np.ndarray], tolerance: float = 1e-3
@@ -101,25 +99,41 @@ def _closed(curve: Branch, width: np.ndarray, follow: int = 5) -> Branch:
     period: it is cut there too, the next one's own locus going on; :func:`whirl_cli.
     continuation.loci._locus_end` tells the two ends apart), elsewhere also in the orbit's
     extremes (scaled by their spread along the locus; the parameter projection of a locus
-    may pass over itself)."""
+    may pass over itself) or, on a locus of cycles, in its period instead (scaled likewise)
+    for a whole lap (the points since the earlier one, repeated): the extremes are maxima over
+    AUTO's mesh, and round a closed locus the mesh points fall elsewhere on the orbit from lap
+    to lap, so the extremes of a fast state (the gimballed hub's rates) differ by a few per
+    cent at the same point of the locus, which then goes round until its step limit."""
     if len(curve) < 10:
         return curve
     scaled = curve.parameters[:, :2] / width
     extremes = np.hstack([curve.state_max, curve.state_min])
-    spread = np.ptp(extremes, axis=0)
-    full = np.hstack([scaled, extremes / np.where(spread > 0, spread, 1.0)])
+    # (coordinates, True if a whole lap must repeat): the extremes, and on a locus of cycles
+    # the period, which must then retrace the whole stretch since the earlier point
+    paths = [(np.hstack([scaled, extremes / _spread(extremes)]), False)]
+    period = np.asarray(curve.period, dtype=float)[:, None]
+    if np.isfinite(period).all():
+        paths.append((np.hstack([scaled, period / _spread(period)]), True))
     from_start = np.abs(scaled - scaled[0]).max(axis=1)
     away = np.maximum.accumulate(from_start) > 0.02
-    farthest = np.zeros(len(full))  # how far the curve got from each point since it
-    for j in range(1, len(full)):
+    # how far the curve got from each point since it, in each path's coordinates
+    farthest = [np.zeros(len(curve)) for _ in paths]
+    for j in range(1, len(curve)):
         if away[j] and from_start[j] < 0.005:
             return head(curve, j + 1)
-        distance = np.abs(full[:j] - full[j]).max(axis=1)
-        farthest[:j] = np.maximum(farthest[:j], distance)
-        for i in np.flatnonzero((distance < 0.005) & (farthest[:j] > 0.02)):
-            if i > 0 and _follows(full, int(i), j, follow):
-                return head(curve, j + 1)
+        for (full, lap), far in zip(paths, farthest, strict=True):
+            distance = np.abs(full[:j] - full[j]).max(axis=1)
+            far[:j] = np.maximum(far[:j], distance)
+            for i in np.flatnonzero((distance < 0.005) & (far[:j] > 0.02)):
+                if i > 0 and _follows(full, int(i), j, max(follow, j - i - 1) if lap else follow):
+                    return head(curve, j + 1)
     return curve
+
+
+def _spread(values: np.ndarray) -> np.ndarray:
+    """The spread of each column of ``values`` (1 where it does not vary)."""
+    spread = np.ptp(values, axis=0)
+    return np.where(spread > 0, spread, 1.0)
 
 
 def _follows(points: np.ndarray, i: int, j: int, follow: int) -> bool:
