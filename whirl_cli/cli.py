@@ -68,7 +68,7 @@ def _output_file(ctx: click.Context, param: click.Parameter, value: str | None) 
               help="HDF5 result file [default: <study name>.h5 in the current directory].")
 @click.option("-j", "--jobs", type=click.IntRange(1, 64), default=min(os.cpu_count() or 1, 64),
               show_default=True,
-              help="AUTO runs (and time-simulation cross-checks, and plots) in parallel.")
+              help="AUTO runs (and time simulations, and plots) in parallel.")
 @click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
 @click.option("--plots/--no-plots", default=True, show_default=True,
               help="Write the study's plots (PNG) next to the output file.")

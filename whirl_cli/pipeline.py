@@ -120,7 +120,7 @@ def _run_study(study: Study, workroot: Path, jobs: int,
         linear_sweeps=tuple(sweeps), runs=engine.records() if engine else (),
         attributes=provenance(study), boundaries=tuple(found_boundaries), linear_grid=grid,
         parameters=resolved_parameters(model, parameters),
-        simulations=tuple(simulations(study, model)))
+        simulations=tuple(simulations(study, model, jobs)))
 
 
 def _only_checks_simulate(study: Study, model) -> bool:
@@ -167,13 +167,26 @@ def repeated(continued: Callable, name: str, parameters: dict[str, float],
     return thread_map(one, range(len(persistence.FACTORS)), len(persistence.FACTORS))
 
 
-def simulations(study: Study, model) -> list[Simulation]:
+def simulations(study: Study, model, jobs: int = 1) -> list[Simulation]:
     """The study's ``simulations:``, each from its initial state (degrees -> SI) with its
-    overrides on top of the study's parameters (scipy; a failure is in the result)."""
-    return [simulate.simulation(
-        model, model.parameter_vector(study.simulation_values(spec)),
-        seeds.seed_state(model, spec.initial), spec.duration, spec.samples, spec.law,
-        str(spec.name), study.simulation_overrides(spec)) for spec in study.simulations]
+    overrides on top of the study's parameters (scipy; a failure is in the result), ``jobs``
+    at a time in forked processes (:func:`whirl_cli.interrupts.forked_map`: each is
+    independent of the others, so the results are identical for any ``jobs``, in the study's
+    order)."""
+    specs = study.simulations
+    if not specs:
+        return []
+    for module in simulate.MODULES:  # imported here, once, not by each forked worker
+        importlib.import_module(module)
+
+    def simulated(k: int) -> Simulation:
+        spec = specs[k]
+        return simulate.simulation(
+            model, model.parameter_vector(study.simulation_values(spec)),
+            seeds.seed_state(model, spec.initial), spec.duration, spec.samples, spec.law,
+            str(spec.name), study.simulation_overrides(spec))
+
+    return forked_map(simulated, len(specs), jobs)
 
 
 def explorations(model, overrides: dict[str, float], spec,

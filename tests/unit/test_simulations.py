@@ -136,7 +136,8 @@ plots: [time_history, hub_path]
 
 def test_a_study_of_simulations_alone_runs_without_auto(monkeypatch, tmp_path, model):
     """Names default to sim_<k>; initial states in deg and deg/s become SI; the overrides
-    go on top of the study's (K_psi = 0.3 and V = 7.9 give the closed form); no AUTO."""
+    go on top of the study's (K_psi = 0.3 and V = 7.9 give the closed form); no AUTO; with
+    two jobs (forked workers) the same results in the same order."""
     def no_auto(*args, **kwargs):
         raise AssertionError("a study without continuations started AUTO")
 
@@ -153,6 +154,11 @@ def test_a_study_of_simulations_alone_runs_without_auto(monkeypatch, tmp_path, m
     expected = closed_form(model, params, first.initial, first.time)
     assert np.abs(first.states - expected).max() < 1e-6 * np.abs(expected).max()
     assert len(rest.time) == 2001 and not rest.states.any()  # the default samples; at rest
+    forked = pipeline.run_study(study, tmp_path, jobs=2).simulations  # one process each
+    assert [s.name for s in forked] == ["sim_1", "rest"]
+    for alone, beside in zip(result.simulations, forked, strict=True):
+        np.testing.assert_array_equal(alone.time, beside.time)
+        np.testing.assert_array_equal(alone.states, beside.states)
     names = plot_names(result, ("time_history", "hub_path"), "out")
     assert names == ["out_sim_1_time_history.png", "out_rest_time_history.png",
                      "out_sim_1_hub_path.png", "out_rest_hub_path.png"]
