@@ -167,6 +167,13 @@ def repeated(continued: Callable, name: str, parameters: dict[str, float],
     return thread_map(one, range(len(persistence.FACTORS)), len(persistence.FACTORS))
 
 
+def _import_integrators() -> None:
+    """Import scipy's integrators (:data:`whirl_cli.analysis.simulate.MODULES`) here, once,
+    before workers fork: they inherit them instead of each importing them."""
+    for module in simulate.MODULES:
+        importlib.import_module(module)
+
+
 def simulations(study: Study, model, jobs: int = 1) -> list[Simulation]:
     """The study's ``simulations:``, each from its initial state (degrees -> SI) with its
     overrides on top of the study's parameters (scipy; a failure is in the result), ``jobs``
@@ -176,8 +183,7 @@ def simulations(study: Study, model, jobs: int = 1) -> list[Simulation]:
     specs = study.simulations
     if not specs:
         return []
-    for module in simulate.MODULES:  # imported here, once, not by each forked worker
-        importlib.import_module(module)
+    _import_integrators()
 
     def simulated(k: int) -> Simulation:
         spec = specs[k]
@@ -250,8 +256,7 @@ def seeded_orbits(model, overrides: dict[str, float], parameter: str, start: flo
         initial = seeds.auto_seeds(model, values)
     else:
         initial = [seeds.seed_state(model, state) for state in given]
-    for module in simulate.MODULES:  # imported here, once, not by each forked worker
-        importlib.import_module(module)
+    _import_integrators()
     settled = forked_map(lambda k: seeds.settle(model, params, initial[k]), len(initial),
                          jobs)
     kept = seeds.distinct(settled)
