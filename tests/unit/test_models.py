@@ -107,3 +107,23 @@ def test_names_and_variants(model):
         model.canonical("K1")  # the thesis' name belongs to a study with one law
     with pytest.raises(KeyError):
         model.canonical("K_phi")
+
+
+def test_the_linearity_probe_agrees_with_the_declared_laws():
+    """``continuation.equilibria.is_linear`` (the right-hand side against its Jacobian at one
+    probe state) and ``Model.is_linear`` (the family and every law declared K x) agree for
+    every shipped variant at its datum and with each law coefficient moved off it."""
+    from whirl_cli.continuation.equilibria import is_linear
+
+    answers = []
+    for variant in all_variants():
+        cases = [{}]
+        for dof in variant.family.dof_names:
+            stiffness = variant.family.dof(dof).stiffness
+            cases += [{name: 1.5 * variant.defaults()[name] + 0.01}
+                      for name in variant.coefficient_names(dof).values() if name != stiffness]
+        for values in cases:
+            declared = variant.is_linear(values)
+            assert is_linear(variant, values) == declared, (variant.name, values)
+            answers.append(declared)
+    assert True in answers and False in answers
