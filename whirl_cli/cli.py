@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 import os
-import shutil
 import sys
 from pathlib import Path
 
@@ -100,14 +99,13 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
 
     _say(f"whirl {_version()}: {study.path} -> {output}")
     from . import api
-    from .interrupts import catching, preloaded
-    from .output.summary import MODULES as TABLE_MODULES
+    from .interrupts import catching
     from .output.summary import render
     from .plots import MODULES as PLOT_MODULES
     from .verdict import verdict
 
     with catching():  # an interrupt while plots are drawn is never lost either
-        later = (*TABLE_MODULES, *(PLOT_MODULES if plots and study.plots else ()))
+        later = PLOT_MODULES if plots and study.plots else ()
         result = api.run(study, jobs=jobs, on_run=report, keep_runs=keep_runs, preload=later)
         published = api.save(result, output, study.plots if plots else (), overwrite,
                              state=study.plot_state, jobs=jobs)
@@ -116,9 +114,7 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     found = verdict(result, published.plot_error)
     for note in found.notes:
         _say(f"note: {note}")
-    width = shutil.get_terminal_size().columns if sys.stderr.isatty() else None
-    preloaded()  # rich's modules, imported while AUTO ran: never by two threads at once
-    _say(render(result, "table", study.variant().family.dof_names, width), end="")
+    _say(render(result, "table", study.variant().family.dof_names), end="")
     checks = [x for c in result.continuations for x in c.cross_checks]
     if checks:
         _say(f"cross-checks by time simulation: {sum(x.passed for x in checks)} of "
@@ -160,8 +156,7 @@ def summary(result_file: Path, output_format: str) -> None:
     study = _stored_study(result)
     dofs = study.variant().family.dof_names if study is not None else None
 
-    width = shutil.get_terminal_size().columns if sys.stdout.isatty() else None
-    click.echo(render(result, output_format, dofs, width), nl=False)
+    click.echo(render(result, output_format, dofs), nl=False)
 
 
 # ------------------------------------------------------------------------------------ check

@@ -7,6 +7,8 @@ import csv
 import io
 import json
 import math
+import subprocess
+import sys
 from dataclasses import replace
 
 import h5py
@@ -16,6 +18,7 @@ from click.testing import CliRunner
 
 from whirl_cli.cli import cli
 from whirl_cli.output import store
+from whirl_cli.output.summary import Table
 from whirl_cli.results import Branch, BranchKind, ContinuationResult, SpecialPoint, StudyResult
 
 from ..conftest import ROOT
@@ -228,3 +231,29 @@ def test_a_long_run_of_one_type_is_shortened_in_the_table_only(tmp_path):
                     ["main", "GH", "-0.01"], ["...", "6", "more"], ["main", "GH", "-0.08"],
                     ["periodic_1", "LPC", "-0.05"]]
     assert lines[5].split() == ["...", "6", "more", "GH"]
+
+
+def test_a_table_aligns_its_columns_and_never_cuts_a_cell():
+    """Columns two spaces apart, each as wide as its widest cell (header included), text
+    left- and numbers right-aligned, trailing blanks dropped; "none" centred without rows."""
+    table = Table("t (one-parameter): 2 special points", ("branch", "V [m/s]"), (False, True),
+                  (("main", "1.5"), ("periodic_12", "-0.0125")))
+    assert table.lines() == ["t (one-parameter): 2 special points",
+                             "branch       V [m/s]",
+                             "main             1.5",
+                             "periodic_12  -0.0125"]
+    empty = Table("t (one-parameter): 0 special points", ("branch", "type", "status"),
+                  (False, False, False), ())
+    assert empty.lines()[1:] == ["branch  type  status", "        none"]
+
+
+def test_the_table_needs_no_rich():
+    """The closing table of `whirl run` and `whirl summary` is plain text: rendering it
+    imports no terminal library (rich takes about 0.03 s to import)."""
+    code = ("import sys; from whirl_cli.output.store import read; "
+            "from whirl_cli.output.summary import render; "
+            f"text = render(read({str(REFERENCES[0])!r}), 'table'); "
+            "print(len(text.splitlines()) > 2, 'rich' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=60, check=True)
+    assert done.stdout.split() == ["True", "False"]

@@ -1,4 +1,4 @@
-"""The special points of a study as a summary a person reads (a rich table per continuation)
+"""The special points of a study as a summary a person reads (a text table per continuation)
 or a script reads (CSV, JSON): type, parameter values, amplitude of every dof, period,
 stability, criticality and status.
 
@@ -27,10 +27,6 @@ import numpy as np
 
 from ..results import Branch, ContinuationResult, PointType, SpecialPoint, StudyResult
 from ..units import axis_label, display_unit
-
-#: The modules a table imports (rich's, about 0.03 s): what ``whirl run`` preloads while AUTO
-#: runs (:func:`whirl_cli.interrupts.preload`).
-MODULES = ("rich.console", "rich.table", "rich.markup")
 
 FORMATS = ("table", "csv", "json")
 """Formats of ``whirl summary --format``."""
@@ -252,50 +248,61 @@ def compact(records_: Sequence[dict[str, object]], longest: int = RUN_SHOWN
     return shown
 
 
-def tables(result: StudyResult, dofs: Sequence[str] | None = None) -> list:
-    """One rich Table per continuation of ``result`` (its special points, as in
-    :func:`summary_rows`, long runs of one type on one branch shortened by :func:`compact`;
-    a continuation without any gets a table with a "none" caption)."""
-    from rich.markup import escape
-    from rich.table import Table
+@dataclass(frozen=True)
+class Table:
+    """A continuation's special points as the table shows them: ``title``, column ``names``
+    (``right``: right-aligned, the numbers) and ``rows`` of cell texts."""
 
+    title: str
+    names: tuple[str, ...]
+    right: tuple[bool, ...]
+    rows: tuple[tuple[str, ...], ...]
+
+    def lines(self) -> list[str]:
+        """The title, the header and a line per row, columns two spaces apart, each as wide
+        as its widest cell (numbers are never cut); "none" centred under the header if no rows."""
+        widths = [max(len(cell) for cell in column)
+                  for column in zip(self.names, *self.rows, strict=True)]
+
+        def line(cells: tuple[str, ...]) -> str:
+            return "  ".join(cell.rjust(w) if right else cell.ljust(w) for cell, w, right
+                             in zip(cells, widths, self.right, strict=True)).rstrip()
+
+        header = line(self.names)
+        body = [line(row) for row in self.rows] or ["none".center(len(header)).rstrip()]
+        return [self.title, header, *body]
+
+
+def tables(result: StudyResult, dofs: Sequence[str] | None = None) -> list[Table]:
+    """One :class:`Table` per continuation of ``result`` (its special points, as in
+    :func:`summary_rows`, long runs of one type on one branch shortened by :func:`compact`;
+    a continuation without any gets a table whose body is "none")."""
     drawn = []
     for continuation in result.continuations:
         rows = continuation_rows(continuation, dofs)
-        names = columns(rows)[1:]  # the continuation is the title
-        table = Table(title=escape(f"{continuation.name} ({continuation.kind}): "
-                            f"{len(rows)} special point{'s' if len(rows) != 1 else ''}"),
-                      title_justify="left", caption=None if rows else "none",
-                      header_style="bold", box=None, pad_edge=False)
-        for name in names:
-            numeric = name not in ("branch", "type", *LAST_COLUMNS[1:])
-            table.add_column(escape(name), justify="right" if numeric else "left", no_wrap=True)
+        names = tuple(columns(rows)[1:])  # the continuation is the title
+        cells = []
         for record in compact(records(rows)):
             if isinstance(record, Skipped):
-                table.add_row("...", escape(f"{record.count} more {record.type}"),
-                              *[""] * (len(names) - 2))
+                cells.append(("...", f"{record.count} more {record.type}",
+                              *[""] * (len(names) - 2)))
             else:
-                table.add_row(*(escape(_cell(record[name])) for name in names))
-        drawn.append(table)
+                cells.append(tuple(_cell(record[name]) for name in names))
+        drawn.append(Table(
+            f"{continuation.name} ({continuation.kind}): "
+            f"{len(rows)} special point{'s' if len(rows) != 1 else ''}", names,
+            tuple(name not in ("branch", "type", *LAST_COLUMNS[1:]) for name in names),
+            tuple(cells)))
     return drawn
 
 
-def render(result: StudyResult, output_format: str, dofs: Sequence[str] | None = None,
-           width: int | None = None) -> str:
+def render(result: StudyResult, output_format: str, dofs: Sequence[str] | None = None) -> str:
     """The summary of ``result`` as text in ``output_format`` (one of :data:`FORMATS`);
-    tables are rendered ``width`` characters wide at most (None: as wide as they need)."""
+    tables one after another, a blank line between them, as wide as they need."""
     if output_format == "csv":
         return to_csv(summary_rows(result, dofs))
     if output_format == "json":
         return to_json(summary_rows(result, dofs)) + "\n"
     if output_format != "table":
         raise ValueError(f"unknown summary format {output_format!r}; choose from {FORMATS}")
-    from rich.console import Console
-
-    buffer = io.StringIO()
-    console = Console(file=buffer, width=width or 10_000, highlight=False, color_system=None)
-    for k, table in enumerate(tables(result, dofs)):
-        if k:
-            console.print()
-        console.print(table)
-    return "\n".join(line.rstrip() for line in buffer.getvalue().splitlines()) + "\n"
+    return "\n\n".join("\n".join(table.lines()) for table in tables(result, dofs)) + "\n"
