@@ -179,6 +179,8 @@ def parse_d(text: str) -> tuple[list[Diagnostics], list[str]]:
     values: list[complex] = []
     kind, n_stable = "", None
     expect_summary = False
+    # most lines are Newton iterations: the patterns are tried only on lines holding their
+    # words (as fast as a substring test), which changes nothing but the time taken
     for line in text.splitlines():
         if not line.strip():
             continue
@@ -192,14 +194,14 @@ def parse_d(text: str) -> tuple[list[Diagnostics], list[str]]:
             points.append(Diagnostics(br, pt, kind, n_stable, np.array(values, dtype=complex)))
             values, kind, n_stable = [], "", None
             continue
-        if _TITLE.match(line):
+        if "BR" in line and _TITLE.match(line):
             expect_summary = True
             continue
-        found = _STABLE.match(line)
+        found = _STABLE.match(line) if "Stable:" in line else None
         if found:
             n_stable = int(found.group(1))
             continue
-        found = _VALUE.match(line)
+        found = _VALUE.match(line) if "Eigenvalue" in line or "Multiplier" in line else None
         if found:
             if int(found.group(4)) == 1:
                 values = []
