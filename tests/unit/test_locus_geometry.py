@@ -284,6 +284,37 @@ def test_points_on_paths_are_measured_to_segments():
     assert not _on_paths(points, []).any()
 
 
+def _segment_distance(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    """Euclidean distance of ``point`` to the segment a-b, by the closed form."""
+    step = b - a
+    length = float(step @ step)
+    t = 0.0 if length == 0 else min(max(float((point - a) @ step) / length, 0.0), 1.0)
+    return float(np.linalg.norm(point - (a + t * step)))
+
+
+def test_points_on_paths_agree_with_the_distance_to_every_segment():
+    """Random walks and points in 2 and 6 coordinates, many of them near the walks: a point
+    is on the paths exactly when its distance to some segment (the closed form, segment by
+    segment) is below the tolerance; also with a one-point path and an empty one."""
+    from whirl_cli.continuation.geometry import _on_paths
+
+    rng = np.random.default_rng(7)
+    found = []
+    for dims in (2, 6):
+        paths = [np.cumsum(rng.normal(0.0, 0.002, (m, dims)), axis=0) + rng.uniform(0, 0.05, dims)
+                 for m in (40, 25, 1)] + [np.empty((0, dims))]
+        ends = np.vstack([path[rng.integers(len(path), size=30)] for path in paths[:3]])
+        points = np.vstack([ends + rng.normal(0.0, 0.0008, ends.shape),
+                            rng.uniform(0.0, 0.06, (40, dims))])
+        expected = [any(_segment_distance(p, a, b) < 1e-3 for path in paths if len(path) > 1
+                        for a, b in zip(path[:-1], path[1:], strict=True))
+                    or any(len(path) == 1 and np.linalg.norm(p - path[0]) < 1e-3
+                           for path in paths) for p in points]
+        assert _on_paths(points, paths).tolist() == expected
+        found += expected
+    assert 0 < sum(found) < len(found)
+
+
 def test_a_locus_back_at_its_start_with_another_orbit_reached_the_next_fold():
     """Back within 0.005 of the ranges of its start's parameters, a locus has closed, unless
     its period there is nearer that of another start point of its type there (the folds of

@@ -61,20 +61,38 @@ def extreme_scale(curves: list[Branch]) -> np.ndarray:
 def _on_paths(points: np.ndarray, paths: list[np.ndarray], tolerance: float = 1e-3
               ) -> np.ndarray:
     """(K,) True where a row of ``points`` (K, D) lies within ``tolerance`` (Euclidean) of a
-    segment of one of the polylines ``paths`` (each (M, D), in the same coordinates)."""
+    segment of one of the polylines ``paths`` (each (M, D), in the same coordinates).
+
+    Only the pairs that can be that near are measured: points not yet found near a path,
+    inside its bounding box widened by twice the tolerance, against its segments whose boxes
+    meet theirs so widened (a point that near a segment is within the tolerance of it in every
+    coordinate)."""
     near = np.zeros(len(points), dtype=bool)
+    margin = 2 * tolerance
     for path in paths:
-        if len(path) == 1:
-            near |= np.linalg.norm(points - path[0], axis=1) < tolerance
-        if len(path) < 2:
+        if len(path) == 0:
             continue
-        start, step = path[:-1], np.diff(path, axis=0)
+        inside = np.all((points >= path.min(axis=0) - margin)
+                        & (points <= path.max(axis=0) + margin), axis=1)
+        rows = np.flatnonzero(inside & ~near)
+        if not len(rows):
+            continue
+        candidates = points[rows]
+        if len(path) == 1:
+            near[rows] |= np.linalg.norm(candidates - path[0], axis=1) < tolerance
+            continue
+        first, last = path[:-1], path[1:]
+        meets = np.all((np.maximum(first, last) >= candidates.min(axis=0) - margin)
+                       & (np.minimum(first, last) <= candidates.max(axis=0) + margin), axis=1)
+        if not meets.any():
+            continue
+        start, step = first[meets], (last - first)[meets]
         length = np.einsum("md,md->m", step, step)
-        offset = points[:, None, :] - start[None]
+        offset = candidates[:, None, :] - start[None]
         along = np.clip(np.einsum("kmd,md->km", offset, step)
                         / np.where(length > 0, length, 1.0), 0.0, 1.0)
         gap = offset - along[..., None] * step[None]
-        near |= np.einsum("kmd,kmd->km", gap, gap).min(axis=1) < tolerance ** 2
+        near[rows] |= np.einsum("kmd,kmd->km", gap, gap).min(axis=1) < tolerance ** 2
     return near
 
 
