@@ -58,3 +58,14 @@ def test_the_console_script_ends_with_the_commands_status_and_output(tmp_path):
     done = subprocess.run([sys.executable, "-m", "whirl_cli", "--version"],
                           capture_output=True, text=True, timeout=60)
     assert done.returncode == 0 and done.stdout.startswith("whirl, version ")
+
+
+def test_the_console_script_module_imports_nothing_before_it_catches_an_interrupt():
+    """The generated script imports :mod:`whirl_cli.entry` before any handler is in place: a
+    Ctrl-C while that import loads another module would end in a traceback. It loads only
+    itself and its package (``os`` and ``sys`` are loaded with the interpreter)."""
+    code = ("import sys; before = set(sys.modules); import whirl_cli.entry; "
+            "print(' '.join(sorted(set(sys.modules) - before)))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=60, check=True)
+    assert done.stdout.split() == ["whirl_cli", "whirl_cli.entry"]
