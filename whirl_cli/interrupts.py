@@ -7,7 +7,8 @@
   simulations, sweep studies), which are forked inside :func:`forking`; :func:`end_processes`
   ends such workers after an interrupt.
 * :func:`thread_map` maps over threads that never outlive the call, an interrupt included;
-  :func:`forked_map` over forked worker processes (CPU-bound Python: simulations, plots).
+  :func:`forked_map` over forked worker processes (CPU-bound Python: simulations, plots);
+  :class:`Standby` is one worker forked early, importing what a later call needs.
 * :func:`preload` imports modules a later stage needs in a background thread (while AUTO
   runs); every fork waits for it first.
 """
@@ -259,6 +260,92 @@ def thread_map(function: Callable, items: Iterable, workers: int) -> list:
         except KeyboardInterrupt:
             pool.shutdown(wait=True)
             raise
+
+
+class Standby:
+    """One worker process forked now and held in reserve for a call whose argument is not
+    known yet (e.g. the cross-checks of continuations AUTO has still to run): it imports
+    ``modules`` at once, on another core while this process goes on, then computes
+    ``function(argument)`` for the argument of :meth:`submit` and sends it back to
+    :meth:`result`. ``function`` is inherited at the fork (it need not pickle); the argument,
+    the result and an exception it raises are pickled. A context manager: leaving it kills
+    the worker if it still runs (an interrupt, an error, a result never asked for).
+
+    Fork it while no other thread of this process runs (as :func:`forked_map`). The worker
+    ignores SIGINT and dies with its parent (:func:`quiet_worker`); it receives the argument
+    in a thread of its own while it imports, so :meth:`submit` never waits for the imports."""
+
+    def __init__(self, function: Callable[[object], object], modules: Iterable[str] = ()
+                 ) -> None:
+        import multiprocessing
+
+        context = multiprocessing.get_context("fork")
+        self._connection, child = context.Pipe()
+        self._process = context.Process(target=_standby, args=(child, function, tuple(modules)),
+                                        name="whirl-standby", daemon=True)
+        with forking():
+            self._process.start()
+        child.close()
+
+    def submit(self, argument: object) -> None:
+        """Give the worker its argument (once)."""
+        self._connection.send(argument)
+
+    def result(self) -> object:
+        """``function(argument)`` as the worker computed it, or its exception raised here."""
+        try:
+            done, value = self._connection.recv()
+        except EOFError:
+            self._process.join(5)
+            raise RuntimeError(f"a worker process ended before its result (exit code "
+                               f"{self._process.exitcode})") from None
+        if not done:
+            raise value
+        return value
+
+    def close(self) -> None:
+        """End the worker (at once if it still runs) and its connection."""
+        end_processes([self._process])
+        self._connection.close()
+
+    def __enter__(self) -> Standby:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
+
+
+def _standby(connection, function: Callable[[object], object], modules: tuple[str, ...]
+             ) -> None:
+    """The body of a :class:`Standby` worker."""
+    quiet_worker()
+    received: list[object] = []
+
+    def receive() -> None:
+        try:
+            received.append(connection.recv())
+        except EOFError:  # the parent closed without submitting
+            pass
+
+    reader = threading.Thread(target=receive, daemon=True)
+    reader.start()
+    for name in modules:
+        try:
+            importlib.import_module(name)
+        except Exception:  # noqa: BLE001, S110 - the function meets the error itself
+            pass
+    reader.join()
+    if not received:
+        return
+    try:
+        outcome = (True, function(received[0]))
+    except BaseException as error:  # noqa: BLE001 - every failure goes back to the parent
+        outcome = (False, error)
+    try:
+        connection.send(outcome)
+    except Exception as error:  # noqa: BLE001 - e.g. an exception that does not pickle
+        connection.send((False, RuntimeError(f"{type(outcome[1]).__name__}: {outcome[1]} "
+                                             f"(not returned whole: {error})")))
 
 
 #: The function of the :func:`forked_map` in progress, inherited by its forked workers.

@@ -17,6 +17,7 @@ import pytest
 
 from whirl_cli.interrupts import (
     Interrupted,
+    Standby,
     catching,
     check,
     forked_map,
@@ -222,3 +223,54 @@ def test_a_failed_preload_is_ignored_and_met_where_the_module_is_used(tmp_path, 
 def test_preload_of_imported_modules_starts_no_thread():
     preload("os", "signal")
     assert not [t for t in threading.enumerate() if t.name == "whirl-preload"]
+
+
+def test_a_standby_worker_imports_first_and_computes_from_what_is_submitted_later(
+        tmp_path, monkeypatch):
+    # a module whose import in the worker ends only once this test has submitted (or 20 s)
+    flag = tmp_path / "submitted"
+    name = "whirl_standby_probe"
+    (tmp_path / f"{name}.py").write_text(
+        "import os, time\ndeadline = time.monotonic() + 20\n"
+        f"while not os.path.exists({str(flag)!r}) and time.monotonic() < deadline:\n"
+        "    time.sleep(0.01)\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, name, raising=False)
+    inherited = {"offset": 10}  # made before the fork: the worker sees it without pickling
+
+    def work(values):  # a closure: it does not pickle, it is inherited at the fork
+        return [v + inherited["offset"] for v in values], name in sys.modules
+
+    started = time.monotonic()
+    with Standby(work, (name,)) as standby:
+        standby.submit(list(range(100_000)))  # more than a pipe holds: read while importing
+        submitted = time.monotonic() - started
+        flag.touch()
+        values, imported = standby.result()
+    assert submitted < 10  # neither the fork nor the submission waited for the import
+    assert values == [v + 10 for v in range(100_000)]
+    assert imported  # in the worker, before the work
+    assert name not in sys.modules  # not here
+
+
+def test_a_standby_worker_raises_its_error_here_and_ends_with_the_block():
+    def failing(_argument):
+        raise ValueError("bad orbit")
+
+    with Standby(failing) as standby:
+        standby.submit(None)
+        with pytest.raises(ValueError, match="bad orbit"):
+            standby.result()
+    with Standby(lambda _argument: time.sleep(60)) as standby:
+        standby.submit(None)
+        process = standby._process  # noqa: SLF001 - what the block must end
+        assert process.is_alive()
+    assert not process.is_alive()  # killed on leaving, not waited for
+    assert process.exitcode == -signal.SIGKILL
+
+
+def test_a_standby_worker_that_dies_is_an_error_not_a_hang():
+    with Standby(lambda _argument: os._exit(3)) as standby:
+        standby.submit(None)
+        with pytest.raises(RuntimeError, match="exit code 3"):
+            standby.result()
