@@ -20,7 +20,8 @@ from __future__ import annotations
 import os
 import shutil
 import tempfile
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -33,7 +34,7 @@ if TYPE_CHECKING:
 
     from .output.study_files import Published
 
-__all__ = ["draw", "load", "read", "run", "save", "special_points"]
+__all__ = ["draw", "load", "read", "run", "run_and_save", "save", "special_points"]
 
 
 def load(path: str | os.PathLike[str]) -> Study:
@@ -50,22 +51,11 @@ def run(study: Study | str | os.PathLike[str], jobs: int = 1,
     ends. AUTO works in a temporary directory, removed afterwards, or kept under
     ``keep_runs``. ``preload``: modules needed afterwards, imported while AUTO runs (e.g.
     :data:`whirl_cli.plots.MODULES` before :func:`save` draws plots)."""
-    from .interrupts import held_signals
     from .pipeline import run_study
 
     study = study if isinstance(study, Study) else load_study(study)
-    with held_signals():  # the work directory is made and removed whole
-        if keep_runs:
-            Path(keep_runs).mkdir(parents=True, exist_ok=True)
-            workroot = Path(tempfile.mkdtemp(prefix=f"{study.name}-", dir=keep_runs))
-        else:
-            workroot = Path(tempfile.mkdtemp(prefix="whirl-"))
-    try:
+    with _workroot(study, keep_runs) as workroot:
         return run_study(study, workroot, jobs=jobs, on_run=on_run, preload=preload)
-    finally:
-        with held_signals():
-            if not keep_runs:
-                shutil.rmtree(workroot, ignore_errors=True)
 
 
 def save(result: StudyResult, path: str | os.PathLike[str], plots: Sequence[str] = (),
@@ -76,6 +66,50 @@ def save(result: StudyResult, path: str | os.PathLike[str], plots: Sequence[str]
     from .output.study_files import publish_study
 
     return publish_study(result, Path(path), tuple(plots), overwrite, state=state, jobs=jobs)
+
+
+def run_and_save(study: Study | str | os.PathLike[str], path: str | os.PathLike[str],
+                 plots: Sequence[str] = (), overwrite: bool = False, jobs: int = 1,
+                 on_run: Callable[[Any], None] | None = None,
+                 keep_runs: str | os.PathLike[str] | None = None,
+                 preload: tuple[str, ...] = ()) -> tuple[StudyResult, Published]:
+    """:func:`run`, then :func:`save` with the study's ``plot_state``, the same files, but
+    the plots drawn in the same ``jobs`` processes as the cross-checks, so that neither waits
+    for the other (:func:`whirl_cli.pipeline.run_and_draw`): what ``whirl run`` does."""
+    from .output.study_files import collected, drawing_tasks, publish_study
+    from .pipeline import run_and_draw
+
+    study = study if isinstance(study, Study) else load_study(study)
+    path, kinds = Path(path), tuple(plots)
+
+    def draw(result: StudyResult) -> list:
+        return drawing_tasks(result, kinds, path.stem, study.plot_state)
+
+    with _workroot(study, keep_runs) as workroot:
+        result, drawn = run_and_draw(study, workroot, draw if kinds else None, jobs=jobs,
+                                     on_run=on_run, preload=preload)
+    return result, publish_study(result, path, kinds, overwrite, state=study.plot_state,
+                                 jobs=jobs, drawn=collected(drawn))
+
+
+@contextmanager
+def _workroot(study: Study, keep_runs: str | os.PathLike[str] | None) -> Iterator[Path]:
+    """AUTO's working directory for ``study``: a new temporary one, removed afterwards, or
+    one kept under ``keep_runs``."""
+    from .interrupts import held_signals
+
+    with held_signals():  # the work directory is made and removed whole
+        if keep_runs:
+            Path(keep_runs).mkdir(parents=True, exist_ok=True)
+            workroot = Path(tempfile.mkdtemp(prefix=f"{study.name}-", dir=keep_runs))
+        else:
+            workroot = Path(tempfile.mkdtemp(prefix="whirl-"))
+    try:
+        yield workroot
+    finally:
+        with held_signals():
+            if not keep_runs:
+                shutil.rmtree(workroot, ignore_errors=True)
 
 
 def read(path: str | os.PathLike[str]) -> StudyResult:

@@ -106,9 +106,9 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
 
     with catching():  # an interrupt while plots are drawn is never lost either
         later = PLOT_MODULES if plots and study.plots else ()
-        result = api.run(study, jobs=jobs, on_run=report, keep_runs=keep_runs, preload=later)
-        published = api.save(result, output, study.plots if plots else (), overwrite,
-                             state=study.plot_state, jobs=jobs)
+        result, published = api.run_and_save(
+            study, output, study.plots if plots else (), overwrite, jobs=jobs, on_run=report,
+            keep_runs=keep_runs, preload=later)
     for path in published.paths:
         _say(f"wrote {path}")
     found = verdict(result, published.plot_error)

@@ -8,8 +8,10 @@ directories under ``workroot`` (the caller stores the result with :mod:`whirl_cl
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from contextlib import ExitStack
 from dataclasses import replace
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -21,7 +23,7 @@ from .continuation.engine import Engine, Numerics
 from .continuation.loci import two_parameter
 from .continuation.one_parameter import one_parameter
 from .continuation.periodic import OrbitStart
-from .interrupts import forked_map, preload, thread_map
+from .interrupts import Standby, forked_map, preload, preloaded, thread_map
 from .output.provenance import provenance
 from .results import (
     Boundary,
@@ -44,25 +46,56 @@ def run_study(study: Study, workroot: Path, jobs: int = 1,
     background once AUTO starts (:func:`whirl_cli.interrupts.preload`). Only modules nothing
     imports while AUTO runs: two threads importing parts of one package at once can meet in
     its circular imports (Python then raises its import-deadlock error in one of them): scipy's
-    integrators are added only where the cross-checks are the first to use scipy
-    (:func:`_only_checks_simulate`), and they join the import before using it.
+    integrators are added only where the cross-checks are the first to use scipy and run
+    here (:func:`_only_checks_simulate`, ``jobs`` 1; see :func:`run_and_draw`), and the
+    stages after the continuations join the import before they start.
 
     In the main thread, SIGINT and SIGTERM kill the running AUTO processes at once and raise
     :class:`whirl_cli.interrupts.Interrupted` (a KeyboardInterrupt), see
     :func:`whirl_cli.auto.runner.interruptible`.
     """
+    return run_and_draw(study, workroot, None, jobs, on_run, preload)[0]
+
+
+def run_and_draw(study: Study, workroot: Path,
+                 draw: Callable[[StudyResult], Sequence[Callable[[], object]]] | None,
+                 jobs: int = 1, on_run: Callable[[RunOutcome], None] | None = None,
+                 preload: tuple[str, ...] = ()) -> tuple[StudyResult, list]:
+    """:func:`run_study`, and the outcomes of the tasks ``draw`` makes of the result (work
+    that needs everything but the cross-checks, such as rendering its plots:
+    :func:`whirl_cli.output.study_files.drawing_tasks`), in their order, run in ``jobs``
+    forked processes. With ``jobs`` > 1 the cross-checks do not hold them up: a worker forked
+    before AUTO starts (:class:`whirl_cli.interrupts.Standby`) imports scipy's integrators
+    meanwhile, on another core (in a short study that import, behind matplotlib's in one
+    background thread, was the last thing to end), and checks the continuations as soon as
+    they are done, while the linear analysis, the simulations and the drawings go on here.
+    The same result and outcomes for any ``jobs``."""
     with interruptible():
-        return _run_study(study, workroot, jobs, on_run, preload)
+        return _run_study(study, workroot, jobs, on_run, preload, draw)
 
 
 def _run_study(study: Study, workroot: Path, jobs: int,
-               on_run: Callable[[RunOutcome], None] | None,
-               later: tuple[str, ...]) -> StudyResult:
+               on_run: Callable[[RunOutcome], None] | None, later: tuple[str, ...],
+               draw: Callable[[StudyResult], Sequence[Callable[[], object]]] | None
+               ) -> tuple[StudyResult, list]:
     model = study.variant()
     parameters = study.parameter_values()
+    with ExitStack() as stack:
+        checker = None
+        if study.cross_check and study.continuations and jobs > 1:  # checks beside the rest
+            checker = stack.enter_context(Standby(
+                partial(_cross_checks, model, parameters), simulate.MODULES))
+        elif _only_checks_simulate(study, model):  # scipy too, while AUTO runs
+            later = (*later, *simulate.MODULES)
+        return _stages(study, model, parameters, workroot, jobs, on_run, later, draw, checker)
+
+
+def _stages(study: Study, model, parameters: dict[str, float], workroot: Path, jobs: int,
+            on_run: Callable[[RunOutcome], None] | None, later: tuple[str, ...],
+            draw: Callable[[StudyResult], Sequence[Callable[[], object]]] | None,
+            checker: Standby | None) -> tuple[StudyResult, list]:
+    """The stages of :func:`run_and_draw`; the cross-checks by ``checker`` if given."""
     numerics = Numerics.from_settings(study.auto)
-    if _only_checks_simulate(study, model):  # scipy's integrators too, while AUTO runs
-        later = (*later, *simulate.MODULES)
     continuations: list[ContinuationResult] = []
     engine = None
     if study.continuations:
@@ -98,9 +131,10 @@ def _run_study(study: Study, workroot: Path, jobs: int,
             continuation = replace(continuation, explorations=explorations(
                 model, parameters, spec, jobs))
         continuations.append(continuation)
-    if study.cross_check:
-        continuations = [replace(c, cross_checks=simulate.cross_check(
-            model, parameters, c.branches, jobs=jobs)) for c in continuations]
+    preloaded()  # the stages below import scipy and draw: not beside a background import
+    branches = tuple(c.branches for c in continuations)
+    if checker is not None:  # checked while the stages below run
+        checker.submit(branches)
     sweeps = []
     if study.linear is not None:
         for sweep in study.linear.sweeps:
@@ -115,12 +149,28 @@ def _run_study(study: Study, workroot: Path, jobs: int,
         x, y = study.linear.grid.x, study.linear.grid.y
         grid = linear.grid(model, parameters, x.parameter, np.linspace(*x.range, x.points),
                            y.parameter, np.linspace(*y.range, y.points))
-    return StudyResult(
+    result = StudyResult(
         study_name=study.name, model=model.name, continuations=tuple(continuations),
         linear_sweeps=tuple(sweeps), runs=engine.records() if engine else (),
         attributes=provenance(study), boundaries=tuple(found_boundaries), linear_grid=grid,
         parameters=resolved_parameters(model, parameters),
         simulations=tuple(simulations(study, model, jobs)))
+    tasks = list(draw(result)) if draw is not None else []
+    drawn = forked_map(lambda k: tasks[k](), len(tasks), jobs)
+    if not study.cross_check:
+        return result, drawn
+    checks = checker.result() if checker is not None else \
+        _cross_checks(model, parameters, branches, jobs)
+    return replace(result, continuations=tuple(
+        replace(c, cross_checks=found)
+        for c, found in zip(result.continuations, checks, strict=True))), drawn
+
+
+def _cross_checks(model, parameters: dict[str, float], branches: Sequence[tuple],
+                  jobs: int = 1) -> list[tuple]:
+    """The cross-checks by time simulation of each continuation's ``branches``
+    (:func:`whirl_cli.analysis.simulate.cross_check`), in order."""
+    return [simulate.cross_check(model, parameters, found, jobs=jobs) for found in branches]
 
 
 def _only_checks_simulate(study: Study, model) -> bool:

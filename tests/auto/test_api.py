@@ -62,3 +62,26 @@ def test_special_points_without_pandas_is_a_clear_error(monkeypatch, tmp_path):
     monkeypatch.setattr(builtins, "__import__", no_pandas)
     with pytest.raises(WhirlError, match=r"pip install 'whirl\[pandas\]'"):
         api.special_points(result)
+
+
+def test_run_and_save_writes_what_run_then_save_writes(tmp_path):
+    """``api.run_and_save`` (what ``whirl run`` does: the plots drawn while a standby worker
+    runs the cross-checks) stores the same result and the same plot files as ``api.run``
+    followed by ``api.save`` (the cross-checks first, then the plots)."""
+    study = api.load(ROOT / "studies/thesis_ch3/softening_case2.yaml")
+    for folder in "ab":
+        (tmp_path / folder).mkdir()
+    together, published = api.run_and_save(study, tmp_path / "a" / "s.h5", study.plots,
+                                            jobs=2)
+    apart = api.run(study, jobs=2)
+    api.save(apart, tmp_path / "b" / "s.h5", study.plots, state=study.plot_state, jobs=2)
+    plots = sorted(p.name for p in (tmp_path / "a").glob("*.png"))
+    assert len(plots) == 3 and not published.plot_error
+    assert plots == sorted(p.name for p in (tmp_path / "b").glob("*.png"))
+    for name in plots:
+        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes()
+    checks = [list(c.cross_checks) for c in together.continuations]
+    assert checks == [list(c.cross_checks) for c in apart.continuations]  # every field equal
+    assert sum(map(len, checks)) >= 2
+    stored = api.read(tmp_path / "a" / "s.h5")
+    assert [len(c.cross_checks) for c in stored.continuations] == list(map(len, checks))

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from whirl_cli import models
+from whirl_cli import models, pipeline
 from whirl_cli.analysis.simulate import integrate
 from whirl_cli.auto import toolchain
 from whirl_cli.auto.codegen import fortran_source, source_key
@@ -94,15 +94,19 @@ def cli_run(tmp_path_factory):
                               for ax in figure.axes]
         return original(figure, dpi)
 
-    def render(result, kinds, stem, state=None, dpi=150, jobs=1):
-        nonlocal names  # drawn here (jobs=1): forked workers would record in their own copy
+    def render(result, kinds, stem, state=None, *args):
+        nonlocal names
         names = iter(files.plot_names(result, kinds, stem, state))
-        return rendering(result, kinds, stem, state, dpi)
+        return rendering(result, kinds, stem, state, *args)
 
-    rendering = files.render_study_plots
+    def in_turn(function, count, jobs):  # drawn here: forked workers would record in their
+        return [function(k) for k in range(count)]  # own copy of ``drawn``
+
+    rendering = files.render_tasks
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(files, "_png", recording)
-        patch.setattr(files, "render_study_plots", render)
+        patch.setattr(files, "render_tasks", render)
+        patch.setattr(pipeline, "forked_map", in_turn)
         done = CliRunner().invoke(cli, ["run", str(folder / "oscillators.yaml"), "-o",
                                         str(output), "--jobs", "2"])
     assert done.exit_code == 0, done.output

@@ -103,14 +103,15 @@ def test_a_file_appearing_meanwhile_leaves_no_plots_behind(airspeed, tmp_path, m
     assert names(tmp_path) == ["r.h5"] and (tmp_path / "r.h5").read_bytes() == b"another run"
 
 
-def test_a_drawing_error_keeps_the_result_and_is_a_problem(tmp_path, monkeypatch):
+@pytest.mark.parametrize("where", ["render_tasks", "_rendered"])  # planning, one figure
+def test_a_drawing_error_keeps_the_result_and_is_a_problem(tmp_path, monkeypatch, where):
     from whirl_cli.plots import files
 
     def broken(*args, **kwargs):
         raise ZeroDivisionError("a bug in a plot")
 
-    monkeypatch.setattr(files, "render_study_plots", broken)
-    failed = run(AIRSPEED, "-o", tmp_path / "r.h5")
+    monkeypatch.setattr(files, where, broken)  # a figure is drawn in a forked worker
+    failed = run(AIRSPEED, "-o", tmp_path / "r.h5", "--jobs", "2")
     assert failed.exit_code == 1
     assert "plots: ZeroDivisionError: a bug in a plot" in failed.output
     assert names(tmp_path) == ["r.h5"]

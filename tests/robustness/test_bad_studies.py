@@ -287,7 +287,7 @@ def test_mutated_studies_are_refused_before_any_run(capsys, monkeypatch):
     def accepted(study, *args, **kwargs):
         raise AssertionError(f"a mutated study was accepted:\n{study.source}")
 
-    monkeypatch.setattr(pipeline, "run_study", accepted)  # never reach AUTO
+    monkeypatch.setattr(pipeline, "run_and_draw", accepted)  # never reach AUTO (nor run_study)
     counts: Counter[str] = Counter()
     seeds = {seed: yaml.safe_load(seed.read_text()) for seed in SEEDS}
 

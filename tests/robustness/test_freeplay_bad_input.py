@@ -46,7 +46,7 @@ def test_bad_freeplay_law_is_refused_before_anything_runs(law, reason, tmp_path,
     def never(*args, **kwargs):
         raise AssertionError("a bad study reached the runs")
 
-    monkeypatch.setattr(pipeline, "run_study", never)
+    monkeypatch.setattr(pipeline, "run_and_draw", never)  # run_study calls it too
     study = tmp_path / "bad.yaml"
     study.write_text(HEAD + f"nonlinearity: {{type: freeplay, dof: theta, {law}}}\n" + TAIL)
     output = tmp_path / "out.h5"

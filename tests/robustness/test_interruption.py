@@ -247,18 +247,18 @@ def test_whirl_run_never_overwrites_without_overwrite(tmp_path, monkeypatch):
 
     # the file appears while the study runs (e.g. a second `whirl run`): refused at the end
     output.unlink()
-    real = pipeline.run_study
+    real = pipeline.run_and_draw
 
     def racing(*args, **kwargs):
-        result = real(*args, **kwargs)
+        done = real(*args, **kwargs)
         output.write_bytes(b"written meanwhile")
-        return result
+        return done
 
-    monkeypatch.setattr(pipeline, "run_study", racing)
+    monkeypatch.setattr(pipeline, "run_and_draw", racing)
     raced = runner.invoke(cli, ["run", str(study), "-o", str(output), "--no-plots"])
     assert raced.exit_code == 1 and "output exists; pass --overwrite" in raced.output
     assert output.read_bytes() == b"written meanwhile"
-    monkeypatch.setattr(pipeline, "run_study", real)
+    monkeypatch.setattr(pipeline, "run_and_draw", real)
 
     replaced = runner.invoke(cli, ["run", str(study), "-o", str(output), "--overwrite",
                                    "--no-plots"])

@@ -2,9 +2,10 @@
 
 :func:`publish_study` is how ``whirl run`` and ``whirl sweep`` write a finished study:
 
-1. every plot is rendered in memory first (:func:`whirl_cli.plots.files.render_study_plots`); if
-   drawing fails (a bug), the HDF5 file is still published, alone, and the error reported
-   (the result is not lost, and a sweep draws the missing plots again next time);
+1. every plot is rendered in memory first (:func:`drawing_tasks`; ``whirl run`` draws them
+   beside the cross-checks, :func:`whirl_cli.pipeline.run_and_draw`); if drawing fails (a
+   bug), the HDF5 file is still published, alone, and the error reported (the result is not
+   lost, and a sweep draws the missing plots again next time);
 2. without ``overwrite`` nothing is written if the HDF5 file or any of the plot files exists
    (one message naming the first such file);
 3. the files are published with SIGINT and SIGTERM held back (an interrupt arriving then is
@@ -21,12 +22,13 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from functools import partial
 from pathlib import Path
 
 from ..errors import OutputError
-from ..interrupts import held_signals
+from ..interrupts import forked_map, held_signals
 from ..results import StudyResult
 from . import atomic, store
 
@@ -43,21 +45,66 @@ class Published:
     plot_error: str = ""
 
 
+@dataclass(frozen=True)
+class Drawn:
+    """A result's plots rendered in memory: (file name, PNG bytes) in drawing order, or, if
+    drawing failed (a bug), none and why."""
+
+    plots: tuple[tuple[str, bytes], ...] = ()
+    error: str = ""
+
+
+def drawing_tasks(result: StudyResult, kinds: Sequence[str], stem: str,
+                  state: str | None = None) -> list[Callable[[], tuple[str, bytes] | str]]:
+    """The tasks that render ``result``'s plots of ``kinds`` (``<stem>_*.png``,
+    :func:`whirl_cli.plots.files.render_tasks`; bifurcation diagrams of ``state``, None: the
+    first dof), to be called in any process: each returns its (file name, PNG bytes), or the
+    error as text if drawing raised (none for no ``kinds``). :func:`collected` makes their
+    outcomes a :class:`Drawn`."""
+    if not kinds:
+        return []
+    from ..plots.files import render_tasks
+
+    try:
+        tasks = render_tasks(result, tuple(kinds), stem, state)
+    except Exception as error:  # noqa: BLE001 - a bug in drawing: reported, never raised
+        return [partial(str, _reason(error))]
+    return [partial(_guarded, task) for task in tasks]
+
+
+def _guarded(task: Callable[[], tuple[str, bytes]]) -> tuple[str, bytes] | str:
+    try:
+        return task()
+    except Exception as error:  # noqa: BLE001 - a bug in drawing: reported, never raised
+        return _reason(error)
+
+
+def _reason(error: Exception) -> str:
+    return f"plots: {type(error).__name__}: {error}"
+
+
+def collected(outcomes: Sequence[tuple[str, bytes] | str]) -> Drawn:
+    """The outcomes of :func:`drawing_tasks` as one :class:`Drawn`: every plot, or none and
+    the first error (a result is published with all its plots or without any)."""
+    errors = [outcome for outcome in outcomes if isinstance(outcome, str)]
+    return Drawn((), errors[0]) if errors else Drawn(tuple(outcomes))
+
+
 def publish_study(result: StudyResult, output: Path, kinds: Sequence[str],
-                  overwrite: bool = False, state: str | None = None, jobs: int = 1
-                  ) -> Published:
+                  overwrite: bool = False, state: str | None = None, jobs: int = 1,
+                  drawn: Drawn | None = None) -> Published:
     """Write ``result`` to ``output`` and its plots of ``kinds`` next to it (``<output
     stem>_*.png``; bifurcation diagrams of ``state``, None: the first dof; drawn in ``jobs``
-    processes), as one unit; see the module doc."""
+    processes, unless ``drawn`` holds them already, from :func:`drawing_tasks` of the same
+    ``kinds``), as one unit; see the module doc."""
     output = Path(output)
-    plots, plot_error = [], ""
-    if kinds:
-        from ..plots.files import render_study_plots
-
+    if drawn is None:
+        tasks = drawing_tasks(result, kinds, output.stem, state)
         try:
-            plots = render_study_plots(result, tuple(kinds), output.stem, state, jobs=jobs)
-        except Exception as error:  # a bug in drawing: keep the result, say what went wrong
-            plot_error = f"plots: {type(error).__name__}: {error}"
+            drawn = collected(forked_map(lambda k: tasks[k](), len(tasks), jobs))
+        except Exception as error:  # noqa: BLE001 - e.g. a drawing worker that died
+            drawn = Drawn((), _reason(error))
+    plots, plot_error = drawn.plots, drawn.error
     targets = [output.parent / name for name, _ in plots]
     if not overwrite:
         for path in [output, *targets]:

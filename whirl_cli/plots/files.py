@@ -8,7 +8,7 @@ import io
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from functools import cache
+from functools import cache, partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -186,9 +186,22 @@ def render_study_plots(result: StudyResult, kinds: tuple[str, ...], stem: str,
     bytes in the same order for any ``jobs``); nothing is written."""
     from ..interrupts import forked_map
 
-    named = _named_jobs(result, kinds, stem, state, view)
-    return forked_map(lambda k: (named[k][0], _png(_viewed(named[k][1](), view), dpi)),
-                      len(named), jobs)
+    tasks = render_tasks(result, kinds, stem, state, dpi, view)
+    return forked_map(lambda k: tasks[k](), len(tasks), jobs)
+
+
+def render_tasks(result: StudyResult, kinds: tuple[str, ...], stem: str,
+                 state: str | None = None, dpi: int = 150, view: View = View()
+                 ) -> list[Callable[[], tuple[str, bytes]]]:
+    """One task per figure of :func:`save_study_plots`, in drawing order: called (in any
+    process), it draws its figure and returns (file name, PNG bytes). Nothing is drawn here."""
+    return [partial(_rendered, name, make, view, dpi)
+            for name, make in _named_jobs(result, kinds, stem, state, view)]
+
+
+def _rendered(name: str, make: Callable[[], Figure], view: View, dpi: int
+              ) -> tuple[str, bytes]:
+    return name, _png(_viewed(make(), view), dpi)
 
 
 def study_figures(result: StudyResult, kinds: tuple[str, ...], stem: str = "",
