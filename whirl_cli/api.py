@@ -22,6 +22,7 @@ import shutil
 import tempfile
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -73,23 +74,21 @@ def run_and_save(study: Study | str | os.PathLike[str], path: str | os.PathLike[
                  on_run: Callable[[Any], None] | None = None,
                  keep_runs: str | os.PathLike[str] | None = None,
                  preload: tuple[str, ...] = ()) -> tuple[StudyResult, Published]:
-    """:func:`run`, then :func:`save` with the study's ``plot_state``, the same files, but
-    the plots drawn in the same ``jobs`` processes as the cross-checks, so that neither waits
-    for the other (:func:`whirl_cli.pipeline.run_and_draw`): what ``whirl run`` does."""
-    from .output.study_files import collected, drawing_tasks, publish_study
+    """:func:`run`, then :func:`save` with the study's ``plot_state``: the same files, but
+    the plots drawn while the cross-checks run (:func:`whirl_cli.pipeline.run_and_draw`):
+    what ``whirl run`` does."""
+    from .output.study_files import drawn_plots, publish_study
     from .pipeline import run_and_draw
 
     study = study if isinstance(study, Study) else load_study(study)
     path, kinds = Path(path), tuple(plots)
-
-    def draw(result: StudyResult) -> list:
-        return drawing_tasks(result, kinds, path.stem, study.plot_state)
-
+    draw = partial(drawn_plots, kinds=kinds, stem=path.stem, state=study.plot_state,
+                   jobs=jobs)
     with _workroot(study, keep_runs) as workroot:
         result, drawn = run_and_draw(study, workroot, draw if kinds else None, jobs=jobs,
                                      on_run=on_run, preload=preload)
     return result, publish_study(result, path, kinds, overwrite, state=study.plot_state,
-                                 jobs=jobs, drawn=collected(drawn))
+                                 jobs=jobs, drawn=drawn)
 
 
 @contextmanager

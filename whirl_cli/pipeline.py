@@ -13,6 +13,7 @@ from contextlib import ExitStack
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
@@ -36,6 +37,8 @@ from .results import (
 )
 from .study import Study
 
+T = TypeVar("T")
+
 
 def run_study(study: Study, workroot: Path, jobs: int = 1,
               on_run: Callable[[RunOutcome], None] | None = None,
@@ -57,27 +60,24 @@ def run_study(study: Study, workroot: Path, jobs: int = 1,
     return run_and_draw(study, workroot, None, jobs, on_run, preload)[0]
 
 
-def run_and_draw(study: Study, workroot: Path,
-                 draw: Callable[[StudyResult], Sequence[Callable[[], object]]] | None,
+def run_and_draw(study: Study, workroot: Path, draw: Callable[[StudyResult], T] | None,
                  jobs: int = 1, on_run: Callable[[RunOutcome], None] | None = None,
-                 preload: tuple[str, ...] = ()) -> tuple[StudyResult, list]:
-    """:func:`run_study`, and the outcomes of the tasks ``draw`` makes of the result (work
-    that needs everything but the cross-checks, such as rendering its plots:
-    :func:`whirl_cli.output.study_files.drawing_tasks`), in their order, run in ``jobs``
-    forked processes. With ``jobs`` > 1 the cross-checks do not hold them up: a worker forked
-    before AUTO starts (:class:`whirl_cli.interrupts.Standby`) imports scipy's integrators
-    meanwhile, on another core (in a short study that import, behind matplotlib's in one
-    background thread, was the last thing to end), and checks the continuations as soon as
-    they are done, while the linear analysis, the simulations and the drawings go on here.
-    The same result and outcomes for any ``jobs``."""
+                 preload: tuple[str, ...] = ()) -> tuple[StudyResult, T | None]:
+    """:func:`run_study`, and ``draw(result)`` (None without ``draw``): work that needs
+    everything but the cross-checks, such as rendering the plots
+    (:func:`whirl_cli.output.study_files.drawn_plots`). With ``jobs`` > 1 the cross-checks do
+    not hold it up: a worker forked before AUTO starts (:class:`whirl_cli.interrupts.Standby`)
+    imports scipy's integrators meanwhile, on another core (in a short study that import,
+    behind matplotlib's in one background thread, was the last thing to end), and checks the
+    continuations as soon as they are done, while the linear analysis, the simulations and
+    ``draw`` run here. The same result and drawings for any ``jobs``."""
     with interruptible():
         return _run_study(study, workroot, jobs, on_run, preload, draw)
 
 
 def _run_study(study: Study, workroot: Path, jobs: int,
                on_run: Callable[[RunOutcome], None] | None, later: tuple[str, ...],
-               draw: Callable[[StudyResult], Sequence[Callable[[], object]]] | None
-               ) -> tuple[StudyResult, list]:
+               draw: Callable[[StudyResult], T] | None) -> tuple[StudyResult, T | None]:
     model = study.variant()
     parameters = study.parameter_values()
     with ExitStack() as stack:
@@ -92,8 +92,8 @@ def _run_study(study: Study, workroot: Path, jobs: int,
 
 def _stages(study: Study, model, parameters: dict[str, float], workroot: Path, jobs: int,
             on_run: Callable[[RunOutcome], None] | None, later: tuple[str, ...],
-            draw: Callable[[StudyResult], Sequence[Callable[[], object]]] | None,
-            checker: Standby | None) -> tuple[StudyResult, list]:
+            draw: Callable[[StudyResult], T] | None, checker: Standby | None
+            ) -> tuple[StudyResult, T | None]:
     """The stages of :func:`run_and_draw`; the cross-checks by ``checker`` if given."""
     numerics = Numerics.from_settings(study.auto)
     continuations: list[ContinuationResult] = []
@@ -155,8 +155,7 @@ def _stages(study: Study, model, parameters: dict[str, float], workroot: Path, j
         attributes=provenance(study), boundaries=tuple(found_boundaries), linear_grid=grid,
         parameters=resolved_parameters(model, parameters),
         simulations=tuple(simulations(study, model, jobs)))
-    tasks = list(draw(result)) if draw is not None else []
-    drawn = forked_map(lambda k: tasks[k](), len(tasks), jobs)
+    drawn = draw(result) if draw is not None else None
     if not study.cross_check:
         return result, drawn
     checks = checker.result() if checker is not None else \

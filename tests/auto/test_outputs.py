@@ -118,6 +118,17 @@ def test_a_drawing_error_keeps_the_result_and_is_a_problem(tmp_path, monkeypatch
     assert study_files.recorded_plots(tmp_path / "r.h5") == ()
 
 
+def test_a_drawing_worker_that_dies_keeps_the_result_and_is_a_problem(tmp_path, monkeypatch):
+    from whirl_cli.plots import files
+
+    monkeypatch.setattr(files, "_rendered", lambda *args: os._exit(1))  # in a forked worker
+    failed = run(AIRSPEED, "-o", tmp_path / "r.h5", "--jobs", "2")
+    assert failed.exit_code == 1
+    assert "plots: BrokenProcessPool" in failed.output, failed.output
+    assert names(tmp_path) == ["r.h5"]
+    assert store.read(tmp_path / "r.h5").continuations  # the result, whole
+
+
 def test_a_sweep_completes_missing_plots_without_rerunning(tmp_path):
     """Before: a sweep interrupted after the HDF5 file left the plots missing for good (the
     rerun called the study up to date)."""

@@ -2,8 +2,8 @@
 
 :func:`publish_study` is how ``whirl run`` and ``whirl sweep`` write a finished study:
 
-1. every plot is rendered in memory first (:func:`drawing_tasks`; ``whirl run`` draws them
-   beside the cross-checks, :func:`whirl_cli.pipeline.run_and_draw`); if drawing fails (a
+1. every plot is rendered in memory first (:func:`drawn_plots`; ``whirl run`` draws them
+   while the cross-checks run, :func:`whirl_cli.pipeline.run_and_draw`); if drawing fails (a
    bug), the HDF5 file is still published, alone, and the error reported (the result is not
    lost, and a sweep draws the missing plots again next time);
 2. without ``overwrite`` nothing is written if the HDF5 file or any of the plot files exists
@@ -24,7 +24,6 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from functools import partial
 from pathlib import Path
 
 from ..errors import OutputError
@@ -54,25 +53,29 @@ class Drawn:
     error: str = ""
 
 
-def drawing_tasks(result: StudyResult, kinds: Sequence[str], stem: str,
-                  state: str | None = None) -> list[Callable[[], tuple[str, bytes] | str]]:
-    """The tasks that render ``result``'s plots of ``kinds`` (``<stem>_*.png``,
-    :func:`whirl_cli.plots.files.render_tasks`; bifurcation diagrams of ``state``, None: the
-    first dof), to be called in any process: each returns its (file name, PNG bytes), or the
-    error as text if drawing raised (none for no ``kinds``). :func:`collected` makes their
-    outcomes a :class:`Drawn`."""
+def drawn_plots(result: StudyResult, kinds: Sequence[str], stem: str,
+                state: str | None = None, jobs: int = 1) -> Drawn:
+    """``result``'s plots of ``kinds`` rendered in memory (``<stem>_*.png``, bifurcation
+    diagrams of ``state``, None: the first dof; in ``jobs`` forked processes, the same bytes in
+    the same order for any ``jobs``, :func:`whirl_cli.plots.files.render_tasks`), or, if
+    drawing failed (a bug in a figure, a drawing worker that died), none and the first error:
+    a result is published with all its plots or without any. Never raises but for an
+    interrupt."""
     if not kinds:
-        return []
+        return Drawn()
     from ..plots.files import render_tasks
 
     try:
         tasks = render_tasks(result, tuple(kinds), stem, state)
+        outcomes = forked_map(lambda k: _guarded(tasks[k]), len(tasks), jobs)
     except Exception as error:  # noqa: BLE001 - a bug in drawing: reported, never raised
-        return [partial(str, _reason(error))]
-    return [partial(_guarded, task) for task in tasks]
+        return Drawn((), _reason(error))
+    errors = [outcome for outcome in outcomes if isinstance(outcome, str)]
+    return Drawn((), errors[0]) if errors else Drawn(tuple(outcomes))
 
 
 def _guarded(task: Callable[[], tuple[str, bytes]]) -> tuple[str, bytes] | str:
+    """``task()``, or the error it raised as text (it travels back from a worker whole)."""
     try:
         return task()
     except Exception as error:  # noqa: BLE001 - a bug in drawing: reported, never raised
@@ -83,27 +86,16 @@ def _reason(error: Exception) -> str:
     return f"plots: {type(error).__name__}: {error}"
 
 
-def collected(outcomes: Sequence[tuple[str, bytes] | str]) -> Drawn:
-    """The outcomes of :func:`drawing_tasks` as one :class:`Drawn`: every plot, or none and
-    the first error (a result is published with all its plots or without any)."""
-    errors = [outcome for outcome in outcomes if isinstance(outcome, str)]
-    return Drawn((), errors[0]) if errors else Drawn(tuple(outcomes))
-
-
 def publish_study(result: StudyResult, output: Path, kinds: Sequence[str],
                   overwrite: bool = False, state: str | None = None, jobs: int = 1,
                   drawn: Drawn | None = None) -> Published:
     """Write ``result`` to ``output`` and its plots of ``kinds`` next to it (``<output
     stem>_*.png``; bifurcation diagrams of ``state``, None: the first dof; drawn in ``jobs``
-    processes, unless ``drawn`` holds them already, from :func:`drawing_tasks` of the same
+    processes, unless ``drawn`` holds them already: :func:`drawn_plots` of the same
     ``kinds``), as one unit; see the module doc."""
     output = Path(output)
     if drawn is None:
-        tasks = drawing_tasks(result, kinds, output.stem, state)
-        try:
-            drawn = collected(forked_map(lambda k: tasks[k](), len(tasks), jobs))
-        except Exception as error:  # noqa: BLE001 - e.g. a drawing worker that died
-            drawn = Drawn((), _reason(error))
+        drawn = drawn_plots(result, kinds, output.stem, state, jobs)
     plots, plot_error = drawn.plots, drawn.error
     targets = [output.parent / name for name, _ in plots]
     if not overwrite:
