@@ -12,8 +12,11 @@
     against a per-point loop.
 (e) one row per study (chapter 3, gimballed, freeplay, peers): ``whirl run`` wall time (plots
     and cross-checks as the study asks, warm cache), the summed wall time of the AUTO runs it
-    launched, their ratio, the runs and how many ended in MX; and a linear-only study
-    (``--no-plots``) against a bare ``python -c "import numpy"``.
+    launched, their ratio, the runs and how many ended in MX, and for one-parameter studies
+    with a bifurcation diagram the time of redrawing it from the result file (``whirl plot``:
+    start-up, imports, one figure; a floor of the run's wall time); and a linear-only study
+    (``--no-plots``) against a bare ``python -c "import numpy"``, beside the time of importing
+    alone what that run imports.
 (f) a fold of cycles: the LPC of softening case 2 by continuation (``run_study``, and the AUTO
     runs of its periodic family) against bisection on time simulations.
 
@@ -332,13 +335,35 @@ class StudyFigures:
     runs: int
     mx: int  # runs that ended in MX
     returncode: int
+    redraw: float = float("nan")  # s, `whirl plot --kind bifurcation` of its file (or NaN)
 
 
 def study_figures(path: Path, scratch: Path, env: dict[str, str]) -> StudyFigures:
+    """``whirl run`` of the study; for a one-parameter study that draws a bifurcation diagram,
+    also the wall time of redrawing that diagram from its result file (no AUTO, no checks,
+    one process): a floor of its run's wall time, whatever AUTO takes."""
     out = scratch / "cases" / f"{path.parent.name}-{path.stem}.h5"
     timed = run(WHIRL + ["run", str(path), "-o", str(out), "--overwrite"], env)
     auto, runs, mx, _ = launched(out) if out.exists() else (0.0, 0, 0, 0)
-    return StudyFigures(path.stem, timed.seconds, auto, runs, mx, timed.returncode)
+    redraw = float("nan")
+    if auto > 0 and not path.stem.startswith("boundary_") and "bifurcation" in asked_plots(path):
+        redraw = run(WHIRL + ["plot", str(out), "--kind", "bifurcation", "-o",
+                              str(scratch / "redrawn")], env).seconds
+    return StudyFigures(path.stem, timed.seconds, auto, runs, mx, timed.returncode, redraw)
+
+
+def asked_plots(path: Path) -> list[str]:
+    """The plot kinds a study file asks for (``plots:``)."""
+    import yaml
+
+    return list((yaml.safe_load(path.read_text()) or {}).get("plots") or [])
+
+
+#: What ``whirl run --no-plots`` of a linear-only study imports, ending as ``whirl`` does
+#: (without the interpreter's teardown: :func:`whirl_cli.entry.leave`).
+RUN_IMPORTS = ("import whirl_cli.cli, whirl_cli.study, whirl_cli.api, whirl_cli.pipeline, "
+               "whirl_cli.output.study_files, whirl_cli.output.summary, whirl_cli.verdict; "
+               "import os; os._exit(0)")
 
 
 def per_case(studies: Path, scratch: Path, env: dict[str, str]) -> None:
@@ -348,7 +373,7 @@ def per_case(studies: Path, scratch: Path, env: dict[str, str]) -> None:
         (group, sorted((ROOT / "studies" / group).glob("*.yaml")))
         for group in ("gimballed", "freeplay", "peers")]
     print(f"  {'study':<34} {'wall s':>8} {'AUTO s':>8} {'wall/AUTO':>9} {'runs':>5} "
-          f"{'MX':>4}")
+          f"{'MX':>4} {'redraw s':>9}")
     rows = []
     for group, paths in groups:
         print(f"  {group}/")
@@ -357,8 +382,9 @@ def per_case(studies: Path, scratch: Path, env: dict[str, str]) -> None:
             rows.append(row)
             ratio = f"{row.wall / row.auto:9.2f}" if row.auto > 0 else f"{'-':>9}"
             failed = "" if row.returncode == 0 else f"   exit {row.returncode}"
+            redraw = f"{row.redraw:9.2f}" if np.isfinite(row.redraw) else f"{'-':>9}"
             print(f"    {row.name:<32} {row.wall:8.2f} {row.auto:8.2f} {ratio} {row.runs:5d} "
-                  f"{row.mx:4d}{failed}", flush=True)
+                  f"{row.mx:4d} {redraw}{failed}", flush=True)
     one_parameter = [r for r in rows if r.auto > 0 and not r.name.startswith("boundary_")]
     ratios = [r.wall / r.auto for r in one_parameter]
     if ratios:
@@ -366,12 +392,22 @@ def per_case(studies: Path, scratch: Path, env: dict[str, str]) -> None:
         print(f"  studies with AUTO runs, boundaries aside: median wall/AUTO "
               f"{np.median(ratios):.2f}, max {worst.wall / worst.auto:.2f} ({worst.name}); "
               f"target <= 2")
+    redrawn = [r for r in one_parameter if np.isfinite(r.redraw)]
+    if redrawn:
+        out_of_reach = [r for r in redrawn if r.redraw > 2 * r.auto]
+        print(f"  redrawing the bifurcation diagram from the file (one figure, no AUTO, no "
+              f"checks; 'redraw s') takes over 2x the study's AUTO time for "
+              f"{len(out_of_reach)} of {len(redrawn)} such studies: for them wall <= 2x AUTO "
+              f"is below what drawing alone costs")
     linear = CHAPTER3 / "linear_datum_airspeed.yaml"
     wall = best_of(lambda: run(WHIRL + ["run", str(linear), "-o", str(scratch / "linear.h5"),
                                         "--no-plots", "--overwrite"], env))
     bare = best_of(lambda: run([sys.executable, "-c", "import numpy"], env))
+    imports = best_of(lambda: run([sys.executable, "-c", RUN_IMPORTS], env))
     print(f"  linear-only study ({linear.stem}, --no-plots, best of 3) {wall:.2f} s vs bare "
-          f"`python -c 'import numpy'` {bare:.2f} s: {wall / bare:.1f}x (target <= 3x)")
+          f"`python -c 'import numpy'` {bare:.2f} s: {wall / bare:.1f}x (target <= 3x); "
+          f"the modules such a run imports, alone (numpy, h5py, pydantic and the study "
+          f"schema, click, PyYAML, whirl's): {imports:.2f} s = {imports / bare:.1f}x")
 
 
 # ------------------------------------------------------------------------------ (f)
