@@ -20,7 +20,7 @@ from whirl_cli.plots.diagrams import (
     projections_figure,
 )
 from whirl_cli.plots.files import PLOT_KINDS, save_study_plots
-from whirl_cli.plots.key import _new_figure, stability_segments
+from whirl_cli.plots.key import _new_figure, stability_curves, stability_segments
 from whirl_cli.plots.linear import linear_sweep_plot
 from whirl_cli.plots.maps import boundary_plot, overhang_diagram, slice_continuation
 from whirl_cli.results import (
@@ -140,6 +140,41 @@ def test_segments_alternating_every_point():
 def test_segments_reject_mismatched_lengths():
     with pytest.raises(ValueError):
         stability_segments(np.arange(3.0), np.arange(2.0), np.ones(3, bool))
+
+
+def test_curves_join_the_runs_of_each_stability_with_breaks():
+    x = np.arange(7.0)
+    curves = stability_curves(x, 10 * x, np.array([1, 1, 0, 0, 1, 0, 0], bool))
+    assert [flag for _, _, flag in curves] == [True, False]  # in the order they first appear
+    (xs_stable, ys_stable, _), (xs_unstable, _, _) = curves
+    # the runs of stability_segments, each ending on the next run's first point, NaN between
+    np.testing.assert_array_equal(xs_stable, [0, 1, 2, np.nan, 4, 5])
+    np.testing.assert_array_equal(ys_stable, [0, 10, 20, np.nan, 40, 50])
+    np.testing.assert_array_equal(xs_unstable, [2, 3, 4, np.nan, 5, 6])
+
+
+def test_curves_of_one_stability_are_the_segment_itself():
+    x, y = np.linspace(0, 1, 4), np.linspace(2, 3, 4)
+    ((xs, ys, flag),) = stability_curves(x, y, np.zeros(4, bool))
+    np.testing.assert_array_equal(xs, x)
+    np.testing.assert_array_equal(ys, y)
+    assert flag is False
+    assert stability_curves(np.array([]), np.array([]), np.array([], bool)) == []
+
+
+def test_flickering_stability_draws_two_lines():
+    """A neutral family (the equilibria of a linear model at its branch point: a zero
+    eigenvalue at every point) whose stability flips at every point is drawn as two lines,
+    one per style, holding every point, not as one line per run (hundreds)."""
+    n = 301
+    flicker = make_branch("secondary_1a", BranchKind.EQUILIBRIUM, np.full(n, 0.039),
+                          np.linspace(-1.5, 1.5, n), np.arange(n) % 2 == 0)
+    ax = bifurcation_diagram(ContinuationResult("k1", "one-parameter", (flicker,), ())).axes[0]
+    lines = branch_lines(ax)
+    assert sorted(line_style(line) for line in lines) == [("green", "-"), ("magenta", "--")]
+    drawn = np.concatenate([line.get_ydata() for line in lines])
+    np.testing.assert_allclose(np.unique(drawn[np.isfinite(drawn)]),
+                               np.degrees(np.linspace(-1.5, 1.5, n)))
 
 
 # -- bifurcation_diagram -------------------------------------------------------------------------

@@ -22,7 +22,7 @@ from .key import (
     axis_label,
     branch_style,
     display_unit,
-    stability_segments,
+    stability_curves,
 )
 
 if TYPE_CHECKING:
@@ -167,7 +167,7 @@ def period_plot(continuation: ContinuationResult, title: str | None = None,
     first: dict[str, object] = {}
     for branch in periodic:
         x = branch.parameters[:, 0]
-        for xs, ys, stable in stability_segments(x, branch.period, branch.stable,
+        for xs, ys, stable in stability_curves(x, branch.period, branch.stable,
                                                  branch.stability_known):
             _plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)
     periods = np.concatenate([b.period for b in periodic]) if periodic else np.array([])
@@ -298,7 +298,7 @@ def _draw_branch(ax: Axes, branch: Branch, state: str, which: tuple[str, ...], d
     tables = [w for w in ("max", "min") if w in which] if branch.is_periodic else [which[0]]
     for table in tables:
         y = branch.state(state, table) * factor
-        for xs, ys, stable in stability_segments(x, y, branch.stable,
+        for xs, ys, stable in stability_curves(x, y, branch.stable,
                                                  branch.stability_known):
             _plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)
 

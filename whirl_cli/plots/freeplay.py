@@ -14,7 +14,7 @@ from .key import (
     _plot_styled,
     axis_label,
     branch_style,
-    stability_segments,
+    stability_curves,
 )
 
 if TYPE_CHECKING:
@@ -49,7 +49,7 @@ def amplitude_diagram(continuation: ContinuationResult, ax: Axes | None = None) 
             continue
         dofs.append(found.dof)
         x_label = axis_label(branch.parameter_names[0], branch.parameter_units[0])
-        for xs, ys, stable in stability_segments(branch.parameters[:, 0], found.amplitude_ratio,
+        for xs, ys, stable in stability_curves(branch.parameters[:, 0], found.amplitude_ratio,
                                                  branch.stable, branch.stability_known):
             _plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)
         if len(found.estimate_ratio):

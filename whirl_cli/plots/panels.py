@@ -29,7 +29,7 @@ from .diagrams import (
     projections_figure,
 )
 from .freeplay import amplitude_diagram, has_amplitudes
-from .key import PLOT_KEY, _colours, display_unit, stability_segments
+from .key import PLOT_KEY, _colours, display_unit, stability_curves
 from .linear import damping_multiples_plot, linear_sweep_plot, root_locus_plot
 from .maps import _oriented_grid, boundary_plot, overhang_diagram
 
@@ -383,7 +383,7 @@ def _draw_coloured(ax: Axes, branch: Branch, state: str, colour: str):
     factor, _ = display_unit(branch.state_units[branch.state_names.index(state)], True)
     y = branch.state(state, "max") * factor
     solid = None
-    for xs, ys, stable in stability_segments(branch.parameters[:, 0], y, branch.stable,
+    for xs, ys, stable in stability_curves(branch.parameters[:, 0], y, branch.stable,
                                              branch.stability_known):
         (line,) = ax.plot(xs, ys, color=colour, linestyle="-" if stable else ":",
                           linewidth=1.4 if branch.is_periodic else 1.0, label="_curve")
