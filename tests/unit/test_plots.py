@@ -20,7 +20,13 @@ from whirl_cli.plots.diagrams import (
     projections_figure,
 )
 from whirl_cli.plots.files import PLOT_KINDS, save_study_plots
-from whirl_cli.plots.key import _new_figure, stability_curves, stability_segments
+from whirl_cli.plots.key import (
+    POSITION_STEP,
+    _new_figure,
+    _round_positions,
+    stability_curves,
+    stability_segments,
+)
 from whirl_cli.plots.linear import linear_sweep_plot
 from whirl_cli.plots.maps import boundary_plot, overhang_diagram, slice_continuation
 from whirl_cli.results import (
@@ -175,6 +181,40 @@ def test_flickering_stability_draws_two_lines():
     drawn = np.concatenate([line.get_ydata() for line in lines])
     np.testing.assert_allclose(np.unique(drawn[np.isfinite(drawn)]),
                                np.degrees(np.linspace(-1.5, 1.5, n)))
+
+
+# -- the layout ----------------------------------------------------------------------------------
+
+def test_layout_rounds_axes_positions_and_keeps_managing_them():
+    figure = _new_figure()
+    ax = figure.add_subplot()
+    ax.plot([0.0, 1.0], [0.0, 123456.0])
+    ax.set_title("a title")
+    figure.canvas.draw()
+    first = ax.get_position().bounds  # (x0, y0, width, height): x1 = x0 + width is stored
+    np.testing.assert_allclose(first, np.round(first, 9), rtol=0, atol=1e-15)
+    assert ax.get_in_layout()
+    figure.set_size_inches(9.0, 3.0)  # still laid out: a new position, rounded too
+    figure.canvas.draw()
+    second = ax.get_position().bounds
+    assert second != first
+    np.testing.assert_allclose(second, np.round(second, 9), rtol=0, atol=1e-15)
+
+
+def test_positions_a_few_ulps_apart_round_to_the_same():
+    """kiwisolver's layout varied by 8e-16 between two drawings of thesis figure 3.21 (its
+    variables are ordered by memory address), enough to move an axes edge by a pixel."""
+    bounds = (0.1362022084780088, 0.5086851851851851, 0.19539487485532367, 0.4279758078703704)
+    rounded = []
+    for noise in (0.0, 7.8e-16, -7.8e-16):
+        figure = _new_figure()
+        ax = figure.add_subplot()
+        ax.set_position([v + noise for v in bounds], which="both")
+        ax.set_in_layout(True)
+        _round_positions(figure)
+        rounded.append(ax.get_position(original=True).bounds)
+    assert rounded[0] == rounded[1] == rounded[2]
+    np.testing.assert_allclose(rounded[0], bounds, atol=POSITION_STEP)
 
 
 # -- bifurcation_diagram -------------------------------------------------------------------------
