@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 from dataclasses import replace
 
 import numpy as np
@@ -215,6 +216,17 @@ def test_positions_a_few_ulps_apart_round_to_the_same():
         rounded.append(ax.get_position(original=True).bounds)
     assert rounded[0] == rounded[1] == rounded[2]
     np.testing.assert_allclose(rounded[0], bounds, atol=POSITION_STEP)
+
+
+@pytest.mark.parametrize("draw", [bifurcation_diagram, period_plot, projections_figure])
+def test_png_is_what_savefig_writes(continuation, draw):
+    """files._png draws a figure once (its layout in that draw) and writes the pixels: the
+    bytes savefig writes after its own layout pass, PNG text chunks included."""
+    ours = files._png(draw(continuation), 150, {"whirl-figure-key": "abc"})
+    buffer = io.BytesIO()
+    draw(continuation).savefig(buffer, format="png", dpi=150,
+                               metadata={"whirl-figure-key": "abc"})
+    assert ours == buffer.getvalue()
 
 
 # -- bifurcation_diagram -------------------------------------------------------------------------
