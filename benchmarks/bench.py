@@ -346,17 +346,13 @@ def study_figures(path: Path, scratch: Path, env: dict[str, str]) -> StudyFigure
     timed = run(WHIRL + ["run", str(path), "-o", str(out), "--overwrite"], env)
     auto, runs, mx, _ = launched(out) if out.exists() else (0.0, 0, 0, 0)
     redraw = float("nan")
-    if auto > 0 and not path.stem.startswith("boundary_") and "bifurcation" in asked_plots(path):
-        redraw = run(WHIRL + ["plot", str(out), "--kind", "bifurcation", "-o",
-                              str(scratch / "redrawn")], env).seconds
+    if auto > 0 and not path.stem.startswith("boundary_"):
+        from whirl_cli.study import load_study
+
+        if "bifurcation" in load_study(path).plots:
+            redraw = run(WHIRL + ["plot", str(out), "--kind", "bifurcation", "-o",
+                                  str(scratch / "redrawn")], env).seconds
     return StudyFigures(path.stem, timed.seconds, auto, runs, mx, timed.returncode, redraw)
-
-
-def asked_plots(path: Path) -> list[str]:
-    """The plot kinds a study file asks for (``plots:``)."""
-    import yaml
-
-    return list((yaml.safe_load(path.read_text()) or {}).get("plots") or [])
 
 
 #: What ``whirl run --no-plots`` of a linear-only study imports, ending as ``whirl`` does

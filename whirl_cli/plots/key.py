@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Iterator
+from functools import cache
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -159,8 +160,8 @@ def _broken(pieces: list[np.ndarray], gap: np.ndarray) -> np.ndarray:
 
 def _new_figure(**kwargs) -> Figure:
     """A Figure on an Agg canvas, outside pyplot (needs no display, no closing), laid out by
-    :func:`_settled_layout` (constrained layout, its axes positions rounded) and drawn with
-    fresh font objects: matplotlib's cached ones keep state between texts, so an axes edge
+    :func:`_settled_layout_class` (constrained layout, its axes positions rounded) and drawn
+    with fresh font objects: matplotlib's cached ones keep state between texts, so an axes edge
     could move by a pixel after other figures were drawn in the process. A figure's pixels
     then depend only on what it shows, not on the figures before it (the order in which
     ``whirl figures`` draws its sheets, or the ``--jobs`` that spread plots over processes)."""
@@ -172,18 +173,22 @@ def _new_figure(**kwargs) -> Figure:
     if fresh is not None:  # a private cache (matplotlib 3.8-3.11): absent, nothing to reset
         fresh()
     layout = kwargs.pop("layout", "constrained")  # no clipped labels, no bbox pass
-    figure = Figure(layout=_settled_layout() if layout == "constrained" else layout, **kwargs)
+    engine = _settled_layout_class()() if layout == "constrained" else layout
+    figure = Figure(layout=engine, **kwargs)
     FigureCanvasAgg(figure)
     return figure
 
 
-#: Figure fraction to which :func:`_settled_layout` rounds axes positions (a millionth of a
-#: pixel at the widest sheet, 3600 pixels).
-POSITION_STEP = 1e-9
+#: Decimals of the figure fraction to which :func:`_settled_layout_class` rounds axes
+#: positions, and that step (a millionth of a pixel at the widest sheet, 3600 pixels).
+_POSITION_DIGITS = 9
+POSITION_STEP = 10.0 ** -_POSITION_DIGITS
 
 
-def _settled_layout():
-    """Constrained layout whose axes positions are rounded to :data:`POSITION_STEP`.
+@cache
+def _settled_layout_class():
+    """The class of a constrained layout whose axes positions are rounded to
+    :data:`POSITION_STEP` (made once, matplotlib imported here).
     kiwisolver, which solves the layout, orders its variables by their memory addresses, so
     its solution varies in the last bits of a double from one drawing of the same figure to
     the next (after a garbage collection, after other figures): measured 8e-16 on thesis
@@ -197,17 +202,16 @@ def _settled_layout():
             _round_positions(fig)
             return info
 
-    return SettledLayout()
+    return SettledLayout
 
 
 def _round_positions(figure) -> None:
     """Round the position of every axes a layout places (``figure``'s and its subfigures')
     to :data:`POSITION_STEP`, leaving it in the layout."""
-    digits = round(-np.log10(POSITION_STEP))
     for ax in figure.axes:
         if ax.get_in_layout():
-            ax.set_position([round(v, digits) for v in ax.get_position(original=True).bounds],
-                            which="both")
+            ax.set_position([round(v, _POSITION_DIGITS)
+                             for v in ax.get_position(original=True).bounds], which="both")
             ax.set_in_layout(True)  # set_position takes it out
     for sub in getattr(figure, "subfigs", ()):
         _round_positions(sub)
