@@ -168,10 +168,10 @@ def check(result_file: Path) -> None:
 
     from . import api
     from .analysis import simulate
-    from .study import validate_text
+    from .study import stored_study
 
     result = api.read(result_file)
-    study = validate_text(str(result.attributes.get("study_yaml", "")), result_file.name)
+    study = stored_study(result.attributes, result_file.name)
     model, parameters, names = study.variant(), study.parameter_values(), study.names()
 
     def compared(x) -> str:  # what expected and simulated are (results.CrossCheck)
@@ -235,15 +235,20 @@ def generate(check: bool, directory: Path) -> None:
 
 # ------------------------------------------------------------------------------------ models
 @cli.command()
-def models() -> None:
-    """List the model variants with their states and parameters (units, defaults)."""
-    from .models import FAMILIES, all_variants, get_model
+@click.argument("model_files", nargs=-1, type=click.Path(dir_okay=False, path_type=Path))
+def models(model_files: tuple[Path, ...]) -> None:
+    """List the model variants with their states and parameters (units, defaults, bounds);
+    with MODEL_FILES, the models those files declare (each checked)."""
+    from .models import FAMILIES, all_variants, get_model, load_model_file
     from .models.laws import LAWS
 
-    shipped = all_variants()
-    others = [get_model(name) for name in FAMILIES
-              if name not in {model.family.name for model in shipped}]
-    click.echo("\n\n".join(model.describe() for model in shipped + others))
+    if model_files:
+        described = [get_model(load_model_file(path, str(path))) for path in model_files]
+    else:
+        shipped = all_variants()
+        described = shipped + [get_model(name) for name in FAMILIES
+                               if name not in {model.family.name for model in shipped}]
+    click.echo("\n\n".join(model.describe() for model in described))
     lines = ["", "stiffness laws (nonlinearity type; on any dof, coefficients named "
              "<key>_<dof>):"]
     for law in LAWS.values():
@@ -326,10 +331,10 @@ def _stored_plot_state(result) -> str | None:
 
 def _stored_study(result):
     """The study stored with ``result`` (None if that study no longer validates)."""
-    from .study import validate_text
+    from .study import stored_study
 
     try:
-        return validate_text(str(result.attributes.get("study_yaml", "")))
+        return stored_study(result.attributes)
     except WhirlError:
         return None
 

@@ -453,7 +453,8 @@ def test_study_name_reasons():
 
 def test_model_reasons():
     assert problems("name: s\nmodel: foo\n") == [
-        "s.yaml:2: model: unknown model 'foo' (known: classical, gimballed, oscillators)"
+        "s.yaml:2: model: unknown model 'foo' (built-in: classical, gimballed, oscillators; "
+        "or a model file path ending in .yaml)"
     ]
     assert problems("# a comment\n\nname: s\n") == ["s.yaml:3: model: required key is missing"]
 
@@ -490,7 +491,8 @@ def test_problems_on_one_line_are_sorted_by_path():
 
 def test_the_file_name_is_the_one_given():
     assert problems("name: s\nmodel: foo\n", "studies/x.yaml") == [
-        "studies/x.yaml:2: model: unknown model 'foo' (known: classical, gimballed, oscillators)"
+        "studies/x.yaml:2: model: unknown model 'foo' (built-in: classical, gimballed, "
+        "oscillators; or a model file path ending in .yaml)"
     ]
 
 
@@ -604,7 +606,8 @@ def test_file_problems_use_the_base_name(tmp_path):
     path = tmp_path / "bad.yaml"
     path.write_text("name: s\nmodel: foo\n")
     assert load_problems(path) == [
-        "bad.yaml:2: model: unknown model 'foo' (known: classical, gimballed, oscillators)"]
+        "bad.yaml:2: model: unknown model 'foo' (built-in: classical, gimballed, oscillators; "
+        "or a model file path ending in .yaml)"]
 
 
 # --------------------------------------------------------------------------- no tracebacks

@@ -49,7 +49,7 @@ def linear_onsets(model: Model, overrides: dict[str, float], dof: str, parameter
     stiffness of ``dof`` at the law's K_out: where linear analysis puts the flutter onset,
     which freeplay cycles undercut."""
     law = model.law_values(dof, overrides)
-    linear = get_model(model.family.name)
+    linear = get_model(model.family)
     known = set(linear.parameter_names)
     fixed = {k: v for k, v in overrides.items() if k in known}
     stiffness = model.family.dof(dof).stiffness
@@ -65,7 +65,7 @@ def describing_estimate(model: Model, overrides: dict[str, float], dof: str, par
     stiffness of ``dof`` set to K_eq(A), for A/delta in ``ratios``, ``parameter`` in
     ``bounds`` (sorted by A/delta; rows repeat an A/delta with several Hopf points)."""
     law = model.law_values(dof, overrides)
-    linear = get_model(model.family.name)
+    linear = get_model(model.family)
     stiffness = model.family.dof(dof).stiffness
     known = set(linear.parameter_names)
     fixed = {k: v for k, v in overrides.items() if k in known}
@@ -89,7 +89,7 @@ def freeplay_amplitudes(model: Model, overrides: dict[str, float],
     values by canonical name; ``bounds``: the continuation's range). The estimate spans A/delta
     from 1 to :data:`ESTIMATE_REACH` times the branch's largest, ``points`` values."""
     found = []
-    linear_names = set(get_model(model.family.name).parameter_names)
+    linear_names = set(get_model(model.family).parameter_names)
     for dof in freeplay_dofs(model):
         own = set(model.coefficient_names(dof).values())
         for branch in continuation.branches:

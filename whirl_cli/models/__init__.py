@@ -19,6 +19,7 @@ shipped studies use, whose AUTO files are committed under ``auto_equations/``.
 from __future__ import annotations
 
 from functools import cache
+from pathlib import Path
 
 from . import classical, gimballed, oscillators
 from .declaration import Bounds, Constraint, Dof, Family, ModeGroup, Parameter, State
@@ -26,7 +27,8 @@ from .laws import LAWS
 from .variant import Model
 
 __all__ = ["Bounds", "Constraint", "Dof", "Family", "ModeGroup", "Model", "Parameter", "State",
-           "FAMILIES", "LAWS", "SHIPPED", "get_model", "all_variants"]
+           "FAMILIES", "LAWS", "SHIPPED", "get_model", "all_variants", "family_of",
+           "is_model_file", "load_model_file", "register_model_text"]
 
 #: Model families by the name a study gives as ``model``.
 FAMILIES: dict[str, Family] = {f.name: f for f in (classical.FAMILY, gimballed.FAMILY,
@@ -41,12 +43,56 @@ SHIPPED: tuple[tuple[str, tuple[str, ...]], ...] = (
 )
 
 
+#: Model files read in this process, by the reference a study holds (the file's absolute path).
+_FILES: dict[str, Family] = {}
+
+
+def is_model_file(reference: object) -> bool:
+    """True if a study's ``model`` names a model file (``*.yaml``/``*.yml``), not a built-in."""
+    return isinstance(reference, str) and reference.lower().endswith((".yaml", ".yml"))
+
+
+def family_of(reference: str) -> Family:
+    """The family a study's ``model`` names: a built-in by name, or a model file read before
+    (:func:`load_model_file`) by its absolute path. KeyError otherwise."""
+    if reference in FAMILIES:
+        return FAMILIES[reference]
+    return _FILES[reference]
+
+
+def is_known(reference: object) -> bool:
+    return isinstance(reference, str) and (reference in FAMILIES or reference in _FILES)
+
+
+def load_model_file(path: Path, label: str | None = None) -> str:
+    """Read and check the model file at ``path`` (StudyError listing every problem) and
+    return the reference a study holds for it: its absolute path."""
+    from .file import read_model_file
+
+    reference = str(Path(path).absolute())
+    _FILES[reference] = read_model_file(Path(path), label)
+    return reference
+
+
+def register_model_text(reference: str, text: str, label: str) -> str:
+    """Hold the model file ``text`` (e.g. as stored with a result) under ``reference``."""
+    from .file import model_from_text
+
+    _FILES[reference] = model_from_text(text, label)
+    return reference
+
+
+def get_model(family: str | Family, laws: tuple[str, ...] | None = None) -> Model:
+    """The variant of ``family`` (a family, or a study's ``model`` reference) with ``laws[i]``
+    on its i-th dof (default: the polynomial law on every dof, which with zero coefficients is
+    the linear model)."""
+    declared = family_of(family) if isinstance(family, str) else family
+    return _variant(declared, tuple(laws) if laws else ("polynomial",) * len(declared.dofs))
+
+
 @cache
-def get_model(family: str, laws: tuple[str, ...] | None = None) -> Model:
-    """The variant of ``family`` with ``laws[i]`` on its i-th dof (default: the polynomial law
-    on every dof, which with zero coefficients is the linear model)."""
-    declared = FAMILIES[family]
-    return Model(declared, tuple(laws) if laws else ("polynomial",) * len(declared.dofs))
+def _variant(family: Family, laws: tuple[str, ...]) -> Model:
+    return Model(family, laws)
 
 
 def all_variants() -> list[Model]:

@@ -173,7 +173,8 @@ class Family:
     secondary branches come in +/- pairs). ``linear``: apart from the stiffness laws, the
     equations are linear in the states (so a study without nonlinear law coefficients is a
     linear system). ``provisional``: whirl's own derivation, not yet checked against the
-    published model.
+    published model. ``key``: for a model file, the sha256 of what it declares (its
+    generated code is keyed on it); ``source``: the file's text (stored with results).
     """
 
     name: str
@@ -189,6 +190,8 @@ class Family:
     linear: bool = True
     provisional: bool = False
     notes: str = ""
+    key: str = ""
+    source: str = field(default="", repr=False, compare=False)
 
     def __post_init__(self) -> None:
         names = [d.name for d in self.dofs] + [d.rate for d in self.dofs]

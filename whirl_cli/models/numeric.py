@@ -42,7 +42,9 @@ def code_key() -> str:
 
 def variant_key(model) -> str:
     """Identifies everything generated for ``model`` without generating it."""
-    return hashlib.sha256(f"{code_key()}:{model.name}:{model.laws}".encode()).hexdigest()
+    declared = f"{model.family.key}:" if model.family.key else ""  # a model file's content
+    return hashlib.sha256(f"{code_key()}:{declared}{model.name}:{model.laws}".encode()
+                          ).hexdigest()
 
 
 # ------------------------------------------------------------------------------ generation

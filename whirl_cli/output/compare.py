@@ -58,7 +58,8 @@ IGNORED_ATTRIBUTES = frozenset({"created", "git_describe", "whirl_version", "whi
                                 "auto_version", "plots"})
 #: Root attributes that say where a result came from: differences are notes, drift only when
 #: comparing ``strict``ly. (``study_name`` and ``model`` say what was computed: always drift.)
-PROVENANCE_ATTRIBUTES = frozenset({"study_yaml", "study_sha256"})
+PROVENANCE_ATTRIBUTES = frozenset({"study_yaml", "study_sha256", "model_file", "model_file_yaml",
+                                   "model_file_sha256"})
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,12 @@ def provenance(study) -> dict[str, str]:
         "study_sha256": study.sha256,
         "created": datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
     }
+    family = study.variant().family
+    if family.key:  # a model file: the equations that made the result, and their hash
+        attributes["model_file"] = study.model
+        attributes["model_file_yaml"] = family.source
+        attributes["model_file_sha256"] = hashlib.sha256(family.source.encode()).hexdigest()
+        attributes["model_key"] = family.key
     try:
         described = subprocess.run(["git", "describe", "--always", "--dirty"], cwd=PACKAGE,
                                    capture_output=True, text=True, timeout=5, check=False)

@@ -73,10 +73,10 @@ def captions(result: StudyResult) -> Captions:
     """The captions of ``result`` from the study stored with it (``study_yaml``); if that does
     not validate (e.g. a file of an older whirl), the study's name alone."""
     from ..errors import WhirlError
-    from ..study import validate_text
+    from ..study import stored_study
 
     try:
-        study = validate_text(str(result.attributes.get("study_yaml", "")))
+        study = stored_study(result.attributes)
     except WhirlError:
         return Captions(result.study_name)
     names = study.names()

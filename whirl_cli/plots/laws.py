@@ -75,10 +75,10 @@ def law_plot(model: Model, values: dict[str, float], dof: str, ax: Axes | None =
 def nonlinear_laws(result: StudyResult) -> list[tuple[Model, dict[str, float], str]]:
     """(model variant, parameter values, dof) of every dof of ``result``'s stored study whose
     law is not a linear spring at its values ([] if the study text does not validate)."""
-    from ..study import validate_text
+    from ..study import stored_study
 
     try:
-        study = validate_text(str(result.attributes.get("study_yaml", "")))
+        study = stored_study(result.attributes)
     except WhirlError:
         return []
     model, values = study.variant(), study.parameter_values()

@@ -51,6 +51,7 @@ from pathlib import Path
 from pydantic import ValidationError
 
 from ..errors import StudyError
+from ..models import is_model_file, load_model_file, register_model_text
 from .checks import _meaning_problems
 from .messages import _report, _translate
 from .reference import schema_reference
@@ -80,24 +81,57 @@ __all__ = [
     "TwoParameterContinuation",
     "load_study",
     "schema_reference",
+    "stored_study",
     "validate_text",
 ]
 
 
 def load_study(path: str | os.PathLike[str], label: str | None = None) -> Study:
     """Read, check and return the study at ``path``; StudyError lists every problem, each
-    line starting with ``label`` (default: the file's name)."""
+    line starting with ``label`` (default: the file's name). A model file the study names is
+    read relative to the study's folder."""
     path = Path(path)
     label = path.name if label is None else label
-    return _validate(_read_text(path, label), label, str(path))
+    return _validate(_read_text(path, label), label, str(path), path.parent)
 
 
-def validate_text(text: str, filename: str = "<study>") -> Study:
-    """Check the study YAML ``text``; messages name it ``filename``."""
-    return _validate(text, filename, filename)
+def validate_text(text: str, filename: str = "<study>",
+                  model_file: tuple[str, str] | None = None) -> Study:
+    """Check the study YAML ``text``; messages name it ``filename``. A model file it names is
+    read relative to the working directory, or is ``model_file`` = (reference, text) where
+    given (the model stored with a result)."""
+    return _validate(text, filename, filename, Path.cwd(), model_file)
 
 
-def _validate(text: str, name: str, path: str) -> Study:
+def stored_study(attributes: dict, filename: str = "<stored study>") -> Study:
+    """The study stored in a result's root ``attributes`` (``study_yaml``), with the model
+    file stored beside it where it names one; StudyError if it does not validate."""
+    stored = None
+    if attributes.get("model_file_yaml"):
+        stored = (str(attributes.get("model_file", "")), str(attributes["model_file_yaml"]))
+    return validate_text(str(attributes.get("study_yaml", "")), filename, stored)
+
+
+def _model_reference(tree: _Tree, name: str, folder: Path,
+                     stored: tuple[str, str] | None) -> None:
+    """Where the study names a model file, read it (StudyError for its problems, each at its
+    own file and line) and put its reference in the data; a missing file is left for the
+    schema to report at ``model``."""
+    written = tree.data.get("model")
+    if not is_model_file(written):
+        return
+    if stored is not None:
+        tree.data["model"] = register_model_text(stored[0], stored[1], written)
+        return
+    target = Path(written) if Path(written).is_absolute() else folder / written
+    if target.is_file():
+        label = written if Path(written).is_absolute() else os.path.normpath(
+            Path(name).parent / written)
+        tree.data["model"] = load_model_file(target, label)
+
+
+def _validate(text: str, name: str, path: str, folder: Path,
+              model_file: tuple[str, str] | None = None) -> Study:
     try:
         encoded = text.encode("utf-8")
     except UnicodeEncodeError as error:
@@ -107,6 +141,7 @@ def _validate(text: str, name: str, path: str) -> Study:
     if len(encoded) > MAX_BYTES:
         raise StudyError(_too_large(name, len(encoded)))
     tree = _Tree(_compose(text, name))
+    _model_reference(tree, name, folder, model_file)
     study, problems = _check(tree)
     if problems:
         raise StudyError(_report(problems, tree, name))

@@ -17,7 +17,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from typing import Any
 
-from ..models import FAMILIES
+from ..models import family_of, is_known
 from .messages import _choice_reason, _dotted
 from .resolve import (
     Names,
@@ -34,7 +34,7 @@ from .source import Loc, Problem
 def _meaning_problems(data: dict) -> list[Problem]:
     """Checks against the model variant, on the raw data; malformed parts are skipped."""
     family = data.get("model")
-    if not isinstance(family, str) or family not in FAMILIES:
+    if not is_known(family):
         return []
     problems = _law_problems(data, family)
     if problems:
@@ -75,7 +75,7 @@ def _simulation_problems(items: Any, names: Names, family: str,
     """Each simulation: a unique name (given, or ``sim_<k>``), its overrides (as the study's,
     and the constraints with them on top of the study's values), initial-state keys states
     of the model, and ``law: exact`` only with a piecewise law (freeplay)."""
-    dofs = FAMILIES[family].dofs
+    dofs = family_of(family).dofs
     states = [d.name for d in dofs] + [d.rate for d in dofs]
     problems: list[Problem] = []
     taken: set[str] = set()
@@ -107,7 +107,7 @@ def _simulation_problems(items: Any, names: Names, family: str,
 def _law_problems(data: dict, family: str) -> list[Problem]:
     """Each law on a dof of the model, each dof with at most one law, and a dof named by every
     law of a list."""
-    dofs = FAMILIES[family].dof_names
+    dofs = family_of(family).dof_names
     single = _is_single(data)
     problems: list[Problem] = []
     seen: dict[str, tuple] = {}
@@ -163,7 +163,7 @@ def _law_range_problems(loc: Loc, canonical: str, bounds: Any, names: Names,
 
 def _plot_state_problems(state: Any, family: str) -> list[Problem]:
     """``plot_state`` a state of the model: a dof or a rate."""
-    dofs = FAMILIES[family].dofs
+    dofs = family_of(family).dofs
     states = [d.name for d in dofs] + [d.rate for d in dofs]
     if not isinstance(state, str) or state in states:
         return []
@@ -242,7 +242,7 @@ def _override_problems(parameters: Any, names: Names, family: str,
 
 def _broken(family: str, values: dict[str, float]) -> list:
     """The family's constraints that ``values`` (canonical name -> SI value) break."""
-    return [c for c in FAMILIES[family].constraints if not c.holds(values)]
+    return [c for c in family_of(family).constraints if not c.holds(values)]
 
 
 def _constraint_problems(parameters: Any, names: Names, family: str,
@@ -361,7 +361,7 @@ def _continuation_problems(
 
 def _seed_problems(loc: Loc, seeds: Any, family: str) -> list[Problem]:
     """Seeds naming states the model lacks."""
-    dofs = FAMILIES[family].dofs
+    dofs = family_of(family).dofs
     states = [d.name for d in dofs] + [d.rate for d in dofs]
     if not isinstance(seeds, list):
         return []
@@ -372,7 +372,7 @@ def _seed_problems(loc: Loc, seeds: Any, family: str) -> list[Problem]:
 
 def _initial_problems(loc: Loc, initial: Any, family: str) -> list[Problem]:
     """An initial state (``explore_initial``) naming states the model lacks."""
-    dofs = FAMILIES[family].dofs
+    dofs = family_of(family).dofs
     states = [d.name for d in dofs] + [d.rate for d in dofs]
     if not isinstance(initial, dict):
         return []
@@ -382,7 +382,7 @@ def _initial_problems(loc: Loc, initial: Any, family: str) -> list[Problem]:
 
 def _state_problems(loc: Loc, name: str, family: str) -> list[Problem]:
     """A state name (``explore_section``) the model lacks."""
-    dofs = FAMILIES[family].dofs
+    dofs = family_of(family).dofs
     states = [d.name for d in dofs] + [d.rate for d in dofs]
     return [] if name in states else [(loc, _choice_reason(states, repr(name)))]
 

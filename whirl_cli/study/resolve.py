@@ -19,7 +19,7 @@ from typing import Any
 
 from pydantic import BaseModel
 
-from ..models import FAMILIES, LAWS, Model, Parameter, get_model
+from ..models import LAWS, Model, Parameter, family_of, get_model, is_known
 
 #: Study law types: ``linear`` is the polynomial law with zero coefficients.
 LAW_TYPES = ("linear", *LAWS)
@@ -63,7 +63,7 @@ def block_dof(block: Any, family: str, single: bool) -> Any:
     """The dof a law block names; a law given as a single mapping without one acts on the
     family's first dof (in a list every law names its dof)."""
     dof = _get(block, "dof")
-    return FAMILIES[family].dofs[0].name if dof is None and single else dof
+    return family_of(family).dofs[0].name if dof is None and single else dof
 
 
 @dataclass(frozen=True)
@@ -96,7 +96,7 @@ class Names:
 def names_of(family: str, laws: list[tuple[str, Any]]) -> Names | None:
     """The :class:`Names` of a study of ``family`` with these (dof, block) laws, or None when
     a dof is unknown, named twice or a law type unknown."""
-    declared = FAMILIES[family]
+    declared = family_of(family)
     dofs = [dof for dof, _ in laws]
     if not all(isinstance(d, str) for d in dofs) or not set(dofs) <= set(declared.dof_names) \
             or len(set(dofs)) != len(dofs):
@@ -120,14 +120,14 @@ def _names_of_data(data: dict) -> Names | None:
     """The :class:`Names` the raw study data asks for, or None when its model or laws are
     invalid (reported by the checks)."""
     family = data.get("model")
-    if not isinstance(family, str) or family not in FAMILIES:
+    if not is_known(family):
         return None
     blocks = law_blocks(data)
     single = _is_single(data)
     laws = []
     for _, block in blocks:
         if block is None:
-            laws.append((FAMILIES[family].dofs[0].name, {"type": "linear"}))
+            laws.append((family_of(family).dofs[0].name, {"type": "linear"}))
             continue
         if not isinstance(block, dict | BaseModel):
             return None

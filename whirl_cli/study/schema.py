@@ -26,7 +26,7 @@ from pydantic import (
 )
 from pydantic_core import PydanticCustomError
 
-from ..models import FAMILIES, Model
+from ..models import FAMILIES, Model, is_known, is_model_file
 from .resolve import Names, _finite, _is_number, _resolved, names_of
 
 NAME_MAX = 64
@@ -136,8 +136,11 @@ def _at_most_orbits(values: tuple) -> tuple:
 
 
 def _as_model_family(value: str) -> str:
-    if value not in FAMILIES:
-        _fail(f"unknown model {{got}} (known: {', '.join(FAMILIES)})")
+    if not is_known(value):
+        if is_model_file(value):
+            _fail("no model file {got}")
+        _fail(f"unknown model {{got}} (built-in: {', '.join(FAMILIES)}; or a model file "
+              "path ending in .yaml)")
     return value
 
 

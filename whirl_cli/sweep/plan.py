@@ -123,6 +123,8 @@ def _decide(study: Study, output: Path, force: bool) -> tuple[str, str, tuple[st
         return RUN, f"unreadable output ({type(error).__name__})", ()
     if stored.study_sha256 != study.sha256:
         return RUN, "study changed", ()
+    if stored.model_key != study.variant().family.key:
+        return RUN, "model file changed", ()
     if stored.whirl_version != __version__:
         return RUN, f"whirl {stored.whirl_version} -> {__version__}", ()
     if stored.code_sha256 != code_sha256():
@@ -141,6 +143,7 @@ class StoredState:
     code_sha256: str  # "" in files written before whirl recorded it
     problems: tuple[str, ...]  # by the failure policy of :mod:`whirl_cli.verdict`
     auto_version: str = ""  # the AUTO engine's version (toolchain.auto_version); "" if unknown
+    model_key: str = ""  # what a model file declares (its content key); "" for a built-in
 
 
 def stored_state(output: Path) -> StoredState:
@@ -164,5 +167,6 @@ def stored_state(output: Path) -> StoredState:
                     problems.append(f"{failed} cross-check(s) failed in {name}")
         return StoredState(text(attrs["study_sha256"]), text(attrs["whirl_version"]),
                            text(attrs.get("whirl_code_sha256", "")), tuple(problems),
-                           text(attrs.get("auto_version", "")))
+                           text(attrs.get("auto_version", "")),
+                           text(attrs.get("model_key", "")))
 

@@ -1,0 +1,229 @@
+"""Model files (no AUTO): safe expressions, every bad file a clean ``file:line: key: reason``,
+the content key, and the classical model written as a file giving the built-in's equations."""
+
+from __future__ import annotations
+
+import math
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from whirl_cli.errors import StudyError
+from whirl_cli.models import get_model, load_model_file
+from whirl_cli.models.expressions import ExpressionError, evaluate, parse, to_sympy
+from whirl_cli.models.file import model_from_text
+from whirl_cli.study import load_study
+
+DATA = Path(__file__).resolve().parents[1] / "data"
+
+#: A small valid model: two coupled oscillators with a flutter-like coupling.
+GOOD = """\
+name: pair
+description: two coupled oscillators
+dofs:
+  - {name: x, unit: m, stiffness: k_x}
+  - {name: y, unit: m, stiffness: k_y, amplitude: 0.1}
+parameters:
+  - {name: k_x, value: 1.0, unit: N/m}
+  - {name: k_y, value: 2.0, unit: N/m}
+  - {name: m, value: 1.0, unit: kg, bounds: positive}
+  - {name: c, value: 0.05, unit: N s/m, bounds: non-negative}
+  - {name: g, value: 0.3, unit: N/m}
+definitions:
+  c2: 2*c
+mass: [[m, 0.1*m], [0.1*m, m]]
+forces:
+  x: -c*dx + g*y
+  y: -c2*dy - g*x
+"""
+
+
+def problems(text: str) -> list[str]:
+    with pytest.raises(StudyError) as error:
+        model_from_text(text, "model.yaml")
+    return error.value.message.splitlines()
+
+
+def edited(old: str, new: str) -> str:
+    assert old in GOOD, old
+    return GOOD.replace(old, new)
+
+
+# (change to GOOD, key path reported, part of the reason)
+BAD = [
+    (("name: pair", "name: classical"), "name", "built-in"),
+    (("name: pair", "name: 3pair"), "name", "letters"),
+    (("  - {name: x, unit: m, stiffness: k_x}", "  - {name: x, unit: m, stiffness: k_z}"),
+     "dofs[0].stiffness", "no parameter 'k_z'"),
+    (("stiffness: k_y,", "stiffness: k_x,"), "dofs[1].stiffness", "already the stiffness"),
+    (("  - {name: g, value: 0.3, unit: N/m}", "  - {name: X, value: 0.3, unit: N/m}"),
+     "parameters[4].name", "declared twice"),
+    (("  - {name: g, value: 0.3, unit: N/m}", "  - {name: g, value: 0.3, unit: N/m}\n"
+      "  - {name: g, value: 1}"), "parameters[5].name", "declared twice"),
+    (("name: g,", "name: K2_x,"), "parameters[4].name", "law"),
+    (("name: g,", "name: K1,"), "parameters[4].name", "reserved"),
+    (("name: g,", "name: ndim,"), "parameters[4].name", "reserved"),
+    (("name: g,", "name: a_very_long_name_x,"), "parameters[4].name", "at most 13"),
+    (("name: g,", "name: sqrt,"), "parameters[4].name", "function"),
+    (("{name: m, value: 1.0", "{name: m, value: -1.0"), "parameters[2].value",
+     "outside its bounds"),
+    (("{name: m, value: 1.0", "{name: m, value: ten"), "parameters[2].value",
+     "expected a number"),
+    (("bounds: positive}", "bounds: sometimes}"), "parameters[2].bounds", "expected"),
+    (("  c2: 2*c", "  c2: 2*c2"), "definitions.c2", "refers to itself"),
+    (("  c2: 2*c", "  c2: 2*c3\n  c3: c"), "definitions.c2", "defined below"),
+    (("  c2: 2*c", "  c2: 2*q"), "definitions.c2", "unknown name 'q'"),
+    (("[[m, 0.1*m], [0.1*m, m]]", "[[m, 0.1*m], [0.2*m, m]]"), "mass[1][0]", "symmetric"),
+    (("[[m, 0.1*m], [0.1*m, m]]", "[[m, m], [m, m]]"), "mass", "singular"),
+    (("[[m, 0.1*m], [0.1*m, m]]", "[[m, 0], [0, m], [0, m]]"), "mass", "2 x 2"),
+    (("[[m, 0.1*m], [0.1*m, m]]", "[[m + x, 0], [0, m]]"), "mass[0][0]",
+     "may not depend on the states"),
+    (("  y: -c2*dy - g*x\n", ""), "forces", "no force for dof y"),
+    (("  y: -c2*dy - g*x\n", "  y: -c2*dy - g*x\n  z: 0\n"), "forces.z", "no dof 'z'"),
+    (("  x: -c*dx + g*y", "  x: -c*dx + g*w"), "forces.x", "unknown name 'w'"),
+    (("  x: -c*dx + g*y", "  x: -c*dx + g^y"), "forces.x", "'**'"),
+    (("  x: -c*dx + g*y", "  x: -c*dx + g.real"), "forces.x", "attribute"),
+    (("  x: -c*dx + g*y", "  x: -c*dx + g[0]"), "forces.x", "subscript"),
+    (("  x: -c*dx + g*y", "  x: \"__import__('os').system('true')\""), "forces.x",
+     "only the named functions"),
+    (("  x: -c*dx + g*y", "  x: \"(lambda: 1)()\""), "forces.x", "only the named functions"),
+    (("  x: -c*dx + g*y", "  x: \"__import__('os')\""), "forces.x",
+     "unknown function '__import__'"),
+    (("  x: -c*dx + g*y", "  x: \"'text'\""), "forces.x", "not a number"),
+    (("  x: -c*dx + g*y", "  x: -c*dx + eval(y)"), "forces.x", "unknown function 'eval'"),
+    (("  x: -c*dx + g*y", "  x: -c*dx + sqrt(y, y)"), "forces.x", "takes 1"),
+    (("  x: -c*dx + g*y", "  x: -c*dx + 2**10**10"), "forces.x", "exponent"),
+    (("  x: -c*dx + g*y", "  x: -c*dx + log(c - c)"), "forces.x", "cannot be computed"),
+    (("  x: -c*dx + g*y", "  x: -c*dx + g*y > 0"), "forces.x", "comparison"),
+    (("  x: -c*dx + g*y", "  x: \"-c*dx + (g*y\""), "forces.x", "cannot read"),
+    (("description: two coupled oscillators", "colour: blue"), "colour", "unknown key"),
+    (("description: two coupled oscillators", "states: [{name: lam}]"), "states",
+     "not supported yet"),
+    (("description: two coupled oscillators", "hub: {y: y*x, z: x}"), "hub.y", "linear"),
+    (("description: two coupled oscillators", "hub: {y: m*x, z: x}"), "hub.y", "not a state"),
+    (("description: two coupled oscillators",
+      "constraints: [{expression: k_x - k_y > 0, reason: x stiffer}]"),
+     "constraints[0].expression", "does not hold"),
+    (("description: two coupled oscillators", "constraints: [{expression: k_x + k_y}]"),
+     "constraints[0].expression", "one comparison"),
+]
+
+
+@pytest.mark.parametrize(("change", "key", "reason"), BAD, ids=[b[1] + ":" + b[2] for b in BAD])
+def test_bad_model_file(change, key, reason):
+    lines = problems(edited(*change))
+    pattern = re.compile(rf"^model\.yaml:\d+: {re.escape(key)}: .*{re.escape(reason)}")
+    assert any(pattern.search(line) for line in lines), lines
+    assert all(re.match(r"^model\.yaml:\d+: \S+: ", line) for line in lines), lines
+
+
+def test_at_least_25_bad_files():
+    assert len(BAD) >= 25
+
+
+def test_every_problem_at_once():
+    text = edited("  c2: 2*c", "  c2: 2*q").replace("g*y", "g*w")
+    lines = problems(text)
+    assert any("definitions.c2" in line for line in lines)
+    assert any("forces.x" in line for line in lines)
+
+
+def test_the_good_model_reads():
+    family = model_from_text(GOOD, "model.yaml")
+    assert family.dof_names == ("x", "y")
+    assert family.dofs[1].rate == "dy" and family.dofs[1].amplitude == 0.1
+    assert family.symmetric and family.linear  # derived: the forces are odd and linear
+
+
+def test_no_code_runs_from_an_expression(tmp_path):
+    """An expression that would create a file if it were evaluated is refused, and nothing
+    is created, through the CLI too (exit 1, nothing written)."""
+    marker = tmp_path / "ran"
+    model = tmp_path / "evil.yaml"
+    model.write_text(edited("  x: -c*dx + g*y",
+                            f"  x: \"__import__('pathlib').Path('{marker}').touch() or 0\""))
+    study = tmp_path / "study.yaml"
+    study.write_text("name: s\nmodel: ./evil.yaml\ncontinuations:\n  - {name: a, type: "
+                     "one-parameter, parameter: g, range: [0, 1], periodic: false}\n")
+    done = subprocess.run([str(Path(sys.executable).with_name("whirl")), "run", str(study),
+                           "-o", str(tmp_path / "out.h5")], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 1
+    assert re.search(r"evil\.yaml:\d+: forces\.x: ", done.stderr), done.stderr
+    assert "Traceback" not in done.stderr
+    assert not marker.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["evil.yaml", "study.yaml"]
+
+
+def test_a_missing_model_file_is_reported_at_the_key(tmp_path):
+    study = tmp_path / "study.yaml"
+    study.write_text("name: s\nmodel: ./nowhere.yaml\n")
+    with pytest.raises(StudyError, match=r"study\.yaml:2: model: no model file './nowhere"):
+        load_study(study)
+
+
+# ------------------------------------------------------------------------------ expressions
+@pytest.mark.parametrize("text", ["sqrt(a**2 + 1) * sin(b) - atan2(a, b) / 3",
+                                  "max(a, b, 2) - min(a, -b) + abs(-a) * sign(b)",
+                                  "exp(-a) + log(b) + tanh(a) + asinh(b) + pi",
+                                  "1/2 * a - -b + +a"])
+def test_expressions_evaluate_as_sympy_does(text):
+    values = {"a": 0.7, "b": 1.3}
+    expression = parse(text)
+    symbols = {n: sp.Symbol(n) for n in values}
+    exact = float(to_sympy(expression, symbols).subs({symbols[n]: v for n, v in
+                                                      values.items()}))
+    assert evaluate(expression, values) == pytest.approx(exact, rel=1e-13)
+    assert expression.names == {"a", "b"}
+
+
+def test_integers_stay_exact():
+    assert to_sympy(parse("1/2"), {}) == sp.Rational(1, 2)
+
+
+@pytest.mark.parametrize("text", ["a.b", "a[0]", "f(a)", "lambda: 1", "'s'", "a if b else c",
+                                  "a and b", "(a, b)", "__import__('os')", "a // b", "a % b",
+                                  "sqrt(x=1)", "", "a ** 1000"])
+def test_refused_expressions(text):
+    with pytest.raises(ExpressionError):
+        parse(text)
+
+
+def test_deep_nesting_is_refused_not_a_crash():
+    with pytest.raises(ExpressionError):
+        parse("(" * 5000 + "a" + ")" * 5000)
+    with pytest.raises(ExpressionError):
+        parse("-" * 100000 + "a")
+
+
+# ------------------------------------------------------------------------------ content key
+def test_the_key_follows_what_is_declared_not_how_it_is_written():
+    key = model_from_text(GOOD, "m.yaml").key
+    assert model_from_text("# a comment\n" + GOOD.replace("2*c", "2 * c"), "m.yaml").key == key
+    assert model_from_text(GOOD.replace("2*c", "3*c"), "m.yaml").key != key
+
+
+# ------------------------------------------------------------------------------ classical
+def test_the_classical_model_file_gives_the_built_in_equations():
+    """Right-hand side and Jacobian of the file model equal the built-in's at random states
+    and parameters (two independent writings of the same equations)."""
+    file_model = get_model(load_model_file(DATA / "classical_as_file.yaml"))
+    built_in = get_model("classical")
+    assert file_model.parameter_names == built_in.parameter_names
+    rng = np.random.default_rng(7)
+    datum = built_in.parameter_vector()
+    for _ in range(5):
+        y = rng.normal(size=4) * 0.3
+        p = datum * (1 + 0.2 * rng.uniform(-1, 1, size=datum.size))
+        p[built_in.parameter_names.index("N")] = 4.0
+        np.testing.assert_allclose(file_model.rhs_numpy(y, p), built_in.rhs_numpy(y, p),
+                                   rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(file_model.jacobian_numpy(y, p),
+                                   built_in.jacobian_numpy(y, p), rtol=1e-11, atol=1e-11)
+    assert file_model.family.time_scale == built_in.time_scale
+    assert math.isclose(file_model.family.hub[0][0][1], -1.0)
