@@ -51,15 +51,21 @@ class SweepItem:
         return self.study.name if self.study is not None else self.source.name
 
 
+#: How a model file beside studies is named, so that a directory sweep does not take it for one.
+MODEL_SUFFIX = ".model.yaml"
+
+
 def find_studies(paths: Iterable[str | os.PathLike[str]], what: str = "study files"
                  ) -> list[Path]:
     """Study files named by ``paths``: files as given, directories searched recursively for
-    ``*.yaml`` (sorted); each file once, in the order found. ``what`` names them in errors."""
+    ``*.yaml`` (sorted) other than model files (``*.model.yaml``); each file once, in the
+    order found. ``what`` names them in errors."""
     found: list[Path] = []
     seen: set[Path] = set()
     for entry in map(Path, paths):
         if entry.is_dir():
-            candidates = sorted(p for p in entry.rglob("*.yaml") if p.is_file())
+            candidates = sorted(p for p in entry.rglob("*.yaml") if p.is_file()
+                                and not p.name.endswith(MODEL_SUFFIX))
             if not candidates:
                 raise WhirlError(f"{entry}: no {what} (*.yaml) in this directory")
         elif entry.exists():
