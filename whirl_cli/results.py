@@ -96,6 +96,14 @@ class Orbit:
     states: np.ndarray
 
 
+#: :attr:`Branch.end` of a branch that used up its study's ``max_steps`` (AUTO's NMX) before
+#: reaching any other end: a truncated branch, which makes the study fail
+#: (:mod:`whirl_cli.verdict`).
+STEP_LIMIT = "step limit"
+#: Between the two ends in :attr:`Branch.end` of a branch traced both ways from its start.
+OTHER_END = "; other end: "
+
+
 @dataclass(frozen=True)
 class Branch:
     """One continuation branch (one AUTO run), N points.
@@ -159,6 +167,11 @@ class Branch:
 
     def __len__(self) -> int:
         return len(self.point_type)
+
+    @property
+    def truncated(self) -> bool:
+        """True if the branch (at one of its ends) stopped at its study's step limit."""
+        return STEP_LIMIT in self.end.split(OTHER_END)
 
     def parameter(self, name: str) -> np.ndarray:
         return self.parameters[:, self.parameter_names.index(name)]

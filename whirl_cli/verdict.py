@@ -6,6 +6,8 @@ A study has *problems* (``whirl run`` exits 1, a sweep counts it failed) when
   except where whirl has judged the end natural: an MX at a period blow-up (the family's
   status is then "ok") and a locus ending in MX, which has mostly reached a degenerate point
   (a cusp of folds of cycles, a Bogdanov-Takens point) and is reported as a *note*;
+* a branch is truncated: it used up the study's ``max_steps`` before reaching any other end
+  (the end of its range, a Hopf point, ...);
 * a time-simulation cross-check failed;
 * a study simulation's integration failed (status -1; one stopped at the divergence bound,
   status 1, is a result, not a failure);
@@ -18,7 +20,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .results import StudyResult
+from .results import OTHER_END, STEP_LIMIT, Branch, StudyResult
 
 
 @dataclass(frozen=True)
@@ -39,6 +41,18 @@ def is_locus_mx(kind: str, status: str) -> bool:
     return status == "mx" and kind.endswith("_locus")
 
 
+def truncation(branch: Branch) -> str:
+    """What a truncated branch is short of, said where it stops."""
+    where = ""
+    if branch.end == STEP_LIMIT and len(branch):  # one end: the last point
+        where = " at " + ", ".join(f"{name} = {value:.6g}" for name, value in zip(
+            branch.parameter_names, branch.parameters[-1], strict=True))
+    elif branch.end != STEP_LIMIT:
+        where = f" ({branch.end.replace(OTHER_END, ', other end: ')})"
+    return (f"{branch.name} stopped at the step limit (auto: max_steps){where}, before the "
+            "end of its range")
+
+
 def verdict(result: StudyResult, plot_error: str = "") -> Verdict:
     """The problems and notes of ``result`` (see the module doc); ``plot_error``: why its
     plots could not be drawn, if so (a problem too)."""
@@ -49,6 +63,7 @@ def verdict(result: StudyResult, plot_error: str = "") -> Verdict:
                      else "at its start") for b in loci_mx)
     problems = [f"{b.name} ({b.run}): {b.message}" for b in branches
                 if is_problem(b.kind, b.status)]
+    problems += [truncation(b) for b in branches if b.truncated]
     problems += [f"cross-check failed on {x.branch} at {x.parameter:.6g}"
                  for c in result.continuations for x in c.cross_checks if not x.passed]
     problems += [f"simulation {s.name} failed: {s.message}" for s in result.simulations

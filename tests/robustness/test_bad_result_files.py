@@ -9,10 +9,12 @@ import shutil
 from pathlib import Path
 
 import h5py
+import numpy as np
 import pytest
 from click.testing import CliRunner
 
 from whirl_cli.cli import cli
+from whirl_cli.output.store import read
 
 from .helpers import ROOT, whirl
 
@@ -44,7 +46,7 @@ def make_bad(kind: str, directory: Path) -> tuple[Path, str]:
     shutil.copyfile(REFERENCE, path)
     with h5py.File(path, "r+") as handle:
         del handle["continuations/k1/branches/main_down/stable"]
-    return path, "not a complete whirl result file ("
+    return path, "a damaged whirl result file (/continuations/k1/branches/main_down/stable: "
 
 
 KINDS = ["yaml", "empty", "truncated", "foreign", "damaged"]
@@ -90,3 +92,110 @@ def test_plot_into_a_directory_that_cannot_be_made_is_one_line(tmp_path):
     assert isinstance(result.exception, SystemExit) and result.exit_code == 1
     assert result.output == f"{blocker / 'plots'}: cannot create the output directory " \
         "(Not a directory)\n"
+
+
+# ------------------------------------------------------------------ a whirl file not whole
+BRANCH = "continuations/k1/branches/main_down"
+POINTS = "continuations/k1/special_points"
+SWEEP = "linear/sweeps/V"
+LINEAR = ROOT / "tests" / "regression" / "references" / "linear_datum_airspeed.h5"
+
+
+def _replace(handle: h5py.File, key: str, change) -> None:
+    """Dataset ``key`` replaced by ``change`` of its values, its attributes kept."""
+    values, attributes = handle[key][()], dict(handle[key].attrs)
+    del handle[key]
+    handle[key] = change(values)
+    handle[key].attrs.update(attributes)
+
+
+def _strings(values: np.ndarray) -> np.ndarray:
+    return np.array([str(v) for v in values.ravel()]).reshape(values.shape).astype("S")
+
+
+def _delete(key: str):
+    return lambda handle: handle.__delitem__(key)
+
+
+def _changed(key: str, change):
+    return lambda handle: _replace(handle, key, change)
+
+
+def _no_attribute(key: str, name: str):
+    return lambda handle: handle[key].attrs.__delitem__(name)
+
+
+#: damage: (the file it is done to, the damage, the HDF5 path and the words whirl must say)
+DAMAGES = {
+    "branches group deleted": (REFERENCE, _delete("continuations/k1/branches"),
+                               "/continuations/k1/branches", "missing"),
+    "branch deleted": (REFERENCE, _delete("continuations/k1/branches/secondary_1b"),
+                       f"/{POINTS}/branch", "'secondary_1b'"),
+    "dataset deleted": (REFERENCE, _delete(f"{BRANCH}/state_max"), f"/{BRANCH}/state_max",
+                        "missing"),
+    "runs deleted": (REFERENCE, _delete("runs"), "/runs", "missing"),
+    "stability as strings": (REFERENCE, _changed(f"{BRANCH}/stable", _strings),
+                             f"/{BRANCH}/stable", "strings"),
+    "point stability as strings": (REFERENCE, _changed(f"{POINTS}/stable", _strings),
+                                   f"/{POINTS}/stable", "strings"),
+    "point types as floats": (REFERENCE, _changed(f"{BRANCH}/point_type",
+                                                  lambda v: v.astype(float)),
+                              f"/{BRANCH}/point_type", "floats"),
+    "whirl directions as numbers": (LINEAR, _changed(f"{SWEEP}/whirl",
+                                                     lambda v: np.zeros(v.shape)),
+                                    f"/{SWEEP}/whirl", "floats"),
+    "columns not its names": (REFERENCE, _changed(f"{BRANCH}/state_min", lambda v: v[:, :3]),
+                              f"/{BRANCH}/state_min", "(204, 3)"),
+    "a point short": (REFERENCE, _changed(f"{BRANCH}/l2_norm", lambda v: v[1:]),
+                      f"/{BRANCH}/l2_norm", "(203,)"),
+    "a table column short": (REFERENCE, _changed(f"{POINTS}/label", lambda v: v[1:]),
+                             f"/{POINTS}/label", "(9,)"),
+    "sweep modes short": (LINEAR, _changed(f"{SWEEP}/frequency", lambda v: v[:, :2]),
+                          f"/{SWEEP}/frequency", "(201, 2)"),
+    "attribute missing": (REFERENCE, _no_attribute(BRANCH, "kind"), f"/{BRANCH}",
+                          "attribute 'kind' missing"),
+    "names missing": (REFERENCE, _no_attribute(f"{BRANCH}/parameters", "names"),
+                      f"/{BRANCH}/parameters", "attribute 'names' missing"),
+}
+
+
+def damaged(name: str, directory: Path) -> tuple[Path, str, str]:
+    """A copy of a committed result in ``directory`` with the damage ``name`` done to it,
+    the HDF5 path whirl must name and words its reason must hold."""
+    source, damage, where, words = DAMAGES[name]
+    path = directory / f"{name.replace(' ', '_')}.h5"
+    shutil.copyfile(source, path)
+    with h5py.File(path, "r+") as handle:
+        damage(handle)
+    return path, where, words
+
+
+@pytest.mark.parametrize("command", ["plot", "summary", "check"])
+@pytest.mark.parametrize("name", list(DAMAGES))
+def test_a_result_file_not_whole_is_one_line_naming_what_is_wrong(tmp_path, name, command):
+    bad, where, words = damaged(name, tmp_path)
+    result = CliRunner().invoke(cli, [command, str(bad)])
+    assert isinstance(result.exception, SystemExit), repr(result.exception)  # no exception
+    assert result.exit_code == 1, result.output
+    lines = result.output.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"{bad}: "), result.output
+    assert f"({where}: " in lines[0] and words in lines[0], result.output
+    assert [p.name for p in tmp_path.iterdir()] == [bad.name]  # no plots of half a file
+
+
+def test_the_console_script_refuses_a_file_without_branches(tmp_path):
+    """The reported symptom, through the real ``whirl`` executable."""
+    bad, where, _ = damaged("branches group deleted", tmp_path)
+    for command in ("plot", "summary", "check"):
+        done = whirl(command, bad)
+        assert done.returncode == 1, done
+        assert done.stdout == "" and done.stderr.splitlines() == [
+            f"{bad}: a damaged whirl result file ({where}: missing)"], done
+
+
+@pytest.mark.parametrize("source", [REFERENCE, LINEAR,
+                                    ROOT / "tests" / "data" / "legacy_hardening_case2.h5"])
+def test_the_committed_results_still_read(source):
+    result = read(source)
+    assert result.continuations and all(len(b) for c in result.continuations
+                                        for b in c.branches)

@@ -155,9 +155,12 @@ def test_every_branch_says_how_it_ends():
     b = branch("b", results.BranchKind.EQUILIBRIUM, 4)
     b = replace(b, parameter_names=("V",), parameters=np.array([[0.0], [1.0], [2.0], [3.0]]),
                 state_max=np.zeros((4, model.n_states)), state_min=np.zeros((4, model.n_states)),
-                point_type=np.zeros(4, dtype=np.int64))
+                point_type=np.array([0, 0, 0, results.PointType.UZ]))  # AUTO's UZSTOP stop
     assert run_end(b, {"UZSTOP": {"V": [-1.0, 3.0]}}, model) == "range"
     assert run_end(b, {"UZSTOP": {"V": [-1.0, 5.0]}, "NMX": 4}, model) == "step limit"
+    # at a bound without a UZ stop: one that only starts there (max_steps: 1) has not reached it
+    start = replace(b, parameters=b.parameters[::-1], point_type=np.array([0, 0, 0, 9]))
+    assert run_end(start, {"UZSTOP": {"V": [0.0, 3.0]}, "NMX": 4}, model) == "step limit"
     big = b.state_max.copy()
     big[-1, 0] = 1.5 * model.dofs[0].amplitude
     dof = model.dofs[0].name
@@ -187,3 +190,24 @@ def test_a_schema_1_file_still_reads_and_plots(tmp_path, name):
     run = CliRunner().invoke(cli, ["plot", str(path), "-o", str(tmp_path)])
     assert run.exit_code == 0, run.output
     assert list(tmp_path.glob("*.png"))
+
+
+@pytest.mark.parametrize(("end", "truncated"), [
+    ("step limit", True),
+    ("returns to HB at V = 0.3 on main; other end: step limit", True),
+    ("period blow-up: homoclinic approach; other end: amplitude bound", False),
+    ("range", False), ("closed", False),
+    ("not continued after its last chunk of steps", False),
+])
+def test_only_a_branch_stopped_at_the_step_limit_fails_the_study(end, truncated):
+    from dataclasses import replace
+
+    from whirl_cli.verdict import verdict
+
+    b = replace(branch("p", results.BranchKind.PERIODIC, 3), end=end)
+    result = results.StudyResult("s", "m", (results.ContinuationResult(
+        "c", "one-parameter", (b,), ()),), (), ())
+    problems = verdict(result).problems
+    assert b.truncated is truncated
+    assert len(problems) == truncated
+    assert all(p.startswith("p stopped at the step limit") for p in problems)

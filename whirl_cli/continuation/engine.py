@@ -20,7 +20,7 @@ from ..auto.codegen import fortran_source, source_key
 from ..auto.parse import parse_s, read_branch
 from ..interrupts import thread_map
 from ..models import Model
-from ..results import Branch, BranchKind, PointType, RunRecord, SpecialPoint
+from ..results import STEP_LIMIT, Branch, BranchKind, PointType, RunRecord, SpecialPoint
 from .branches import special_points
 
 
@@ -207,8 +207,9 @@ def _read(engine: Engine, spec: RunSpec, outcome: runner.RunOutcome) -> Branch:
 def run_end(branch: Branch, constants: dict, model: Model) -> str:
     """Why an AUTO run's branch ends, from the stops it ran with: "failed: ..." (no output),
     "no convergence (MX)", "range" (a parameter at a UZSTOP bound), "amplitude bound" (a dof
-    at its UZSTOP amplitude, in typical amplitudes), "period cap", "step limit" (NMX points)
-    or "AUTO end point" (another EP, e.g. a locus meeting a degenerate point)."""
+    at its UZSTOP amplitude, in typical amplitudes), "period cap" (each a UZ stop: a branch
+    only starting at a bound has not reached it), :data:`STEP_LIMIT` (NMX points) or "AUTO
+    end point" (another stop, e.g. a locus meeting a degenerate point)."""
     if not len(branch):
         return f"failed: {branch.message}"
     if branch.status == "mx" or branch.point_type[-1] == PointType.MX:
@@ -217,7 +218,8 @@ def run_end(branch: Branch, constants: dict, model: Model) -> str:
         return f"{branch.status}: {branch.message}"
     dofs = {dof.name: k for k, dof in enumerate(model.dofs)}
     amplitudes = [dof.amplitude for dof in model.dofs]
-    for name, limit in constants.get("UZSTOP", {}).items():
+    stops = constants.get("UZSTOP", {}) if branch.point_type[-1] == PointType.UZ else {}
+    for name, limit in stops.items():
         limits = limit if isinstance(limit, list | tuple) else [limit]
         if name in branch.parameter_names:
             value = branch.parameters[-1, branch.parameter_names.index(name)]
@@ -233,6 +235,6 @@ def run_end(branch: Branch, constants: dict, model: Model) -> str:
             if reach >= 0.999 * abs(limits[0]):
                 return "amplitude bound"
     if len(branch) >= constants.get("NMX", np.inf):
-        return "step limit"
-    return "AUTO end point" if branch.point_type[-1] == PointType.EP else "step limit"
+        return STEP_LIMIT
+    return "AUTO end point"
 

@@ -13,7 +13,7 @@ from ..auto import runner
 from ..auto.constants import TORUS_ANGLE_INDEX, par_layout
 from ..interrupts import thread_map
 from ..models import Model
-from ..results import Branch, BranchKind, ContinuationResult, PointType, SpecialPoint
+from ..results import STEP_LIMIT, Branch, BranchKind, ContinuationResult, PointType, SpecialPoint
 from .branches import _same_point, head, join, special_points, typical_amplitudes
 from .engine import Engine, Numerics, RunSpec, _read
 from .equilibria import equilibrium_constants
@@ -195,7 +195,7 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
             sorted(curves, key=lambda c: c[1].name))}, [], width)[0].values()]
     codim2 = _codim2(kept)
     points = tuple(point for point, _ in starts)
-    return [_locus_end(c, codim2, bounds, width, points) for c in kept]
+    return [_locus_end(c, codim2, bounds, width, points, numerics.max_steps) for c in kept]
 
 
 def _wave(engine: Engine, pair: tuple[str, str], bounds: dict[str, tuple[float, float]],
@@ -458,11 +458,13 @@ def _reached(curve: Branch, starts: tuple[SpecialPoint, ...], width: np.ndarray
 
 
 def _locus_end(curve: Branch, codim2: list[SpecialPoint], bounds: dict[str, tuple[float, float]],
-               width: np.ndarray, starts: tuple[SpecialPoint, ...] = ()) -> Branch:
+               width: np.ndarray, starts: tuple[SpecialPoint, ...] = (),
+               max_steps: int = Numerics.max_steps) -> Branch:
     """The locus with its end classified: range edge, closed (or back at its start's
     parameters with another orbit: at another of the ``starts`` of its type, if one is
-    there), or a codimension-2 point (where AUTO typically stops with MX: that is the locus'
-    natural end, not a failure)."""
+    there), a codimension-2 point (where AUTO typically stops with MX: that is the locus'
+    natural end, not a failure), its study's step limit (``max_steps`` points), or a chunk
+    of steps after which whirl did not continue it (:func:`_grown`)."""
     last = curve.parameters[-1, :2]
     if _at_range_edge(curve, bounds, width):
         return replace(curve, end="range")
@@ -486,5 +488,8 @@ def _locus_end(curve: Branch, codim2: list[SpecialPoint], bounds: dict[str, tupl
             "AUTO stopped with MX at the codimension-2 point (the locus ends there)"
         return replace(curve, end=f"{point.type_name} at ({where})", status="ok",
                        message=message)
-    return replace(curve, end="no convergence (MX)" if curve.status == "mx" else "step limit")
+    if curve.status == "mx":
+        return replace(curve, end="no convergence (MX)")
+    return replace(curve, end=STEP_LIMIT if len(curve) >= max_steps else "not continued after "
+                   "its last chunk of steps")
 

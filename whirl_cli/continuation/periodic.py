@@ -17,7 +17,7 @@ from ..analysis import global_bifurcations
 from ..auto.constants import AMPLITUDE, par_layout
 from ..interrupts import thread_map
 from ..models import Model
-from ..results import Branch, BranchKind, Orbit, PointType, SpecialPoint
+from ..results import OTHER_END, STEP_LIMIT, Branch, BranchKind, Orbit, PointType, SpecialPoint
 from .branches import amplitude, head, join, reverse, special_points
 from .engine import Engine, Numerics, RunSpec, _read
 from .equilibria import equilibrium_constants
@@ -181,7 +181,7 @@ def _two_sided(a: Branch, b: Branch) -> Branch:
         whole = b if len(b) else a
     else:
         whole = join(reverse(a), b, a.name)
-    end = a.end if a.end == b.end else f"{a.end}; other end: {b.end}"
+    end = a.end if a.end == b.end else f"{a.end}{OTHER_END}{b.end}"
     return replace(whole, end=end)
 
 
@@ -440,5 +440,7 @@ def _periodic_end(family: Branch, model: Model, hopfs: list[SpecialPoint],
         return "amplitude bound", None
     if len(state.pieces) >= MAX_SEGMENTS:
         return f"fold limit ({MAX_SEGMENTS} segments)", None
-    return "step limit", None
+    if state.pieces and len(state.pieces[-1]) >= numerics.max_steps:
+        return STEP_LIMIT, None
+    return "AUTO end point", None
 

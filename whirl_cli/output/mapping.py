@@ -8,6 +8,11 @@ recover an object (a branch, an orbit, a linear sweep, ...) from those declarati
 :func:`write_table` and :func:`read_table` do the same for a list of objects stored column by
 column (special points, cross-checks, unsafe intervals). ``store.py`` holds the declarations
 and the file's layout of groups; nothing else names a field.
+
+Reading checks what it reads against the same declarations: a required dataset or attribute
+that is missing, one whose type does not fit its ``kind`` (a stability flag stored as
+strings), or a dataset whose shape does not fit its ``shape`` (points whose columns do not
+match their names) raise :class:`Damaged`, naming the HDF5 path.
 """
 
 from __future__ import annotations
@@ -39,8 +44,11 @@ class Field:
     ``width``: columns of a table's 2-D column (an int, or the name of a context value), so
     that an empty table keeps its shape. ``default``: the value where an older file lacks the
     field (a function of nothing, or a value); a dataset with default None is optional: not
-written when the object's value is None. ``derived``: written from the object's
-    attribute of that name, never read (e.g. a point type's name beside its code).
+    written when the object's value is None. ``shape``: the dataset's axes, checked on
+    reading: an int is a fixed size; a name is the size every dataset of the group naming
+    it shares or, for a ``columns`` names field, the number of its names. ``derived``:
+    written from the object's attribute of that name, never read (e.g. a point type's name
+    beside its code).
     """
 
     name: str
@@ -53,6 +61,7 @@ written when the object's value is None. ``derived``: written from the object's
     width: int | str | None = None
     default: Any = REQUIRED
     derived: bool = False
+    shape: tuple[int | str, ...] | None = None
 
     def hdf5_key(self, kind: str = "") -> str:
         return _choose(self.key, kind) or self.name
@@ -63,6 +72,76 @@ written when the object's value is None. ``derived``: written from the object's
 
 def _choose(value, kind: str):
     return value(kind) if callable(value) else value
+
+
+class Damaged(ValueError):
+    """A result file holding something else than its declarations say: ``where`` (the HDF5
+    path of the group or dataset) and what is wrong there."""
+
+    def __init__(self, where: str, reason: str) -> None:
+        super().__init__(f"{where}: {reason}")
+
+
+def _path(group: h5py.Group, key: str) -> str:
+    return f"{group.name.rstrip('/')}/{key}"
+
+
+def member(group: h5py.Group, key: str):
+    """The required member ``key`` of ``group``; :class:`Damaged` where it is missing."""
+    if key not in group:
+        raise Damaged(_path(group, key), "missing")
+    return group[key]
+
+
+def attribute(obj, key: str):
+    """The required attribute ``key`` of a group or dataset; :class:`Damaged` if missing."""
+    if key not in obj.attrs:
+        raise Damaged(obj.name, f"attribute {key!r} missing")
+    return obj.attrs[key]
+
+
+#: NumPy dtype kinds each field ``kind`` accepts in a file, and its word for them.
+_ACCEPTS = {"text": ("OSU", "text"), "int": ("iu", "integers"), "float": ("iuf", "numbers"),
+            "optional_float": ("iuf", "numbers"), "bool": ("biu", "booleans"),
+            "array": ("biufc", "numbers")}
+_FOUND = {"O": "strings", "S": "strings", "U": "strings", "b": "booleans", "i": "integers",
+          "u": "integers", "f": "floats", "c": "complex numbers"}
+
+
+def _check_type(where: str, dtype: np.dtype, kind: str, what: str = "") -> None:
+    """:class:`Damaged` unless ``dtype`` (of a dataset, or of an attribute's value) fits a
+    field of ``kind``."""
+    accepted, word = _ACCEPTS[kind]
+    if dtype.kind not in accepted:
+        found = _FOUND.get(dtype.kind, f"of type {dtype}")
+        raise Damaged(where, f"{what}stored as {found}, expected {word}")
+
+
+def _check_shape(where: str, shape: tuple[int, ...], declared: tuple[int | str, ...],
+                 sizes: dict[str, int], values: dict[str, Any]) -> None:
+    """:class:`Damaged` unless ``shape`` fits ``declared`` (see :attr:`Field.shape`);
+    ``sizes``: the named sizes seen so far in the group (updated), ``values``: the names
+    read so far."""
+    if len(shape) != len(declared):
+        raise Damaged(where, f"shape {shape}, expected {len(declared)} dimension(s)")
+    for size, axis in zip(shape, declared, strict=True):
+        if isinstance(axis, int):
+            expected, what = axis, ""
+        elif axis in values:
+            expected, what = len(values[axis]), f" (its {axis.replace('_', ' ')})"
+        else:
+            expected = sizes.setdefault(axis, size)
+            what = f" ({axis}, as in the other datasets of its group)"
+        if size != expected:
+            raise Damaged(where, f"shape {shape}: {size} where {expected} belong{what}")
+
+
+def _names(dataset: h5py.Dataset, key: str) -> tuple[str, ...]:
+    """A dataset's ``names`` or ``units`` attribute (a list of strings)."""
+    value = attribute(dataset, key)
+    if np.size(value):  # an empty list is stored as an empty array of floats
+        _check_type(dataset.name, np.asarray(value).dtype, "text", f"attribute {key!r} ")
+    return texts(np.atleast_1d(value))
 
 
 def text(value) -> str:
@@ -148,33 +227,45 @@ def write_record(group: h5py.Group, obj, fields: Sequence[Field]) -> None:
 
 def read_record(group: h5py.Group, fields: Sequence[Field]) -> dict[str, Any]:
     """The dataclass fields stored in ``group`` (the keyword arguments of its class), those
-    a dataset's ``names``/``units`` attributes carry included."""
+    a dataset's ``names``/``units`` attributes carry included; :class:`Damaged` where the
+    group does not hold what ``fields`` declare."""
     values: dict[str, Any] = {}
     for field in (f for f in fields if f.stored == "attribute"):
-        values[field.name] = _read_attribute(group.attrs, field)
+        values[field.name] = _read_attribute(group, field)
     kind = str(values.get("kind", ""))
+    sizes: dict[str, int] = {}
     for field in (f for f in fields if f.stored == "dataset" and not f.derived):
         key = field.hdf5_key(kind)
         if key not in group:
-            values[field.name] = _missing(field, key)
+            values[field.name] = _missing(field, _path(group, key))
             continue
         dataset = group[key]
-        values[field.name] = _decoded(dataset[()], field.kind)
+        if not isinstance(dataset, h5py.Dataset):
+            raise Damaged(dataset.name, "a group where a dataset belongs")
+        _check_type(dataset.name, dataset.dtype, field.kind)
         if field.columns is not None:
             names, units = field.columns
-            values[names] = texts(dataset.attrs["names"])
+            values[names] = _names(dataset, "names")
             if units is not None:
-                values[units] = texts(dataset.attrs["units"])
+                values[units] = _names(dataset, "units")
+                if len(values[units]) != len(values[names]):
+                    raise Damaged(dataset.name, f"{len(values[units])} units for "
+                                  f"{len(values[names])} names")
         if field.unit_field is not None:
-            values[field.unit_field] = text(dataset.attrs["units"])
+            values[field.unit_field] = text(attribute(dataset, "units"))
+        if field.shape is not None:
+            _check_shape(dataset.name, dataset.shape, field.shape, sizes, values)
+        values[field.name] = _decoded(dataset[()], field.kind)
     return values
 
 
-def _read_attribute(attributes, field: Field):
+def _read_attribute(group: h5py.Group, field: Field):
     key = field.hdf5_key()
-    if key not in attributes:
-        return _missing(field, key)
-    value = attributes[key]
+    if key not in group.attrs:
+        return _missing(field, group.name, key)
+    value = group.attrs[key]
+    if np.size(value):  # an empty list is stored as an empty array of floats
+        _check_type(group.name, np.asarray(value).dtype, field.kind, f"attribute {key!r} ")
     if field.kind == "array":
         return value
     if isinstance(value, np.ndarray):  # a list of names, or of numbers
@@ -182,9 +273,11 @@ def _read_attribute(attributes, field: Field):
     return _CONVERT[field.kind](value)
 
 
-def _missing(field: Field, key: str):
+def _missing(field: Field, where: str, attribute_key: str = ""):
+    """The default of a field missing from the file; :class:`Damaged` if it is required."""
     if field.default is REQUIRED:
-        raise KeyError(f"no {key!r}")
+        raise Damaged(where, f"attribute {attribute_key!r} missing" if attribute_key
+                      else "missing")
     return field.default() if callable(field.default) else field.default
 
 
@@ -214,26 +307,43 @@ def write_table(group: h5py.Group, rows: Sequence, fields: Sequence[Field],
 
 
 def read_table(group: h5py.Group, cls: type, fields: Sequence[Field]) -> tuple:
-    """The ``cls`` objects stored column by column in ``group`` by :func:`write_table`."""
+    """The ``cls`` objects stored column by column in ``group`` by :func:`write_table`;
+    :class:`Damaged` where a column is missing, of another type, or of another length or
+    width than the others."""
     columns: dict[str, Any] = {}
     shared: dict[str, Any] = {}
     for field in (f for f in fields if not f.derived):
         key = field.hdf5_key()
-        if key in group:
-            columns[field.name] = group[key][()]
-            if field.columns is not None:
-                names, units = field.columns
-                shared[names] = texts(group[key].attrs["names"])
-                if units is not None and "units" in group[key].attrs:  # older files: none
-                    shared[units] = texts(group[key].attrs["units"])
-    length = max((len(c) for c in columns.values()), default=0)
+        if key not in group:
+            continue
+        dataset = group[key]
+        if not isinstance(dataset, h5py.Dataset):
+            raise Damaged(dataset.name, "a group where a dataset belongs")
+        _check_type(dataset.name, dataset.dtype, field.kind)
+        columns[field.name] = dataset[()]
+        if field.columns is not None:
+            names, units = field.columns
+            shared[names] = _names(dataset, "names")
+            if units is not None and "units" in dataset.attrs:  # older files: none
+                shared[units] = _names(dataset, "units")
+        _check_column(dataset, field, len(columns[next(iter(columns))]), shared)
     rows = []
-    for k in range(length):
+    for k in range(len(columns[next(iter(columns))]) if columns else 0):
         values = dict(shared)
         for field in (f for f in fields if not f.derived):
             if field.name in columns:
                 values[field.name] = _CONVERT[field.kind](columns[field.name][k])
             else:
-                values[field.name] = _missing(field, field.hdf5_key())
+                values[field.name] = _missing(field, _path(group, field.hdf5_key()))
         rows.append(cls(**values))
     return tuple(rows)
+
+
+def _check_column(dataset: h5py.Dataset, field: Field, rows: int, shared: dict) -> None:
+    """:class:`Damaged` unless a table's column has ``rows`` rows, and the width its field
+    declares (a fixed width, or its number of names, where there are rows)."""
+    width: tuple[int | str, ...] = ()
+    if field.width is not None:
+        width = (field.width if isinstance(field.width, int)
+                 else field.columns[0] if field.columns is not None and rows else "width",)
+    _check_shape(dataset.name, dataset.shape, ("rows", *width), {"rows": rows}, shared)

@@ -108,7 +108,17 @@ from ..results import (
     UnsafeInterval,
 )
 from .atomic import publish
-from .mapping import Field, read_record, read_table, text, write_record, write_table
+from .mapping import (
+    Damaged,
+    Field,
+    attribute,
+    member,
+    read_record,
+    read_table,
+    text,
+    write_record,
+    write_table,
+)
 
 SCHEMA = 2
 #: Schemas :func:`read` reads (1: before units on every dataset and the parameter set).
@@ -122,25 +132,28 @@ BRANCH = (
     Field("kind", "attribute", "text"), Field("origin", "attribute", "text"),
     Field("status", "attribute", "text"), Field("message", "attribute", "text"),
     Field("run", "attribute", "text"), Field("end", "attribute", "text"),
-    Field("parameters", columns=("parameter_names", "parameter_units")),
-    Field("state_max", columns=("state_names", "state_units")),
-    Field("state_min", columns=("state_names", "state_units")),
-    Field("l2_norm", units="1"),
-    Field("period", units="s"),
-    Field("stable", kind="bool"),
-    Field("stability_known", kind="bool", default=None),  # older files: known everywhere
-    Field("point_type", kind="int"),
-    Field("label", kind="int"),
+    Field("parameters", columns=("parameter_names", "parameter_units"),
+          shape=("points", "parameter_names")),
+    Field("state_max", columns=("state_names", "state_units"), shape=("points", "state_names")),
+    Field("state_min", columns=("state_names", "state_units"), shape=("points", "state_names")),
+    Field("l2_norm", units="1", shape=("points",)),
+    Field("period", units="s", shape=("points",)),
+    Field("stable", kind="bool", shape=("points",)),
+    Field("stability_known", kind="bool", default=None,  # older files: known everywhere
+          shape=("points",)),
+    Field("point_type", kind="int", shape=("points",)),
+    Field("label", kind="int", shape=("points",)),
     Field("eigenvalues",
           key=lambda kind: "floquet_multipliers" if kind == _PERIODIC else "eigenvalues",
-          units=lambda kind: "1" if kind == _PERIODIC else "1/s"),
-    Field("torus_angle", units="rad", default=None),  # torus loci only
+          units=lambda kind: "1" if kind == _PERIODIC else "1/s",
+          shape=("points", "state_names")),
+    Field("torus_angle", units="rad", default=None, shape=("points",)),  # torus loci only
 )
 #: An :class:`Orbit` in ``orbits/<label>`` of its branch.
 ORBIT = (
     Field("point_type", "attribute", "int"), Field("index", "attribute", "int"),
     Field("period", "attribute", "float"), Field("parameters", "attribute"),
-    Field("time", units="s"), Field("states"),
+    Field("time", units="s", shape=("samples",)), Field("states", shape=("samples", "states")),
 )
 #: The :class:`SpecialPoint` table of a continuation (``special_points/``), one column each.
 SPECIAL_POINT = (
@@ -183,42 +196,47 @@ SEED = (
 EXPLORATION = (
     Field("parameter", "attribute", "text"), Field("kind", "attribute", "text"),
     Field("multiplicity", "attribute", "int"), Field("evidence", "attribute", "text"),
-    Field("value", kind="float", unit_field="unit"),
-    Field("initial", columns=("state_names", "state_units")),
-    Field("lyapunov", kind="float", units="1/s"),
-    Field("lyapunov_error", kind="float", units="1/s"),
-    Field("frequencies", units="Hz"),
-    Field("section", columns=("state_names", "state_units")),
-    Field("section_dimension", kind="float", units="1"),
-    Field("peaks", units="Hz"),
-    Field("broadband", kind="float", units="1"),
+    Field("value", kind="float", unit_field="unit", shape=()),
+    Field("initial", columns=("state_names", "state_units"), shape=("state_names",)),
+    Field("lyapunov", kind="float", units="1/s", shape=()),
+    Field("lyapunov_error", kind="float", units="1/s", shape=()),
+    Field("frequencies", units="Hz", shape=("frequencies",)),
+    Field("section", columns=("state_names", "state_units"), shape=("crossings", "state_names")),
+    Field("section_dimension", kind="float", units="1", shape=()),
+    Field("peaks", units="Hz", shape=("peaks",)),
+    Field("broadband", kind="float", units="1", shape=()),
 )
 #: The :class:`FreeplayAmplitudes` of a periodic branch, in ``<branch>/freeplay_<dof>``.
 FREEPLAY = (
     Field("dof", "attribute", "text"),
-    Field("amplitude_ratio", units="1"),
-    Field("estimate_ratio", key="describing_function/amplitude_ratio", units="1"),
+    Field("amplitude_ratio", units="1", shape=("points",)),
+    Field("estimate_ratio", key="describing_function/amplitude_ratio", units="1",
+          shape=("estimates",)),
     Field("estimate_stiffness", key="describing_function/stiffness",
-          unit_field="stiffness_unit"),
+          unit_field="stiffness_unit", shape=("estimates",)),
     Field("estimate_parameter", key="describing_function/parameter",
-          unit_field="parameter_unit"),
+          unit_field="parameter_unit", shape=("estimates",)),
     Field("onset", key="linear_onset", unit_field="parameter_unit",
           default=lambda: np.empty(0)),
 )
 #: A :class:`LinearSweep` in ``linear/sweeps/<parameter>``.
 LINEAR_SWEEP = (
     Field("parameter", "attribute", "text"),
-    Field("values", unit_field="unit"), Field("eigenvalues", units="1/s"),
-    Field("damping_ratio", units="1"), Field("frequency", units="rad/s"),
-    Field("whirl", kind="text"), Field("mode_group", kind="text", default=None),
-    Field("datum", kind="float", unit_field="unit", default=None),  # older files: none
+    Field("values", unit_field="unit", shape=("values",)),
+    Field("eigenvalues", units="1/s", shape=("values", "modes")),
+    Field("damping_ratio", units="1", shape=("values", "modes")),
+    Field("frequency", units="rad/s", shape=("values", "modes")),
+    Field("whirl", kind="text", shape=("values", "modes")),
+    Field("mode_group", kind="text", default=None, shape=("values", "modes")),
+    Field("datum", kind="float", unit_field="unit", default=None,  # older files: none
+          shape=()),
     Field("multiples", "attribute", "bool", default=False),
 )
 #: A :class:`LinearGrid` in ``linear/grid`` (its contour lines: collections of their own).
 LINEAR_GRID = (
     Field("x_parameter", "attribute", "text"), Field("y_parameter", "attribute", "text"),
-    Field("x", unit_field="x_unit"), Field("y", unit_field="y_unit"),
-    Field("max_real", units="1/s"), Field("oscillatory"),
+    Field("x", unit_field="x_unit", shape=("x",)), Field("y", unit_field="y_unit", shape=("y",)),
+    Field("max_real", units="1/s", shape=("y", "x")), Field("oscillatory", shape=("y", "x")),
 )
 #: A :class:`Boundary` in ``boundaries/<name>`` (its loci and polygons: collections).
 BOUNDARY = (
@@ -235,11 +253,12 @@ UNSAFE_INTERVAL = (
 SIMULATION = (
     Field("law", "attribute", "text"), Field("status", "attribute", "int"),
     Field("message", "attribute", "text"),
-    Field("parameter_values", key="parameters", columns=("parameter_names", "parameter_units")),
-    Field("initial", columns=("state_names", "state_units")),
-    Field("time", units="s"),
-    Field("states", columns=("state_names", "state_units")),
-    Field("hub", unit_field="hub_unit"),
+    Field("parameter_values", key="parameters", columns=("parameter_names", "parameter_units"),
+          shape=("parameter_names",)),
+    Field("initial", columns=("state_names", "state_units"), shape=("state_names",)),
+    Field("time", units="s", shape=("samples",)),
+    Field("states", columns=("state_names", "state_units"), shape=("samples", "state_names")),
+    Field("hub", unit_field="hub_unit", shape=("samples", 2)),
 )
 #: A :class:`RunRecord` in ``runs/<name>``.
 RUN = (
@@ -271,8 +290,9 @@ def _write_branch(group: h5py.Group, branch: Branch) -> None:
 
 def _write_continuation(group: h5py.Group, continuation: ContinuationResult) -> None:
     group.attrs["kind"] = continuation.kind
+    branches = _collection(group, "branches")  # also where there are none: it is required
     for branch in continuation.branches:
-        _write_branch(_collection(group, "branches").create_group(branch.name), branch)
+        _write_branch(branches.create_group(branch.name), branch)
     for found in continuation.freeplay:
         _write_freeplay(group["branches"][found.branch], found)
     points = continuation.special_points
@@ -427,16 +447,28 @@ def _read_branch(name: str, group: h5py.Group) -> Branch:
 
 
 def _read_continuation(name: str, group: h5py.Group) -> ContinuationResult:
-    branches = group.get("branches", {})
-    return ContinuationResult(
-        name, text(group.attrs["kind"]),
+    branches = member(group, "branches")
+    found = ContinuationResult(
+        name, text(attribute(group, "kind")),
         tuple(_read_branch(b, g) for b, g in branches.items()),
-        read_table(group["special_points"], SpecialPoint, SPECIAL_POINT),
+        read_table(member(group, "special_points"), SpecialPoint, SPECIAL_POINT),
         read_table(group["cross_checks"], CrossCheck, CROSS_CHECK)
         if "cross_checks" in group else (),
         tuple(f for b, g in branches.items() for f in _read_freeplay(b, g)),
         read_table(group["seeds"], SeedOutcome, SEED) if "seeds" in group else (),
         _read_explorations(group.get("explorations", {})))
+    for table, rows in (("special_points", found.special_points),
+                        ("cross_checks", found.cross_checks)):
+        _check_branches(group, table, rows, {b.name for b in found.branches})
+    return found
+
+
+def _check_branches(group: h5py.Group, table: str, rows, names: set[str]) -> None:
+    """:class:`Damaged` where a row of ``table`` is on a branch the file does not hold."""
+    missing = sorted({row.branch for row in rows} - names)
+    if missing:
+        raise Damaged(f"{group.name}/{table}/branch", f"names branch {missing[0]!r}, "
+                      f"which is not in {group.name}/branches")
 
 
 def _read_explorations(group) -> tuple[Exploration, ...]:
@@ -451,12 +483,12 @@ def _read_explorations(group) -> tuple[Exploration, ...]:
 
 
 def _read_boundary(name: str, group: h5py.Group) -> Boundary:
-    loci = {key: (text(data.attrs["kind"]), data[()])
+    loci = {key: (text(attribute(data, "kind")), data[()])
             for key, data in group.get("loci", {}).items()}
     polygons = tuple(group["unsafe"][key][()] for key in _members(group.get("unsafe", {}),
                                                                    _number))
     return Boundary(name=name, **read_record(group, BOUNDARY), loci=loci, polygons=polygons,
-                    intervals=read_table(group["unsafe_intervals"], UnsafeInterval,
+                    intervals=read_table(member(group, "unsafe_intervals"), UnsafeInterval,
                                          UNSAFE_INTERVAL))
 
 
@@ -488,6 +520,8 @@ def opened(path: Path) -> Iterator[h5py.File]:
     try:
         with handle:
             yield handle
+    except Damaged as error:
+        raise OutputError(f"{path}: a damaged whirl result file ({error})") from None
     except _DAMAGED as error:
         raise OutputError(f"{path}: not a complete whirl result file "
                           f"({_reason(error)})") from None
@@ -530,17 +564,18 @@ def read(path: Path) -> StudyResult:
         sweeps = tuple(LinearSweep(**read_record(group, LINEAR_SWEEP))
                        for group in handle.get("linear/sweeps", {}).values())
         runs = tuple(RunRecord(name=name, **read_record(group, RUN))
-                     for name, group in handle.get("runs", {}).items())
+                     for name, group in member(handle, "runs").items())
         grid = _read_grid(handle["linear/grid"]) if "linear/grid" in handle else None
         boundaries = tuple(_read_boundary(name, group)
                            for name, group in handle.get("boundaries", {}).items())
         skip = {"whirl_schema", "study_name", "model"}
         attributes = {k: (text(v) if isinstance(v, bytes | str) else v)
                       for k, v in handle.attrs.items() if k not in skip}
-        parameters = read_table(handle["parameters"], ParameterValue, PARAMETER) \
-            if "parameters" in handle else ()
+        parameters = read_table(member(handle, "parameters"), ParameterValue, PARAMETER) \
+            if schema >= 2 else ()
         simulations = tuple(Simulation(name=name, **read_record(group, SIMULATION))
                             for name, group in handle.get("simulations", {}).items())
-        return StudyResult(text(handle.attrs["study_name"]), text(handle.attrs["model"]),
+        return StudyResult(text(attribute(handle, "study_name")),
+                           text(attribute(handle, "model")),
                            continuations, sweeps, runs, attributes, boundaries, grid,
                            parameters, simulations)

@@ -27,6 +27,7 @@ import numpy as np
 
 from ..results import Branch, ContinuationResult, PointType, SpecialPoint, StudyResult
 from ..units import axis_label, display_unit
+from ..verdict import truncation
 
 FORMATS = ("table", "csv", "json")
 """Formats of ``whirl summary --format``."""
@@ -251,12 +252,14 @@ def compact(records_: Sequence[dict[str, object]], longest: int = RUN_SHOWN
 @dataclass(frozen=True)
 class Table:
     """A continuation's special points as the table shows them: ``title``, column ``names``
-    (``right``: right-aligned, the numbers) and ``rows`` of cell texts."""
+    (``right``: right-aligned, the numbers), ``rows`` of cell texts and ``notes``, lines
+    below them (branches stopped short of their range)."""
 
     title: str
     names: tuple[str, ...]
     right: tuple[bool, ...]
     rows: tuple[tuple[str, ...], ...]
+    notes: tuple[str, ...] = ()
 
     def lines(self) -> list[str]:
         """The title, the header and a line per row, columns two spaces apart, each as wide
@@ -270,7 +273,7 @@ class Table:
 
         header = line(self.names)
         body = [line(row) for row in self.rows] or ["none".center(len(header)).rstrip()]
-        return [self.title, header, *body]
+        return [self.title, header, *body, *self.notes]
 
 
 def tables(result: StudyResult, dofs: Sequence[str] | None = None) -> list[Table]:
@@ -292,7 +295,8 @@ def tables(result: StudyResult, dofs: Sequence[str] | None = None) -> list[Table
             f"{continuation.name} ({continuation.kind}): "
             f"{len(rows)} special point{'s' if len(rows) != 1 else ''}", names,
             tuple(name not in ("branch", "type", *LAST_COLUMNS[1:]) for name in names),
-            tuple(cells)))
+            tuple(cells), tuple(f"note: {truncation(b)}" for b in continuation.branches
+                                if b.truncated)))
     return drawn
 
 
