@@ -227,3 +227,14 @@ def test_the_classical_model_file_gives_the_built_in_equations():
                                    built_in.jacobian_numpy(y, p), rtol=1e-11, atol=1e-11)
     assert file_model.family.time_scale == built_in.time_scale
     assert math.isclose(file_model.family.hub[0][0][1], -1.0)
+
+
+def test_a_fresh_process_finds_a_model_file_by_its_reference():
+    """A study travels to another process (a Dask worker) with its model's absolute path: the
+    process reads the file itself."""
+    code = ("from whirl_cli.models import get_model; import sys; "
+            "print(get_model(sys.argv[1]).family.name)")
+    done = subprocess.run([sys.executable, "-c", code, str(DATA / "classical_as_file.yaml")],
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "classical_file"

@@ -53,10 +53,13 @@ def is_model_file(reference: object) -> bool:
 
 
 def family_of(reference: str) -> Family:
-    """The family a study's ``model`` names: a built-in by name, or a model file read before
-    (:func:`load_model_file`) by its absolute path. KeyError otherwise."""
+    """The family a study's ``model`` names: a built-in by name, or a model file by its
+    absolute path (read once per process, :func:`load_model_file`). KeyError otherwise."""
     if reference in FAMILIES:
         return FAMILIES[reference]
+    if reference not in _FILES and is_model_file(reference) and Path(reference).is_absolute() \
+            and Path(reference).is_file():  # e.g. in a worker process of another machine
+        load_model_file(Path(reference))
     return _FILES[reference]
 
 
