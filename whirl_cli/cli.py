@@ -461,13 +461,20 @@ def figures(paths: tuple[Path, ...], out_dir: Path, results_dir: Path, jobs: int
 
 
 # ------------------------------------------------------------------------------------ compare
+def _tolerance(ctx: click.Context, param: click.Parameter, value: float | None):
+    """``--rtol``/``--atol``: a finite number (>= 0 by its type; None if not given)."""
+    if value is not None and not math.isfinite(value):
+        raise click.BadParameter(f"expected a finite number >= 0, got {value:g}")
+    return value
+
+
 @cli.command()
 @click.argument("file_a", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.argument("file_b", type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.option("--rtol", type=click.FloatRange(min=0), default=None,
+@click.option("--rtol", type=click.FloatRange(min=0), default=None, callback=_tolerance,
               help="Relative tolerance: periods, linear sweeps, special-point parameters "
                    "(fraction of the continuation's range) [default: 1e-5, 1e-9, 1e-6].")
-@click.option("--atol", type=click.FloatRange(min=0), default=None,
+@click.option("--atol", type=click.FloatRange(min=0), default=None, callback=_tolerance,
               help="Absolute tolerance on states (rad, rad/s) of special points and branches "
                    "[default: 1e-6, 1e-5].")
 @click.option("--limit", type=click.IntRange(1), default=20, show_default=True,

@@ -83,6 +83,7 @@ def test_a_figure_that_cannot_be_drawn_is_reported(tmp_path):
 
 
 def test_bad_sheet_runs_nothing(tmp_path):
+    """A sheet that is not valid runs nothing; it is listed in the index as not drawn."""
     folder = tmp_path / "sheets"
     folder.mkdir()
     (folder / "bad.yaml").write_text('figure: "9.1"\ncaption: c\npanels:\n'
@@ -91,7 +92,9 @@ def test_bad_sheet_runs_nothing(tmp_path):
                                       "--results", str(tmp_path / "r")])
     assert result.exit_code == 1
     assert "bad.yaml:4: panels[0].study: no study file" in result.output
-    assert not (tmp_path / "f").exists() and not (tmp_path / "r").exists()
+    assert not (tmp_path / "r").exists()
+    assert [p.name for p in (tmp_path / "f").iterdir()] == ["index.html"]
+    assert "not drawn: " in (tmp_path / "f" / "index.html").read_text()
 
 
 #: The result figures of thesis chapter 3 (shared/figures.md: 3.3, 3.6 to 3.30 without 3.25).
@@ -99,7 +102,8 @@ CHAPTER_3 = {"3.3"} | {f"3.{n}" for n in range(6, 31) if n != 25}
 
 
 def test_shipped_sheets_are_valid_and_cover_the_figures_list():
-    shipped = load_sheets([ROOT / "sheets" / "thesis_ch3"])
+    shipped, refused = load_sheets([ROOT / "sheets" / "thesis_ch3"])
+    assert refused == []
     assert {s.figure for s in shipped} == CHAPTER_3
     for sheet in shipped:
         for path in sheet.studies():

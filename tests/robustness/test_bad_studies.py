@@ -17,6 +17,7 @@ from collections import Counter
 from pathlib import Path
 from typing import Any
 
+import pytest
 import yaml
 from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings
@@ -376,3 +377,84 @@ def test_bad_multiples_sweeps_are_refused_at_their_keys(tmp_path):
         assert result.exit_code == 1, result.output
         assert result.output.startswith(expected), result.output
         assert not out.parent.exists()
+
+
+# ------------------------------------------------------------------------------ named cases
+HEAD = "name: s\nmodel: classical\n"
+ONE = "  - {name: %s, type: one-parameter, parameter: K1, range: [-0.3, 0.5]}\n"
+PAIR = ("  - {name: b, type: two-parameter, parameters: [K1, K_psi],\n"
+        "     range: {K1: [0.0, 0.5], K_psi: [0.0, 0.5]}}\n")
+SIM = "  - {name: %s, initial: {theta: 1}, duration: 1}\n"
+FREEPLAY = "nonlinearity: {type: freeplay, delta: 0.01}\n"
+#: (study text, the first message line): stored names that would collide, AUTO steps out of
+#: order, and reasons that name the value at fault.
+NAMED_CASES = {
+    "sweep_twice": (HEAD + "linear:\n  sweeps:\n    - {parameter: V, range: [10, 20]}\n"
+                    "    - {parameter: V, range: [30, 40]}\n",
+                    "s.yaml:6: linear.sweeps[1].parameter: a second sweep of V, the first is "
+                    "linear.sweeps[0]"),
+    "sweep_alias": (HEAD + "linear:\n  sweeps:\n    - {parameter: K1, range: [0.1, 0.5]}\n"
+                    "    - {parameter: K_theta, range: [0.6, 0.9]}\n",
+                    "s.yaml:6: linear.sweeps[1].parameter: a second sweep of K_theta "
+                    "('K_theta' and 'K1' both name K_theta)"),
+    "grid_alias": (HEAD + "linear:\n  grid:\n    x: {parameter: K1, range: [0.1, 0.5]}\n"
+                   "    y: {parameter: K_theta, range: [0.1, 0.5]}\n",
+                   "s.yaml:6: linear.grid.y.parameter: the same parameter as x ('K_theta' and "
+                   "'K1' both name K_theta); a grid needs two different parameters"),
+    "slice_run_names": (HEAD + "continuations:\n" + PAIR + ONE % "b.slice_0",
+                        "s.yaml:6: continuations[1].name: 'b.slice_0' would share AUTO run "
+                        "names with continuation 'b' (its runs are named b.<run>)"),
+    "repetition_names": (HEAD + FREEPLAY + "continuations:\n"
+                         + (ONE % "k_eps1" + ONE % "k").replace("-0.3", "0.1"),
+                         "s.yaml:5: continuations[0].name: 'k_eps1' would share AUTO run names "
+                         "with continuation 'k' (with a smoothed law its repetitions are named "
+                         "k_eps<k>)"),
+    "unnamed_simulation": (HEAD + "simulations:\n" + SIM % "sim_2" + SIM % "null",
+                           "s.yaml:5: simulations[1].name: duplicate simulation name 'sim_2' "
+                           "(an unnamed simulation's name, from its position)"),
+    "step_initial_over_max": (HEAD + "auto: {step_initial: 0.1, step_max: 0.01}\n",
+                              "s.yaml:3: auto.step_initial: must be <= step_max (0.01), got "
+                              "0.1"),
+    "step_min_over_max": (HEAD + "auto: {step_min: 0.1, step_max: 0.01}\n",
+                          "s.yaml:3: auto.step_min: must be <= step_max (0.01), got 0.1"),
+    "step_max_under_default": (HEAD + "auto: {step_max: 0.001}\n",
+                               "s.yaml:3: auto.step_max: must be >= step_initial (0.002, "
+                               "whirl's default), got 0.001"),
+    "step_over_range": (HEAD + "auto: {step_initial: 1.5, step_max: 1}\n",
+                        "s.yaml:3: auto.step_initial: must be <= 1, got 1.5"),
+    "seed_nan": (HEAD + "continuations:\n" + (ONE % "k")[:-2] + ", seeds: [{theta: .nan}]}\n",
+                 "s.yaml:4: continuations[0].seeds[0].theta: expected a finite number, got "
+                 ".nan"),
+    "initial_inf": (HEAD + "simulations:\n  - {initial: {theta: .inf}, duration: 1}\n",
+                    "s.yaml:4: simulations[0].initial.theta: expected a finite number, got "
+                    ".inf"),
+    "range_inf": (HEAD + "continuations:\n" + (ONE % "k").replace("-0.3", "-.inf"),
+                  "s.yaml:4: continuations[0].range[0]: expected a finite number, got -.inf"),
+    "range_quoted": (HEAD + "continuations:\n" + (ONE % "k").replace("0.5]", "'0.5']"),
+                     "s.yaml:4: continuations[0].range[1]: expected a number, got '0.5'"),
+    "pair_too_short": (HEAD + "continuations:\n" + PAIR.replace("[K1, K_psi]", "[K1]"),
+                       "s.yaml:4: continuations[0].parameters: expected 2 items, got ['K1']"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(NAMED_CASES))
+def test_named_bad_studies_are_refused_with_their_reason(case, tmp_path, monkeypatch):
+    """Each refused before any run (``whirl run``: exit 1, no output) with the reason at the
+    key at fault; before, the collisions crashed after all the work (``name already
+    exists``), the steps out of order ran and returned less, and the reasons blamed the
+    container ("expected a list of mappings, got a list")."""
+    def accepted(study, *args, **kwargs):
+        raise AssertionError(f"accepted:\n{study.source}")
+
+    monkeypatch.setattr(pipeline, "run_and_draw", accepted)
+    text, expected = NAMED_CASES[case]
+    path = tmp_path / "s.yaml"
+    path.write_text(text)
+    out = tmp_path / "out" / "r.h5"
+    result = CliRunner().invoke(cli, ["run", str(path), "-o", str(out)])
+    assert result.exit_code == 1, result.output
+    assert isinstance(result.exception, SystemExit), result.exception
+    lines = result.output.splitlines()
+    assert lines[0].startswith(expected), result.output
+    assert len(lines) == 1, result.output  # one reason, no second one for the container
+    assert not out.parent.exists()

@@ -339,6 +339,18 @@ def test_cli_exit_status_and_output(files):
     assert relaxed.exit_code == 0, relaxed.output
 
 
+@pytest.mark.parametrize("option", ["--rtol", "--atol"])
+@pytest.mark.parametrize("value", ["nan", "inf", "-inf", "-1"])
+def test_cli_refuses_tolerances_that_are_not_finite_and_non_negative(files, option, value):
+    """A NaN tolerance made a file differ from itself (no difference is <= NaN); an infinite
+    one accepts anything. Both are usage errors, before either file is read."""
+    a, _ = files
+    result = CliRunner().invoke(cli, ["compare", str(a), str(a), option, value])
+    assert result.exit_code == 2, result.output
+    assert f"Invalid value for '{option}'" in result.output
+    assert "differ" not in result.output and "agree" not in result.output
+
+
 def test_cli_prints_at_most_the_limit(tmp_path):
     base = make_result()
     sweep = base.linear_sweeps[0]

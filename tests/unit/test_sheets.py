@@ -75,6 +75,53 @@ def test_bad_sheets_name_file_line_key_and_reason(tmp_path, body, expected):
     assert expected in str(caught.value)
 
 
+PANEL = "panels:\n  - {kind: bifurcation, study: a.yaml}\n"
+
+
+@pytest.mark.parametrize("body, expected", [
+    ("size: [1200, 560]\n" + PANEL,
+     ["f.yaml:3: size[0]: expected inches, 1 to 40, got 1200 (the size is in inches, not "
+      "pixels)", "f.yaml:3: size[1]: expected inches, 1 to 40, got 560 (the size is in "
+      "inches, not pixels)"]),
+    ("size: [.nan, 5]\n" + PANEL, ["f.yaml:3: size[0]: expected a finite number, got .nan"]),
+    ("size: [.inf, 5]\n" + PANEL, ["f.yaml:3: size[0]: expected a finite number, got .inf"]),
+    ("size: ['6', 5]\n" + PANEL, ["f.yaml:3: size[0]: expected a number, got '6'"]),
+    ("size: [0.2, 5]\n" + PANEL, ["f.yaml:3: size[0]: expected inches, 1 to 40, got 0.2"]),
+    ("layout: [1, 100000000]\n" + PANEL, ["f.yaml:3: layout[1]: must be <= 64, got 100000000"]),
+    ("layout: [8, 8]\n" + PANEL,
+     ["f.yaml:3: layout: 8 x 8 panels of 5.2 x 4.2 inches make 41.6 x 33.6 inches, over 40; "
+      "give `size`"]),
+    ("panels:\n  - {kind: phase, study: a.yaml, orbits: [0, 2]}\n",
+     ["f.yaml:4: panels[0].orbits[0]: must be >= 1, got 0"]),
+    ("panels:\n  - {kind: bifurcation, study: a.yaml, colour: red}\n",
+     ["f.yaml:4: panels[0].colour: unknown key (allowed: kind, study, overlay, continuation, "
+      "branch, state, sweep, slice, orbits, simulation, hz, title)"]),
+    ("panels: []\n", ["f.yaml:3: panels: expected 1 to 64 panels, got 0"]),
+])
+def test_numeric_sheet_keys_are_bounded_and_each_problem_is_said_once(tmp_path, body,
+                                                                      expected):
+    """Sizes in inches within bounds (pixels drew a 180000-pixel figure: MemoryError), finite
+    and of the right type; counts bounded; a bad panel reported alone (it added "panels:
+    Tuple should have at least 1 item")."""
+    write(tmp_path, "a.yaml", STUDY)
+    path = write(tmp_path, "f.yaml", 'figure: "3.1"\ncaption: c\n' + body)
+    with pytest.raises(StudyError) as caught:
+        load_sheet(path)
+    assert caught.value.message.splitlines() == [line.replace("f.yaml", str(path))
+                                                 for line in expected]
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("", ": the sheet file is empty"),
+    ("- a\n", ":1: a sheet must be a YAML mapping of keys, got a list"),
+])
+def test_whole_sheet_problems_call_it_a_sheet(tmp_path, text, expected):
+    path = write(tmp_path, "f.yaml", text)
+    with pytest.raises(StudyError) as caught:
+        load_sheet(path)
+    assert caught.value.message == f"{path}{expected}"
+
+
 def test_bad_figure_number(tmp_path):
     path = write(tmp_path, "f.yaml", 'figure: "three"\ncaption: c\npanels: []\n')
     with pytest.raises(StudyError, match=r"f.yaml:1: figure: expected a figure number"):

@@ -10,6 +10,8 @@ Modules, lowest first (each imports only those above it):
 
 * :mod:`~whirl_cli.continuation.branches` -- operations on branches: first rows, joined runs,
   orbit amplitude, special points;
+* :mod:`~whirl_cli.continuation.numerics` -- AUTO numerics under readable names, whirl's
+  defaults (imported by the study schema too);
 * :mod:`~whirl_cli.continuation.engine` -- numerics, run specifications, the engine that
   makes the runs and reads their branches;
 * :mod:`~whirl_cli.continuation.equilibria` -- equilibrium branches with branch switching;

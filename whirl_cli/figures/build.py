@@ -1,7 +1,8 @@
 """``whirl figures`` (``make figures``): run what the sheets need, draw every sheet, write the
 index (:func:`make_figures`).
 
-1. every sheet is read and checked (all problems at once, nothing run);
+1. every sheet is read and checked (all problems at once, nothing run); a sheet that is not
+   valid is reported and left out (:class:`Refused`), the others are drawn;
 2. the studies they name are run as one sweep into the results folder
    (:func:`whirl_cli.sweep.run.run_sweep`: up-to-date results are reused, studies run in
    parallel, without their own plots);
@@ -35,34 +36,64 @@ KEY = "whirl-figure-key"
 
 
 @dataclass(frozen=True)
+class Refused:
+    """A sheet file that is not valid: its path, its problems (``file:line: key: reason``
+    lines) and, for the index, its figure number (its file name where the number cannot be
+    read) and caption. It draws no study."""
+
+    path: Path
+    problem: str
+    figure: str
+    caption: str = ""
+    note: str = ""
+
+    def studies(self) -> list[Path]:
+        return []
+
+
+@dataclass(frozen=True)
 class FigureOutcome:
     """One sheet's result: the PNG (None: not drawn) and, if not, why; ``reused``: the PNG
     was up to date and not redrawn."""
 
-    sheet: Sheet
+    sheet: Sheet | Refused
     image: Path | None
     problem: str = ""
     reused: bool = False
 
 
-def load_sheets(paths: Sequence[str | os.PathLike[str]]) -> list[Sheet]:
-    """Every sheet named by ``paths`` (files, or folders of ``*.yaml``); a StudyError lists
-    the problems of every bad sheet, and two sheets of one figure number."""
-    sheets, problems = [], []
+def load_sheets(paths: Sequence[str | os.PathLike[str]]) -> tuple[list[Sheet], list[Refused]]:
+    """Every sheet named by ``paths`` (files, or folders of ``*.yaml``): the valid ones, and
+    those refused with their problems (a second sheet of a figure number is refused too)."""
+    sheets, refused = [], []
     for path in find_sheets(paths):
         try:
             sheets.append(load_sheet(path))
         except StudyError as error:
-            problems.append(str(error))
+            refused.append(Refused(path, error.message, *_figure_and_caption(path)))
     seen: dict[str, Path] = {}
-    for sheet in sheets:
+    for sheet in list(sheets):
         if sheet.stem in seen:
-            problems.append(f"{sheet.path}: figure {sheet.figure} is also drawn by "
-                            f"{seen[sheet.stem]}")
+            sheets.remove(sheet)
+            refused.append(Refused(sheet.path, f"{sheet.path}: figure {sheet.figure} is also "
+                                   f"drawn by {seen[sheet.stem]}", sheet.figure, sheet.caption,
+                                   sheet.note))
         seen.setdefault(sheet.stem, sheet.path)
-    if problems:
-        raise StudyError("\n".join(problems))
-    return sheets
+    return sheets, refused
+
+
+def _figure_and_caption(path: Path) -> tuple[str, str]:
+    """The figure number and caption of a sheet that is not valid, as far as they can be read
+    (else its file name and no caption)."""
+    from ..study.source import _compose, _read_text, _Tree
+
+    try:
+        data = _Tree(_compose(_read_text(path, path.name, "sheet"), path.name, "sheet")).data
+    except StudyError:
+        data = {}
+    figure, caption = data.get("figure"), data.get("caption")
+    return (figure if isinstance(figure, str) and figure.strip() else path.name,
+            caption if isinstance(caption, str) else "")
 
 
 def make_figures(paths: Sequence[str | os.PathLike[str]], out_dir: Path, results_dir: Path,
@@ -77,7 +108,8 @@ def make_figures(paths: Sequence[str | os.PathLike[str]], out_dir: Path, results
     from ..output.atomic import publish
     from ..sweep.run import run_sweep
 
-    sheets = sorted(load_sheets(paths), key=lambda s: figure_order(s.figure))
+    sheets, refused = load_sheets(paths)
+    sheets.sort(key=lambda s: figure_order(s.figure))
     studies = list(dict.fromkeys(p for s in sheets for p in s.studies()))
     artist = _Artist(out_dir, force, dpi)
 
@@ -90,11 +122,14 @@ def make_figures(paths: Sequence[str | os.PathLike[str]], out_dir: Path, results
             if ready:
                 artist.draw_ready([min(ready, key=lambda s: len(s.panels))], jobs=1)
 
-    run_sweep(studies, results_dir, jobs=jobs, force=force, plots=False, console=console,
-              on_outcome=stored)
+    if studies:
+        run_sweep(studies, results_dir, jobs=jobs, force=force, plots=False, console=console,
+                  on_outcome=stored)
     artist.draw_ready(sheets, jobs)
     _make_folder(out_dir)
     outcomes = [artist.outcome(sheet) for sheet in sheets]
+    outcomes += [FigureOutcome(sheet, None, sheet.problem) for sheet in refused]
+    outcomes.sort(key=lambda o: figure_order(o.sheet.figure))
     page = index_html([_entry(o, out_dir) for o in outcomes], "whirl figures")
     publish(page.encode("utf-8"), out_dir / "index.html", overwrite=True, what="the index")
     return outcomes
@@ -123,8 +158,11 @@ class _Artist:
         source = Path(os.path.normpath(outcome.item.source))
         if outcome.status in ("ok", "failed", "skipped") and outcome.item.output is not None:
             self.outputs[source] = outcome.item.output
+        elif outcome.status == "invalid":  # its problems name the study file
+            self.failed[source] = "; ".join(outcome.problems)
         else:
-            self.failed[source] = "; ".join(outcome.problems) or outcome.status
+            self.failed[source] = f"{source}: " + ("; ".join(outcome.problems)
+                                                   or outcome.status)
 
     def draw_ready(self, sheets: Sequence[Sheet], jobs: int) -> None:
         """Every sheet of ``sheets`` that is ready, ``jobs`` at a time in forked processes
@@ -149,7 +187,7 @@ class _Artist:
         """``sheet``'s outcome once every ready sheet is drawn (:meth:`draw_ready`)."""
         if sheet.path in self.done:
             return self.done[sheet.path]
-        missing = [f"{p}: {self.failed.get(p, 'no result')}" for p in sheet.studies()
+        missing = [self.failed.get(p, f"{p}: no result") for p in sheet.studies()
                    if p not in self.outputs]
         return FigureOutcome(sheet, None, "; ".join(missing))
 
@@ -177,6 +215,8 @@ class _Artist:
             return _render(draw_sheet(sheet, self.read), self.dpi, {KEY: key}), ""
         except WhirlError as error:
             return None, str(error)
+        except Exception as error:  # noqa: BLE001 - a bug in drawing: this sheet only
+            return None, f"{sheet.path}: {type(error).__name__}: {error}"
 
     def _published(self, sheet: Sheet, image: bytes | None, problem: str) -> FigureOutcome:
         from ..output.atomic import publish

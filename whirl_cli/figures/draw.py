@@ -19,17 +19,13 @@ from .sheet import PanelSpec, Sheet
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-PANEL_SIZE = (5.2, 4.2)
-"""Default width and height of one panel, inches."""
-
-
 def draw_sheet(sheet: Sheet, results: Mapping[Path, StudyResult]) -> Figure:
     """The figure of ``sheet`` from ``results`` (keyed by :meth:`Sheet.resolve` paths):
     panels row by row on the sheet's layout, titled "Figure <number>: <caption>" (legends
     on the first panel only if the sheet says ``legends: first``).
     A panel that cannot be drawn is a :class:`WhirlError` naming the sheet and the panel."""
     rows, columns = sheet.shape
-    size = sheet.size or (PANEL_SIZE[0] * columns, PANEL_SIZE[1] * rows)
+    size = sheet.figure_size
     figure = _new_figure(figsize=size)
     grid = figure.add_gridspec(rows, columns)
     for k, panel in enumerate(sheet.panels):

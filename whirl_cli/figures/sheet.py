@@ -18,25 +18,67 @@ from __future__ import annotations
 import os
 import re
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
-from pydantic import AfterValidator, Field, PrivateAttr, ValidationError, model_validator
+from pydantic import (
+    AfterValidator,
+    BeforeValidator,
+    Field,
+    PrivateAttr,
+    ValidationError,
+    model_validator,
+)
 
 from ..errors import StudyError
 from ..plots.panels import OVERLAY_KINDS, PANEL_KINDS
 from ..study.messages import _report, _translate
-from ..study.schema import Boolean, Integer, Text, _bound, _fail, _Strict
+from ..study.schema import (
+    Boolean,
+    Integer,
+    Text,
+    _as_number,
+    _at_most_orbits,
+    _bound,
+    _fail,
+    _Strict,
+)
 from ..study.source import _compose, _read_text, _Tree
 
 PanelKind = Literal[PANEL_KINDS]  # the kinds plots.panels.draw draws
 _FIGURE_RE = re.compile(r"\d+(\.\d+)*[a-z]?")
 _MAX_PANELS = 64
+PANEL_SIZE = (5.2, 4.2)
+"""Default width and height of one panel, inches."""
+INCHES = (1.0, 40.0)
+"""Smallest and largest width or height of a figure, inches (40 in: 6000 pixels at 150 dpi)."""
 
 
 def _as_figure(value: str) -> str:
     if not _FIGURE_RE.fullmatch(value):
         _fail("expected a figure number such as 3.14, got {got}")
     return value
+
+
+def _as_inches(value: Any) -> float:
+    """A finite width or height within :data:`INCHES`."""
+    number = _as_number(value)
+    low, high = INCHES
+    if not low <= number <= high:
+        hint = " (the size is in inches, not pixels)" if number > high else ""
+        _fail(f"expected inches, {low:g} to {high:g}, got {{got}}{hint}")
+    return number
+
+
+def _panel_count(value: Any) -> Any:
+    """A list of 1 to _MAX_PANELS panels (counted before the panels are checked, so that a
+    bad panel is reported alone)."""
+    if isinstance(value, list) and not 1 <= len(value) <= _MAX_PANELS:
+        _fail(f"expected 1 to {_MAX_PANELS} panels, got {len(value)}")
+    return value
+
+
+Inches = Annotated[float, BeforeValidator(_as_inches)]
+Count = Annotated[Integer, _bound(">=", 1), _bound("<=", _MAX_PANELS)]
 
 
 class Member(_Strict):
@@ -62,8 +104,9 @@ class PanelSpec(_Strict):
     sweep: Text | None = Field(None, description="Parameter of the linear sweep drawn.")
     slice: Annotated[Integer, _bound(">=", 0)] | None = Field(
         None, description="Boundary slice of an `overhang` panel, from 0.")
-    orbits: tuple[Integer, ...] | None = Field(
-        None, description="AUTO labels of the orbits a `phase` panel draws.")
+    orbits: Annotated[tuple[Annotated[Integer, _bound(">=", 1)], ...],
+                      AfterValidator(_at_most_orbits)] | None = Field(
+        None, description="AUTO labels (>= 1) of the orbits a `phase` panel draws.")
     simulation: Text | None = Field(
         None, description="Simulation of a `time_history` or `hub_path` panel; unset: the first.")
     hz: Boolean = Field(False, description="Frequencies in Hz.")
@@ -85,14 +128,15 @@ class Sheet(_Strict):
         description="Figure number (3.14 -> file fig3_14.png).")
     caption: Text = Field(description="What the figure shows, for the index page.")
     note: Text = Field("", description="How whirl's figure differs from the thesis', if it does.")
-    layout: tuple[Annotated[Integer, _bound(">=", 1)], Annotated[Integer, _bound(">=", 1)]] | \
-        None = Field(None, description="[rows, columns] of panels; unset: one row.")
-    size: tuple[Annotated[float, _bound(">", 0)], Annotated[float, _bound(">", 0)]] | None = \
-        Field(None, description="[width, height] in inches; unset: 5.2 x 4.2 per panel.")
+    layout: tuple[Count, Count] | None = Field(
+        None, description=f"[rows, columns] of panels, each 1 to {_MAX_PANELS}; unset: one row.")
+    size: tuple[Inches, Inches] | None = Field(
+        None, description=f"[width, height] in inches, each {INCHES[0]:g} to {INCHES[1]:g}; "
+        f"unset: {PANEL_SIZE[0]:g} x {PANEL_SIZE[1]:g} per panel.")
     legends: Literal["all", "first"] = Field(
         "all", description="Legends on every panel, or on the first panel only (grids).")
-    panels: Annotated[tuple[PanelSpec, ...], Field(min_length=1, max_length=_MAX_PANELS)] = \
-        Field(description="The panels, row by row.")
+    panels: Annotated[tuple[PanelSpec, ...], BeforeValidator(_panel_count)] = Field(
+        description="The panels, row by row.")
 
     _path: Path = PrivateAttr(Path("."))
 
@@ -100,6 +144,13 @@ class Sheet(_Strict):
     def shape(self) -> tuple[int, int]:
         """(rows, columns) of the panel grid."""
         return tuple(self.layout) if self.layout else (1, len(self.panels))
+
+    @property
+    def figure_size(self) -> tuple[float, float]:
+        """(width, height) in inches: ``size``, else :data:`PANEL_SIZE` per panel."""
+        rows, columns = self.shape
+        return tuple(self.size) if self.size else (PANEL_SIZE[0] * columns,
+                                                   PANEL_SIZE[1] * rows)
 
     @property
     def stem(self) -> str:
@@ -130,7 +181,7 @@ def load_sheet(path: str | os.PathLike[str]) -> Sheet:
     """Read and check the sheet at ``path``; a StudyError lists every problem."""
     path = Path(path)
     label = str(path)
-    tree = _Tree(_compose(_read_text(path, label), label))
+    tree = _Tree(_compose(_read_text(path, label, "sheet"), label, "sheet"))
     problems = list(tree.problems)
     sheet = None
     try:
@@ -144,9 +195,21 @@ def load_sheet(path: str | os.PathLike[str]) -> Sheet:
         if len(sheet.panels) > rows * columns:
             problems.append((("layout",), f"{len(sheet.panels)} panels do not fit a {rows} x "
                                           f"{columns} layout"))
+        problems += _default_size_problems(sheet)
     if problems:
         raise StudyError(_report(problems, tree, label))
     return sheet
+
+
+def _default_size_problems(sheet: Sheet) -> list:
+    """A sheet without ``size`` whose panels at their default size make too large a figure."""
+    width, height = sheet.figure_size
+    if sheet.size or max(width, height) <= INCHES[1]:
+        return []
+    rows, columns = sheet.shape
+    return [(("layout",) if sheet.layout else ("panels",),
+             f"{rows} x {columns} panels of {PANEL_SIZE[0]:g} x {PANEL_SIZE[1]:g} inches make "
+             f"{width:g} x {height:g} inches, over {INCHES[1]:g}; give `size`")]
 
 
 def _missing_studies(sheet: Sheet) -> list:

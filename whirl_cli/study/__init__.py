@@ -29,7 +29,8 @@ Validation also fills the model-dependent defaults (:mod:`~whirl_cli.study.resol
 ``Study.model_validate`` applies these fills too, but only the two entry points check parameter
 names and ranges against the model.
 
-Modules, lowest first (each imports only those above it, and :mod:`whirl_cli.models`):
+Modules, lowest first (each imports only those above it, :mod:`whirl_cli.models`, and the
+schema :mod:`whirl_cli.continuation.numerics` for the AUTO defaults its step checks use):
 
 * :mod:`~whirl_cli.study.source` -- the file as YAML nodes and data, with line numbers;
 * :mod:`~whirl_cli.study.resolve` -- model-dependent defaults filled on the raw data;

@@ -6,7 +6,9 @@ study may use (:class:`~whirl_cli.study.resolve.Names`), law coefficients only u
 of a list naming its dof), a parameter given once, values and ranges inside the physical
 bounds, the family's constraints on several parameters at once (e.g. I_d < I_y, for the
 study's values and at each end of a range), unique continuation names, ``start``, ``slices``,
-``orbits_at`` and ``explore`` inside ``range``, ``plot_state``, seed keys, ``explore_initial`` keys
+``orbits_at`` and ``explore`` inside ``range``, continuation names that share no stored AUTO
+run name, one linear sweep per parameter and two different grid parameters (by any of their
+names), ``plot_state``, seed keys, ``explore_initial`` keys
 and the initial states of ``simulations`` states of the model, unique simulation names, their
 overrides checked like the study's, ``law: exact`` only with a piecewise law, and what a law
 requires of its coefficients together (freeplay: epsilon < delta, K_out > K_in).
@@ -14,6 +16,7 @@ requires of its coefficients together (freeplay: epsilon < delta, K_out > K_in).
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from typing import Any
 
@@ -55,10 +58,12 @@ def _meaning_problems(data: dict) -> list[Problem]:
         problems += found or _combination_problems(loc, block, dof, names, values)
     items = data.get("continuations")
     problems += _continuation_problems(items, names, family, values)
+    problems += _continuation_name_problems(items, names)
     linear = data.get("linear")
     sweeps = linear.get("sweeps") if isinstance(linear, dict) else None
     for i, sweep in _dict_items(sweeps):
         problems += _sweep_problems(("linear", "sweeps", i), sweep, names, family, values)
+    problems += _repeated_sweeps(sweeps, names)
     grid = linear.get("grid") if isinstance(linear, dict) else None
     for axis in ("x", "y"):
         spec = grid.get(axis) if isinstance(grid, dict) else None
@@ -66,7 +71,76 @@ def _meaning_problems(data: dict) -> list[Problem]:
             axis_spec = {k: v for k, v in spec.items() if k != "multiples"}  # sweeps only
             problems += _sweep_problems(("linear", "grid", axis), axis_spec, names, family,
                                         values)
+    problems += _grid_axes_problems(grid, names)
     problems += _simulation_problems(data.get("simulations"), names, family, values)
+    return problems
+
+
+def _known_canonical(name: Any, names: Names) -> str | None:
+    """The canonical name of a parameter name the study may use, else None."""
+    known = isinstance(name, str) and name in names.known_parameter_names()
+    return names.canonical(name) if known else None
+
+
+def _spelled(name: str, other: str, canonical: str) -> str:
+    """How two spellings of one parameter name it ("" when they are the same)."""
+    return "" if name == other else f" ({name!r} and {other!r} both name {canonical})"
+
+
+def _repeated_sweeps(sweeps: Any, names: Names) -> list[Problem]:
+    """A second linear sweep of a parameter, by any of its names: a result file stores one
+    sweep per parameter (``linear/sweeps/<parameter>``)."""
+    first: dict[str, tuple[int, str]] = {}
+    problems: list[Problem] = []
+    for i, sweep in _dict_items(sweeps):
+        name = sweep.get("parameter")
+        canonical = _known_canonical(name, names)
+        if canonical is None:
+            continue
+        if canonical in first:
+            k, other = first[canonical]
+            problems.append((("linear", "sweeps", i, "parameter"),
+                             f"a second sweep of {canonical}{_spelled(name, other, canonical)}"
+                             f", the first is linear.sweeps[{k}]; a study sweeps a parameter "
+                             "once (widen that range instead)"))
+        else:
+            first[canonical] = (i, name)
+    return problems
+
+
+def _grid_axes_problems(grid: Any, names: Names) -> list[Problem]:
+    """The two axes of a linear grid, one parameter twice (by any of its names)."""
+    axes = [grid.get(a) if isinstance(grid, dict) else None for a in ("x", "y")]
+    given = [a.get("parameter") if isinstance(a, dict) else None for a in axes]
+    x, y = (_known_canonical(name, names) for name in given)
+    if x is None or x != y:
+        return []
+    return [(("linear", "grid", "y", "parameter"), f"the same parameter as x"
+             f"{_spelled(given[1], given[0], y)}; a grid needs two different parameters")]
+
+
+def _continuation_name_problems(items: Any, names: Names) -> list[Problem]:
+    """Continuation names that would share AUTO run names (and the result file's run
+    records, ``runs/<run>``) with another continuation's: a continuation's runs are named
+    ``<name>.<run>``, and with a smoothed law (freeplay) a one-parameter continuation is
+    repeated as ``<name>_eps<k>``."""
+    named = [(i, item["name"], item.get("type")) for i, item in _dict_items(items)
+             if isinstance(item.get("name"), str)]
+    smoothed = bool(names.model.smoothing_parameters)
+    problems: list[Problem] = []
+    for i, name, _ in named:
+        for _, other, kind in named:
+            if name.startswith(other + "."):
+                reason = f"its runs are named {other}.<run>"
+            elif smoothed and kind == "one-parameter" and re.fullmatch(
+                    re.escape(other) + r"_eps\d+", name):
+                reason = (f"with a smoothed law its repetitions are named {other}_eps<k>")
+            else:
+                continue
+            problems.append((("continuations", i, "name"), f"{name!r} would share AUTO run "
+                             f"names with continuation {other!r} ({reason}); choose another "
+                             "name"))
+            break
     return problems
 
 
@@ -81,9 +155,11 @@ def _simulation_problems(items: Any, names: Names, family: str,
     taken: set[str] = set()
     for i, item in _dict_items(items):
         loc = ("simulations", i)
-        name = item.get("name", f"sim_{i + 1}")
+        unnamed = item.get("name") is None
+        name = f"sim_{i + 1}" if unnamed else item["name"]
         if isinstance(name, str) and name in taken:
-            problems.append((loc + ("name",), f"duplicate simulation name {name!r}"))
+            how = " (an unnamed simulation's name, from its position)" if unnamed else ""
+            problems.append((loc + ("name",), f"duplicate simulation name {name!r}{how}"))
         if isinstance(name, str):
             taken.add(name)
         parameters = item.get("parameters")

@@ -30,6 +30,7 @@ def _dotted(loc: Loc) -> str:
 
 _MAPPING_ERRORS = {"dict_type", "model_type", "model_attributes_type"}
 _LIST_ERRORS = {"tuple_type", "list_type"}
+_LENGTH_ERRORS = {"too_short": ("min_length", "at least"), "too_long": ("max_length", "at most")}
 
 
 def _translate(error: Any, tree: _Tree, root: type[BaseModel] = Study) -> Problem:
@@ -39,10 +40,16 @@ def _translate(error: Any, tree: _Tree, root: type[BaseModel] = Study) -> Proble
         loc = loc[:1] + loc[2:]  # one law mapping counts as a list of one: report at it
     kind = error["type"]
     if kind == "whirl":
+        loc += tuple(error["ctx"].get("at", ()))
         template = error["ctx"]["reason"]
         return loc, template.format(got=tree.shown(loc), value=tree.flow(loc))
+    if kind == "missing" and loc and isinstance(loc[-1], int):  # a fixed-length list
+        return loc[:-1], f"expected {loc[-1] + 1} items, got {tree.flow(loc[:-1])}"
     if kind == "missing":
         return loc, "required key is missing"
+    if kind in _LENGTH_ERRORS:
+        limit, most = _LENGTH_ERRORS[kind]
+        return loc, f"expected {most} {error['ctx'][limit]} items, got {tree.flow(loc)}"
     if kind == "extra_forbidden":
         return loc, f"unknown key (allowed: {', '.join(owner.model_fields)})"
     if kind in ("union_tag_invalid", "union_tag_not_found"):

@@ -26,8 +26,9 @@ from pydantic import (
 )
 from pydantic_core import PydanticCustomError
 
+from ..continuation.numerics import Numerics
 from ..models import FAMILIES, Model, is_known, is_model_file
-from .resolve import Names, _finite, _is_number, _resolved, names_of
+from .resolve import Names, _is_number, _resolved, names_of
 
 NAME_MAX = 64
 #: Largest integer AUTO-07p reads into its (32-bit) INTEGER constants (NMX, NTST, ITNW).
@@ -45,9 +46,11 @@ _NAME_REASON = (
 )
 
 
-def _fail(reason: str) -> NoReturn:
-    """Reject a value; ``{got}`` in ``reason`` becomes the value as written in the YAML."""
-    raise PydanticCustomError("whirl", "{reason}", {"reason": reason})
+def _fail(reason: str, at: tuple[str | int, ...] = ()) -> NoReturn:
+    """Reject a value; ``{got}`` in ``reason`` becomes the value as written in the YAML.
+    ``at``: the key path, below the checked value, of the part at fault (a list item, a
+    mapping's key), where the message is reported."""
+    raise PydanticCustomError("whirl", "{reason}", {"reason": reason, "at": at})
 
 
 def _as_string(value: Any) -> str:
@@ -57,10 +60,15 @@ def _as_string(value: Any) -> str:
 
 
 def _as_number(value: Any) -> float:
+    return _number(value, ())
+
+
+def _number(value: Any, at: tuple[str | int, ...]) -> float:
+    """``value`` as a finite float; else the reason, reported at ``at`` below the value."""
     if not _is_number(value):
-        _fail("expected a number, got {got}")
+        _fail("expected a number, got {got}", at)
     if not math.isfinite(value):
-        _fail("expected a finite number, got {got}")
+        _fail("expected a finite number, got {got}", at)
     return float(value)
 
 
@@ -85,30 +93,33 @@ def _as_name(value: Any) -> str:
 
 
 def _as_range(value: Any) -> tuple[float, float]:
-    bounds = [_finite(v) for v in value] if isinstance(value, list | tuple) else []
-    if len(bounds) != 2 or None in bounds or not bounds[0] < bounds[1]:
+    if not isinstance(value, list | tuple) or len(value) != 2:
+        _fail("expected [lower, upper], two numbers, got {value}")
+    lower, upper = (_number(v, (k,)) for k, v in enumerate(value))
+    if not lower < upper:
         _fail("expected [lower, upper] with lower < upper, got {value}")
-    lower, upper = bounds
     if not (math.isfinite(upper - lower) and math.isfinite(lower - (upper - lower))
             and math.isfinite(upper + (upper - lower))):  # AUTO's bounds lie 5 % beyond
         _fail("the range is too wide: its width overflows double precision, got {value}")
     return lower, upper
 
 
-def _is_state(value: Any) -> bool:
-    """True for a mapping state name -> finite number (a seed, an initial state)."""
-    return isinstance(value, dict) and all(isinstance(k, str) and _finite(v) is not None
-                                           for k, v in value.items())
+def _state(value: Any, at: tuple[str | int, ...], example: str) -> dict[str, float]:
+    """A mapping state name -> finite number (a seed, an initial state), each value checked at
+    its key; ``example``: the mapping's shape, for the message."""
+    if not isinstance(value, dict) or not all(isinstance(k, str) for k in value):
+        _fail(f"expected a mapping state -> number, e.g. {example}, got {{got}}", at)
+    return {k: _number(v, (*at, k)) for k, v in value.items()}
 
 
 def _as_seeds(value: Any) -> str | tuple[dict[str, float], ...]:
     """``auto``, or a list of mappings state name -> finite number."""
     if value == "auto":
         return value
-    if not isinstance(value, list) or not all(_is_state(seed) for seed in value):
+    if not isinstance(value, list):
         _fail("expected `auto` or a list of mappings state -> number, e.g. [{{theta: 4}}], "
               "got {got}")
-    return tuple({k: float(v) for k, v in seed.items()} for seed in value)
+    return tuple(_state(seed, (k,), "{{theta: 4}}") for k, seed in enumerate(value))
 
 
 #: The description of ``seeds`` (one- and two-parameter continuations share the key).
@@ -124,9 +135,7 @@ SEEDS_TEXT = (
 
 def _as_state(value: Any) -> dict[str, float]:
     """A mapping state name -> finite number (the names are checked against the model)."""
-    if not _is_state(value):
-        _fail("expected a mapping state -> number, e.g. {{theta: 2}}, got {got}")
-    return {k: float(v) for k, v in value.items()}
+    return _state(value, (), "{{theta: 2}}")
 
 
 def _at_most_orbits(values: tuple) -> tuple:
@@ -167,6 +176,8 @@ Integer = Annotated[int, BeforeValidator(_as_integer)]
 Boolean = Annotated[bool, BeforeValidator(_as_boolean)]
 Range = Annotated[tuple[float, float], BeforeValidator(_as_range)]
 Positive = Annotated[Number, _bound(">", 0)]
+#: An AUTO step, a fraction of the continuation range's width.
+Step = Annotated[Positive, _bound("<=", 1)]
 ModelFamily = Annotated[Text, AfterValidator(_as_model_family)]
 
 
@@ -243,15 +254,20 @@ def _as_laws(value: Any) -> Any:
 Laws = Annotated[tuple[LawBlock, ...], BeforeValidator(_as_laws)]
 
 
+_RUN_NAME_DOC = (
+    "Run name, unique within the study (same characters as the study name); not another "
+    "continuation's name followed by `.` (its AUTO runs are named `<name>.<run>`), nor, with "
+    "a freeplay law, a one-parameter continuation's name followed by `_eps<k>` (its "
+    "repetitions at smaller smoothing).")
+
+
 class OneParameterContinuation(_Strict):
     """Equilibria in one parameter, with the branches that hang off them.
 
     After validation ``parameter`` is the canonical name and ``start`` is filled.
     """
 
-    name: Name = Field(
-        description="Run name, unique within the study (same characters as the study name)."
-    )
+    name: Name = Field(description=_RUN_NAME_DOC)
     type: Literal["one-parameter"] = Field(
         description="`one-parameter`: equilibria in one parameter (AUTO-07p continuation)."
     )
@@ -335,9 +351,9 @@ def _as_slice(value: Any) -> Any:
     """A slice given as a bare number is ``{value: number}``."""
     if isinstance(value, dict):
         return value
-    if _finite(value) is None:
+    if not _is_number(value):
         _fail("expected a finite number or a mapping {{value, label}}, got {got}")
-    return {"value": value}
+    return {"value": _as_number(value)}
 
 
 SliceEntry = Annotated[Slice, BeforeValidator(_as_slice)]
@@ -351,9 +367,7 @@ class TwoParameterContinuation(_Strict):
     ``bounds(model)`` gives ``range`` by canonical names.
     """
 
-    name: Name = Field(
-        description="Run name, unique within the study (same characters as the study name)."
-    )
+    name: Name = Field(description=_RUN_NAME_DOC)
     type: Literal["two-parameter"] = Field(
         description="`two-parameter`: loci of special points in two parameters."
     )
@@ -454,14 +468,16 @@ class LinearGridSpec(_Strict):
     """Linear stability over a grid of two parameters."""
 
     x: LinearAxisSpec = Field(description="First grid axis: parameter, range, points.")
-    y: LinearAxisSpec = Field(description="Second grid axis: parameter, range, points.")
+    y: LinearAxisSpec = Field(description="Second grid axis: another parameter, range, "
+                              "points.")
 
 
 class LinearSpec(_Strict):
     """Linear (eigenvalue) analysis, done with numpy, without AUTO."""
 
     sweeps: tuple[LinearSweepSpec, ...] = Field(
-        (), description="Eigenvalue sweeps (damping ratio, frequency, whirl direction)."
+        (), description="Eigenvalue sweeps (damping ratio, frequency, whirl direction), one "
+        "per parameter."
     )
     grid: LinearGridSpec | None = Field(
         None,
@@ -500,20 +516,28 @@ class SimulationSpec(_Strict):
         "freeplay law).")
 
 
+#: (smaller, larger) pairs of AUTO step settings, checked in this order.
+_STEP_ORDER = (("step_min", "step_max"), ("step_initial", "step_max"), ("step_min", "step_initial"))
+
+
 class AutoSettings(_Strict):
     """AUTO-07p settings under readable names; unset ones use whirl's defaults."""
 
     max_steps: Annotated[Integer, _bound(">=", 1), _bound("<=", FORTRAN_INT_MAX)] | None = Field(
-        None, description="Maximum continuation steps per run (AUTO NMX), >= 1."
+        None, description="Maximum continuation steps per run (AUTO NMX), >= 1; a branch "
+        "that uses them up before its range ends fails the study."
     )
-    step_initial: Positive | None = Field(
-        None, description="Initial step (AUTO DS), fraction of the continuation range width, > 0."
+    step_initial: Step | None = Field(
+        None, description="Initial step (AUTO DS), fraction of the continuation range width, "
+        "> 0 and <= 1, from `step_min` to `step_max`."
     )
-    step_min: Positive | None = Field(
-        None, description="Smallest step (AUTO DSMIN), fraction of the range width, > 0."
+    step_min: Step | None = Field(
+        None, description="Smallest step (AUTO DSMIN), fraction of the range width, > 0 and "
+        "<= `step_max`."
     )
-    step_max: Positive | None = Field(
-        None, description="Largest step (AUTO DSMAX), fraction of the range width, > 0."
+    step_max: Step | None = Field(
+        None, description="Largest step (AUTO DSMAX), fraction of the range width, > 0 and "
+        "<= 1."
     )
     mesh_intervals: Annotated[
         Integer, _bound(">=", 2), _bound("<=", FORTRAN_INT_MAX)] | None = Field(
@@ -534,6 +558,33 @@ class AutoSettings(_Strict):
         None, description="Amplitude at which branches are stopped, in units of each dof's "
         "typical amplitude (`whirl models` lists them; classical: 1 rad), > 0."
     )
+
+    @model_validator(mode="after")
+    def _steps_in_order(self) -> AutoSettings:
+        """step_min <= step_initial <= step_max, an unset one at whirl's default."""
+        for low, high in _STEP_ORDER:
+            problem = _step_order_problem(self, low, high)
+            if problem is not None:
+                _fail(*problem)
+        return self
+
+
+def _step_order_problem(settings: AutoSettings, low: str, high: str
+                        ) -> tuple[str, tuple[str]] | None:
+    """Why the step ``low`` exceeds ``high`` (each as given, else whirl's default), and the
+    key given to report it at; None if they are in order or both unset."""
+    given = getattr(settings, low), getattr(settings, high)
+    if given == (None, None):
+        return None
+    defaults = Numerics()
+    lower, upper = (getattr(defaults, key) if value is None else value
+                    for key, value in zip((low, high), given, strict=True))
+    if lower <= upper:
+        return None
+    if given[0] is None:
+        return f"must be >= {low} ({lower:g}, whirl's default), got {{got}}", (high,)
+    note = ", whirl's default" if given[1] is None else ""
+    return f"must be <= {high} ({upper:g}{note}), got {{got}}", (low,)
 
 
 class Study(_Strict):

@@ -1,4 +1,5 @@
-"""A study file as YAML: bytes -> nodes -> plain Python data, with the node and line of every key.
+"""A study (or sheet) file as YAML: bytes -> nodes -> plain Python data, with the node and
+line of every key.
 
 Steps 1 to 3 of :mod:`whirl_cli.study`: :func:`_read_text` (at most :data:`MAX_BYTES` of UTF-8),
 :func:`_compose` (a SafeLoader subclass, :class:`_Loader`, that records anchors, aliases and
@@ -38,9 +39,10 @@ _TAGS_BY_EVENT = {
 }
 
 
-def _parse(text: str) -> tuple[Node | None, list[tuple[int, str]]]:
-    """The root node and the (line, reason) problems recorded while composing it."""
-    loader = _Loader(text)
+def _parse(text: str, what: str = "study") -> tuple[Node | None, list[tuple[int, str]]]:
+    """The root node and the (line, reason) problems recorded while composing it (``what``:
+    the kind of file, for the reasons)."""
+    loader = _Loader(text, what)
     try:
         return loader.get_single_node(), loader.problems
     finally:
@@ -63,8 +65,9 @@ class _Loader(yaml.SafeLoader):
     ``problems`` (an alias becomes a null node) and stops below MAX_DEPTH levels of nesting.
     """
 
-    def __init__(self, stream: str) -> None:
+    def __init__(self, stream: str, what: str = "study") -> None:
         super().__init__(stream)
+        self.what = what
         self.problems: list[tuple[int, str]] = []
         self._depth = 0
 
@@ -72,11 +75,12 @@ class _Loader(yaml.SafeLoader):
         event = self.peek_event()
         line = event.start_mark.line + 1
         if isinstance(event, yaml.AliasEvent) or event.anchor is not None:
-            self.problems.append((line, "YAML anchors and aliases are not allowed in study files"))
+            self.problems.append((line, "YAML anchors and aliases are not allowed in "
+                                  f"{self.what} files"))
             event.anchor = None
         tag = getattr(event, "tag", None)
         if tag is not None and tag not in _TAGS_BY_EVENT.get(type(event), ()):
-            reason = f"YAML tag {_short_tag(tag)!r} is not allowed in study files"
+            reason = f"YAML tag {_short_tag(tag)!r} is not allowed in {self.what} files"
             self.problems.append((line, reason))
         if isinstance(event, yaml.AliasEvent):
             self.get_event()
@@ -108,17 +112,18 @@ _Loader.add_implicit_resolver(
 )
 
 
-def _read_text(path: Path, label: str) -> str:
-    """The file's text: at most MAX_BYTES of UTF-8 (errors name the file ``label``)."""
+def _read_text(path: Path, label: str, what: str = "study") -> str:
+    """The file's text: at most MAX_BYTES of UTF-8 (errors name the file ``label``, and call
+    it a ``what`` file)."""
     try:
         with path.open("rb") as stream:
             raw = stream.read(MAX_BYTES + 1)
             size = max(len(raw), os.fstat(stream.fileno()).st_size)
     except OSError as error:
-        reason = f"cannot read the study file ({error.strerror or error})"
+        reason = f"cannot read the {what} file ({error.strerror or error})"
         raise StudyError(f"{label}: {reason}") from None
     if len(raw) > MAX_BYTES:
-        raise StudyError(_too_large(label, size))
+        raise StudyError(_too_large(label, size, what))
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as error:
@@ -126,14 +131,15 @@ def _read_text(path: Path, label: str) -> str:
         raise StudyError(f"{label}: {reason}") from None
 
 
-def _too_large(name: str, size: int) -> str:
-    return f"{name}: the study file is too large ({size} bytes; the limit is {MAX_BYTES})"
+def _too_large(name: str, size: int, what: str = "study") -> str:
+    return f"{name}: the {what} file is too large ({size} bytes; the limit is {MAX_BYTES})"
 
 
-def _compose(text: str, name: str) -> MappingNode:
-    """The root node of ``text``; StudyError for problems that concern the whole file."""
+def _compose(text: str, name: str, what: str = "study") -> MappingNode:
+    """The root node of ``text``; StudyError for problems that concern the whole file
+    (``what``: the kind of file, a study or a sheet)."""
     try:
-        root, whole_file = _parse(text)
+        root, whole_file = _parse(text, what)
     except yaml.MarkedYAMLError as error:
         mark = error.problem_mark or error.context_mark
         where = f"{name}:{mark.line + 1}" if mark else name
@@ -145,16 +151,16 @@ def _compose(text: str, name: str) -> MappingNode:
     except yaml.YAMLError as error:
         raise StudyError(f"{name}: YAML syntax error: {error}") from None
     except _TooDeep as error:
-        reason = f"YAML nesting deeper than {MAX_DEPTH} levels is not allowed in study files"
+        reason = f"YAML nesting deeper than {MAX_DEPTH} levels is not allowed in {what} files"
         raise StudyError(f"{name}:{error.args[0]}: {reason}") from None
     if whole_file:
         raise StudyError("\n".join(f"{name}:{line}: {reason}" for line, reason in whole_file))
     if root is None or (root.tag == _NULL and root.value == ""):
-        raise StudyError(f"{name}: the study file is empty")
+        raise StudyError(f"{name}: the {what} file is empty")
     if not isinstance(root, MappingNode):
         line = root.start_mark.line + 1
         got = _shown(root)
-        raise StudyError(f"{name}:{line}: a study must be a YAML mapping of keys, got {got}")
+        raise StudyError(f"{name}:{line}: a {what} must be a YAML mapping of keys, got {got}")
     return root
 
 
