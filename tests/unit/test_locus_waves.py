@@ -12,6 +12,7 @@ import numpy as np
 from tests.unit.test_locus_geometry import _locus
 from whirl_cli.continuation import loci
 from whirl_cli.continuation.engine import _Slots
+from whirl_cli.continuation.numerics import Numerics
 from whirl_cli.results import PointType, SpecialPoint
 
 
@@ -102,7 +103,7 @@ def test_a_next_wave_start_on_a_locus_of_the_wave_before_is_set_aside(monkeypatc
     monkeypatch.setattr(loci, "_wave", wave)
     starts = [(_start(0, 0.5, 0.1), "r0"), (_start(1, 0.5, 0.3), "r1"),
               (_start(1, 0.8, 0.3), "r1")]
-    loci._loci(None, "c", ("p", "q"), {"p": (0.0, 1.0), "q": (0.0, 0.5)}, None, starts)
+    loci._loci(None, "c", ("p", "q"), {"p": (0.0, 1.0), "q": (0.0, 0.5)}, Numerics(), starts)
     assert traced_sets == [[1], [2, 3]] and background_flags == [False, True]
     assert grown == [["c/fold_of_cycles_1a2", "c/fold_of_cycles_1b2"],
                      ["c/fold_of_cycles_3a2", "c/fold_of_cycles_3b2"]]
