@@ -238,3 +238,9 @@ def test_a_fresh_process_finds_a_model_file_by_its_reference():
                           capture_output=True, text=True, timeout=60)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "classical_file"
+
+
+def test_an_empty_or_missing_model_file(tmp_path):
+    assert problems("") == ["model.yaml: the model file is empty"]
+    with pytest.raises(StudyError, match=r"nowhere\.yaml: cannot read the model file"):
+        load_model_file(tmp_path / "nowhere.yaml", "nowhere.yaml")

@@ -220,12 +220,12 @@ class FileEquations:
 def read_model_file(path: Path, label: str | None = None) -> Family:
     """The family a model file declares; StudyError listing every problem otherwise."""
     label = str(path) if label is None else label
-    return model_from_text(_read_text(path, label).replace("\r\n", "\n"), label)
+    return model_from_text(_read_text(path, label, "model").replace("\r\n", "\n"), label)
 
 
 def model_from_text(text: str, label: str) -> Family:
     """The family the model file ``text`` declares (messages name it ``label``)."""
-    tree = _Tree(_compose(text, label))
+    tree = _Tree(_compose(text, label, "model"))
     try:
         declared = ModelFile.model_validate(tree.data)
     except ValidationError as error:
