@@ -25,7 +25,7 @@ from pathlib import Path
 
 import pytest
 
-from .helpers import STUDIES, WHIRL, auto_processes, environment
+from .helpers import ROOT, STUDIES, WHIRL, auto_processes, environment
 
 pytestmark = pytest.mark.auto
 
@@ -143,3 +143,40 @@ def test_sigint_at_any_moment_stops_at_once_without_a_trace(tmp_path):
     print(f"\n  {len(plan)} SIGINTs over a {duration:.1f} s run of {STUDY.name} from "
           f"{first:.3f} s (half to the process group): {counts}")
     assert endings.count("interrupted") >= SPREAD // 2 + TARGETED  # most of them land mid-run
+
+
+SWEEP_STUDY = STUDIES / "linear_case2.yaml"  # three short AUTO runs
+SHEET = ROOT / "sheets" / "thesis_ch3" / "fig3_13.yaml"
+EARLY_SIGNALS, EARLY_SECONDS = 8, 0.5
+
+
+@pytest.mark.parametrize("command", ["run", "sweep", "figures"])
+def test_a_sigterm_early_in_a_command_ends_it_as_an_interrupt(tmp_path, command):
+    """SIGTERM while the command line is imported and the command sets out (before any AUTO
+    run): whirl's handler, not the signal's default action, ends it: exit 143, "interrupted",
+    no traceback, nothing left in TMPDIR."""
+    cache = Path(os.environ["WHIRL_CACHE_DIR"])
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    env = environment(cache, TMPDIR=str(scratch))
+    first = 1.5 * interpreter_start(env)  # whirl's own code runs from here on (module doc)
+    arguments = {"run": ["run", str(SWEEP_STUDY), "-o", str(tmp_path / "out" / "r.h5")],
+                 "sweep": ["sweep", str(SWEEP_STUDY), "-o", str(tmp_path / "out")],
+                 "figures": ["figures", str(SHEET), "-o", str(tmp_path / "out"),
+                             "--results", str(tmp_path / "results")]}[command]
+    for k in range(EARLY_SIGNALS):
+        delay = first + k / EARLY_SIGNALS * EARLY_SECONDS
+        process = subprocess.Popen([str(WHIRL), *arguments], env=env, stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE, text=True, start_new_session=True)
+        try:
+            time.sleep(delay)
+            os.killpg(process.pid, signal.SIGTERM)
+            stdout, stderr = process.communicate(timeout=30)
+        finally:
+            if process.poll() is None:
+                os.killpg(process.pid, signal.SIGKILL)
+                process.wait()
+        assert process.returncode == 143, (command, delay, process.returncode, stderr)
+        assert stderr.rstrip().endswith("interrupted") and "Traceback" not in stdout + stderr
+        assert list(scratch.iterdir()) == [], (command, delay)
+        assert not list(tmp_path.glob("out/*.h5")), (command, delay)
