@@ -63,10 +63,15 @@ def stop_all() -> None:
     with _LIVE_LOCK:
         _STOPPING.set()
         for process in list(_LIVE):
-            try:
-                os.killpg(process.pid, signal.SIGKILL)
-            except (ProcessLookupError, PermissionError):
-                pass
+            kill_group(process.pid)
+
+
+def kill_group(pid: int) -> None:
+    """SIGKILL the process group of the AUTO run ``pid``; one that has ended is no error."""
+    try:
+        os.killpg(pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):  # ended (and reaped) meanwhile
+        pass
 
 
 @contextmanager
@@ -221,11 +226,11 @@ def run(executable: Path, constants: dict, workdir: Path, name: str,
             returncode = process.wait(timeout=timeout)
             timed_out = False
         except subprocess.TimeoutExpired:
-            os.killpg(process.pid, signal.SIGKILL)
+            kill_group(process.pid)
             process.wait()
             returncode, timed_out = None, True
         except BaseException:  # KeyboardInterrupt: never leave AUTO running
-            os.killpg(process.pid, signal.SIGKILL)
+            kill_group(process.pid)
             process.wait()
             raise
         finally:
