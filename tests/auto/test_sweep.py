@@ -128,7 +128,10 @@ def test_sweep_runs_in_parallel_resumes_and_reports_failures(tmp_path):
     first = runner.invoke(cli, ["sweep", str(studies), "-o", str(out), "-j", "2"])
     assert first.exit_code == 1, first.output  # the broken study; the others still ran
     assert "broken.yaml:3: colour: unknown key" in first.output
-    assert "sweep: 2 ok, 0 up to date, 1 invalid of 3 studies" in first.output
+    # the summary is the result (stdout: `> log` keeps it), a line per study progress
+    assert first.stdout.startswith("sweep: 2 ok, 0 up to date, 1 invalid of 3 studies")
+    assert "broken.yaml:3: colour: unknown key" in first.stdout
+    assert "ok       linear-case2" in first.stderr and "ok       linear" not in first.stdout
     assert sorted(p.name for p in out.iterdir()) == [
         "linear-case2.h5", "linear-case2_k1_bifurcation.png", "linear-datum-airspeed.h5",
         "linear-datum-airspeed_airspeed_bifurcation.png", "linear-datum-airspeed_linear_V.png"]
