@@ -103,6 +103,9 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
         _say(f"  {outcome.name:<32} {mark:<8} {outcome.n_points:>6} points "
              f"{outcome.wall_seconds:7.3f} s{detail}")
 
+    def slow(name: str, seconds: float) -> None:
+        _say(f"  {name:<32} still running after {seconds:g} s")
+
     _say(f"whirl {_version()}: {study.path} -> {output}")
     from . import api
     from .interrupts import catching
@@ -114,7 +117,7 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
         later = PLOT_MODULES if plots and study.plots else ()
         result, published = api.run_and_save(
             study, output, study.plots if plots else (), overwrite, jobs=jobs, on_run=report,
-            keep_runs=keep_runs, preload=later)
+            keep_runs=keep_runs, preload=later, on_slow=slow)
     for path in published.paths:
         _tell(f"wrote {path}")
     found = verdict(result, published.plot_error)

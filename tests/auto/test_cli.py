@@ -6,6 +6,7 @@ import h5py
 import numpy as np
 from click.testing import CliRunner
 
+from whirl_cli.auto import runner
 from whirl_cli.cli import cli
 from whirl_cli.output import store
 
@@ -101,3 +102,28 @@ def test_validate_reports_bad_study_word_for_word(tmp_path):
     assert result.output == "case2.yaml:5: nonlinearity.K2: expected a number, got 'ten'\n"
     run = CliRunner().invoke(cli, ["run", str(bad), "-o", str(tmp_path / "x.h5")])
     assert run.exit_code == 1 and not (tmp_path / "x.h5").exists()
+
+
+def test_a_run_stuck_until_its_timeout_says_so_meanwhile(tmp_path, monkeypatch):
+    """Newton cannot converge to 1e-30: AUTO spins until the 2 s timeout. Meanwhile a line
+    on stderr says which run is still running (the first after SLOW_NOTICE, here 0.5 s),
+    before the line of its end."""
+    monkeypatch.setattr(runner, "SLOW_NOTICE", 0.5)
+    study = tmp_path / "stuck.yaml"
+    study.write_text((STUDIES / "linear_case2.yaml").read_text()
+                     + "auto: {tolerance: 1.0e-30, newton_max_iterations: 1, timeout: 2}\n")
+    ran = CliRunner().invoke(cli, ["run", str(study), "-o", str(tmp_path / "r.h5"),
+                                   "--no-plots", "-j", "1"])
+    assert ran.exit_code == 1, ran.output
+    lines = ran.stderr.splitlines()
+    notices = [k for k, line in enumerate(lines) if "still running after 0.5 s" in line]
+    assert notices and "still running after 1 s" in lines[notices[0] + 1], lines
+    name = lines[notices[0]].split()[0]
+    ended = next(k for k, line in enumerate(lines) if line.split()[:2] == [name, "TIMEOUT"])
+    assert ended > notices[0] + 1
+    assert "still running" not in ran.stdout
+
+
+def test_slow_notices_double_up_to_the_timeout():
+    assert runner.slow_notices(60) == [10, 20, 40]
+    assert runner.slow_notices(10) == []

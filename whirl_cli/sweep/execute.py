@@ -16,10 +16,12 @@ from __future__ import annotations
 import pickle
 import shutil
 import signal
+import sys
 import tempfile
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Executor, Future, as_completed, wait
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 from ..errors import WhirlError
@@ -60,13 +62,19 @@ def compute(study: Study) -> StudyResult:
         try:
             with held_signals():
                 workroot = Path(tempfile.mkdtemp(prefix=f"whirl-sweep-{study.name}-"))
-            return run_study(study, workroot, jobs=1)
+            return run_study(study, workroot, jobs=1, on_slow=partial(_still_running, study.name))
         except BaseException as error:  # run_study's threads have ended (interrupts.thread_map)
             raise portable(error) from None
         finally:
             with held_signals():  # an interrupt meanwhile is raised once it is removed
                 if workroot is not None:
                     shutil.rmtree(workroot, ignore_errors=True)
+
+
+def _still_running(study: str, run: str, seconds: float) -> None:
+    """A line on the sweep's stderr: an AUTO run of ``study`` still running after ``seconds``."""
+    sys.stderr.write(f"  {study}: AUTO run {run} still running after {seconds:g} s\n")
+    sys.stderr.flush()
 
 
 def portable(error: BaseException) -> BaseException:
