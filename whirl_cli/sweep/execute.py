@@ -58,6 +58,8 @@ def compute(study: Study) -> StudyResult:
     with catching():
         if _CANCELLED is not None and _CANCELLED.is_set():
             raise KeyboardInterrupt("sweep cancelled")
+        if _CANCELLED is not None and not sys.stderr.isatty():  # a local worker, no progress bar
+            _progress(f"{'start':<8} {study.name}")
         workroot = None
         try:
             with held_signals():
@@ -73,7 +75,12 @@ def compute(study: Study) -> StudyResult:
 
 def _still_running(study: str, run: str, seconds: float) -> None:
     """A line on the sweep's stderr: an AUTO run of ``study`` still running after ``seconds``."""
-    sys.stderr.write(f"  {study}: AUTO run {run} still running after {seconds:g} s\n")
+    _progress(f"  {study}: AUTO run {run} still running after {seconds:g} s")
+
+
+def _progress(line: str) -> None:
+    """``line`` on the sweep's stderr, from a worker (one write: lines never interleave)."""
+    sys.stderr.write(line + "\n")
     sys.stderr.flush()
 
 
