@@ -12,7 +12,7 @@ onto a matplotlib Axes::
     table = api.special_points(api.read("linear-case2.h5"))
     api.draw(result, "bifurcation", ax)
 
-Nothing here prints; progress of the AUTO runs goes to ``on_run`` if given.
+Nothing here prints; progress of the AUTO runs goes to ``on_run`` (and ``on_slow``) if given.
 """
 
 from __future__ import annotations
@@ -46,17 +46,20 @@ def load(path: str | os.PathLike[str]) -> Study:
 def run(study: Study | str | os.PathLike[str], jobs: int = 1,
         on_run: Callable[[Any], None] | None = None,
         keep_runs: str | os.PathLike[str] | None = None,
-        preload: tuple[str, ...] = ()) -> StudyResult:
+        preload: tuple[str, ...] = (),
+        on_slow: Callable[[str, float], None] | None = None) -> StudyResult:
     """Run every continuation, linear analysis and cross-check of ``study`` (a Study or a
     path); ``jobs`` AUTO runs at once; ``on_run`` is called with each AUTO run's outcome as it
-    ends. AUTO works in a temporary directory, removed afterwards, or kept under
-    ``keep_runs``. ``preload``: modules needed afterwards, imported while AUTO runs (e.g.
+    ends, ``on_slow`` with a run's name and seconds when it still runs after 10 s, 20 s, ...
+    AUTO works in a temporary directory, removed afterwards, or kept under ``keep_runs``.
+    ``preload``: modules needed afterwards, imported while AUTO runs (e.g.
     :data:`whirl_cli.plots.MODULES` before :func:`save` draws plots)."""
     from .pipeline import run_study
 
     study = study if isinstance(study, Study) else load_study(study)
     with _workroot(study, keep_runs) as workroot:
-        return run_study(study, workroot, jobs=jobs, on_run=on_run, preload=preload)
+        return run_study(study, workroot, jobs=jobs, on_run=on_run, preload=preload,
+                         on_slow=on_slow)
 
 
 def save(result: StudyResult, path: str | os.PathLike[str], plots: Sequence[str] = (),
@@ -73,7 +76,9 @@ def run_and_save(study: Study | str | os.PathLike[str], path: str | os.PathLike[
                  plots: Sequence[str] = (), overwrite: bool = False, jobs: int = 1,
                  on_run: Callable[[Any], None] | None = None,
                  keep_runs: str | os.PathLike[str] | None = None,
-                 preload: tuple[str, ...] = ()) -> tuple[StudyResult, Published]:
+                 preload: tuple[str, ...] = (),
+                 on_slow: Callable[[str, float], None] | None = None
+                 ) -> tuple[StudyResult, Published]:
     """:func:`run`, then :func:`save` with the study's ``plot_state``: the same files, but
     the plots drawn while the cross-checks run (:func:`whirl_cli.pipeline.run_and_draw`):
     what ``whirl run`` does."""
@@ -86,7 +91,7 @@ def run_and_save(study: Study | str | os.PathLike[str], path: str | os.PathLike[
                    jobs=jobs)
     with _workroot(study, keep_runs) as workroot:
         result, drawn = run_and_draw(study, workroot, draw if kinds else None, jobs=jobs,
-                                     on_run=on_run, preload=preload)
+                                     on_run=on_run, preload=preload, on_slow=on_slow)
     return result, publish_study(result, path, kinds, overwrite, state=study.plot_state,
                                  jobs=jobs, drawn=drawn)
 

@@ -29,8 +29,14 @@ def _console():
 
 
 def _say(text: str, end: str = "\n") -> None:
-    """A line of ``whirl run``'s report on stderr, as written (no markup, no wrapping)."""
+    """A line of ``whirl run``'s progress or a diagnostic, on stderr, as written (no markup,
+    no wrapping)."""
     click.echo(text + end, err=True, nl=False)
+
+
+def _tell(text: str, end: str = "\n") -> None:
+    """A line of a command's results (files written, tables, final reports), on stdout."""
+    click.echo(text + end, nl=False)
 
 
 def _show_version(ctx: click.Context, _param: click.Parameter, value: bool) -> None:
@@ -97,6 +103,9 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
         _say(f"  {outcome.name:<32} {mark:<8} {outcome.n_points:>6} points "
              f"{outcome.wall_seconds:7.3f} s{detail}")
 
+    def slow(name: str, seconds: float) -> None:
+        _say(f"  {name:<32} still running after {seconds:g} s")
+
     _say(f"whirl {_version()}: {study.path} -> {output}")
     from . import api
     from .interrupts import catching
@@ -108,28 +117,28 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
         later = PLOT_MODULES if plots and study.plots else ()
         result, published = api.run_and_save(
             study, output, study.plots if plots else (), overwrite, jobs=jobs, on_run=report,
-            keep_runs=keep_runs, preload=later)
+            keep_runs=keep_runs, preload=later, on_slow=slow)
     for path in published.paths:
-        _say(f"wrote {path}")
+        _tell(f"wrote {path}")
     found = verdict(result, published.plot_error)
     for note in found.notes:
         _say(f"note: {note}")
-    _say(render(result, "table", study.variant().family.dof_names), end="")
+    _tell(render(result, "table", study.variant().family.dof_names), end="")
     checks = [x for c in result.continuations for x in c.cross_checks]
     if checks:
-        _say(f"cross-checks by time simulation: {sum(x.passed for x in checks)} of "
-             f"{len(checks)} passed")
+        _tell(f"cross-checks by time simulation: {sum(x.passed for x in checks)} of "
+              f"{len(checks)} passed")
     for continuation in result.continuations:
         for explored in continuation.explorations:
             frequencies = ", ".join(f"{f:.4g}" for f in explored.frequencies)
-            _say(f"{continuation.name} explore {explored.parameter} = {explored.value:g}: "
-                 f"{explored.kind}" + (f" at {frequencies} Hz" if frequencies else "")
-                 + f", lambda = {explored.lyapunov:.3g} +- {explored.lyapunov_error:.2g} 1/s")
+            _tell(f"{continuation.name} explore {explored.parameter} = {explored.value:g}: "
+                  f"{explored.kind}" + (f" at {frequencies} Hz" if frequencies else "")
+                  + f", lambda = {explored.lyapunov:.3g} +- {explored.lyapunov_error:.2g} 1/s")
     for sim in result.simulations:
         state = "ok" if sim.status == 0 else ("stopped" if sim.status > 0 else "FAILED")
-        _say(f"simulation {sim.name}: {len(sim.time)} samples to "
-             f"{sim.time[-1] if len(sim.time) else 0:.6g} s, {state}"
-             + ("" if sim.status == 0 else f": {sim.message}"))
+        _tell(f"simulation {sim.name}: {len(sim.time)} samples to "
+              f"{sim.time[-1] if len(sim.time) else 0:.6g} s, {state}"
+              + ("" if sim.status == 0 else f": {sim.message}"))
     if found.problems:
         raise WhirlError(f"{len(found.problems)} problem(s); the results are stored with "
                          "their status: " + "; ".join(found.problems))
@@ -416,7 +425,7 @@ def sweep(paths: tuple[Path, ...], out_dir: Path, jobs: int, dask_address: str |
 
     try:
         tally = run_sweep(paths, out_dir, jobs=jobs, dask_address=dask_address, force=force,
-                          plots=plots, console=_console())
+                          plots=plots, console=_console(), on_summary=_tell)
     except KeyboardInterrupt as error:
         click.echo("interrupted", err=True)
         raise SystemExit(128 + getattr(error, "signum", 2)) from None  # 130 SIGINT, 143 TERM

@@ -24,32 +24,22 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 
-
-class Interrupted(KeyboardInterrupt):
-    """SIGINT or SIGTERM during :func:`interruptible`: every running AUTO process is killed."""
-
-    def __init__(self, signum: int = signal.SIGINT) -> None:
-        super().__init__(signal.Signals(signum).name)
-        self.signum = int(signum)
-
-    def __reduce__(self):
-        """Pickle by the signal number (the default would re-create it from its message, the
-        signal's name, which is no signal number): an interrupt raised in a worker process
-        must reach the parent intact, or the process pool breaks."""
-        return type(self), (self.signum,)
+from .signals import Interrupted
 
 
-def quiet_worker() -> None:
+def quiet_worker(sigterm=signal.SIG_DFL) -> None:
     """Initializer of worker processes forked from whirl (cross-check and sweep pools).
 
     A fork inherits the parent's signal handlers; whirl's (:func:`interruptible`) would raise
     inside the pool's queue code of a worker, where an interrupt can leave a lock held and
     the other workers waiting for ever. So: SIGINT is ignored (a terminal's Ctrl-C reaches the
-    whole process group; the parent alone decides and then ends its workers), SIGTERM is the
-    default (the parent, or a batch system, can end a worker at once), and the worker dies
-    with its parent (Linux parent-death signal), so none outlives a SIGKILLed whirl."""
+    whole process group; the parent alone decides and then ends its workers), SIGTERM is
+    ``sigterm``: the default (the parent, or a batch system, can end a worker at once), or
+    ignored like SIGINT by workers whose tasks leave files to remove (a sweep's, which
+    handle both inside a task), and the worker dies with its parent (Linux parent-death
+    signal), so none outlives a SIGKILLed whirl."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, sigterm)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD)  # blocked while forking: see below
     die_with_parent()
 

@@ -42,7 +42,8 @@ T = TypeVar("T")
 
 def run_study(study: Study, workroot: Path, jobs: int = 1,
               on_run: Callable[[RunOutcome], None] | None = None,
-              preload: tuple[str, ...] = ()) -> StudyResult:
+              preload: tuple[str, ...] = (),
+              on_slow: Callable[[str, float], None] | None = None) -> StudyResult:
     """Run every continuation, linear sweep and simulation of ``study``; AUTO works under
     ``workroot`` (a study without continuations needs no AUTO). ``preload``: modules the
     caller needs afterwards (e.g. :data:`whirl_cli.plots.MODULES` to draw), imported in the
@@ -51,18 +52,22 @@ def run_study(study: Study, workroot: Path, jobs: int = 1,
     its circular imports (Python then raises its import-deadlock error in one of them): scipy's
     integrators are added only where the cross-checks are the first to use scipy and run
     here (:func:`_only_checks_simulate`, ``jobs`` 1; see :func:`run_and_draw`), and the
-    stages after the continuations join the import before they start.
+    stages after the continuations join the import before they start. ``on_run`` is called
+    with each AUTO run's outcome as it ends, ``on_slow`` with a run's name and seconds when it
+    is still running after 10 s, 20 s, 40 s ... (:func:`whirl_cli.auto.runner.run`).
 
     In the main thread, SIGINT and SIGTERM kill the running AUTO processes at once and raise
     :class:`whirl_cli.interrupts.Interrupted` (a KeyboardInterrupt), see
     :func:`whirl_cli.auto.runner.interruptible`.
     """
-    return run_and_draw(study, workroot, None, jobs, on_run, preload)[0]
+    return run_and_draw(study, workroot, None, jobs, on_run, preload, on_slow)[0]
 
 
 def run_and_draw(study: Study, workroot: Path, draw: Callable[[StudyResult], T] | None,
                  jobs: int = 1, on_run: Callable[[RunOutcome], None] | None = None,
-                 preload: tuple[str, ...] = ()) -> tuple[StudyResult, T | None]:
+                 preload: tuple[str, ...] = (),
+                 on_slow: Callable[[str, float], None] | None = None
+                 ) -> tuple[StudyResult, T | None]:
     """:func:`run_study`, and ``draw(result)`` (None without ``draw``): work that needs
     everything but the cross-checks, such as rendering the plots
     (:func:`whirl_cli.output.study_files.drawn_plots`). With ``jobs`` > 1 the cross-checks do
@@ -72,11 +77,12 @@ def run_and_draw(study: Study, workroot: Path, draw: Callable[[StudyResult], T] 
     continuations as soon as they are done, while the linear analysis, the simulations and
     ``draw`` run here. The same result and drawings for any ``jobs``."""
     with interruptible():
-        return _run_study(study, workroot, jobs, on_run, preload, draw)
+        return _run_study(study, workroot, jobs, partial(Engine, jobs=jobs, on_run=on_run,
+                                                         on_slow=on_slow), preload, draw)
 
 
-def _run_study(study: Study, workroot: Path, jobs: int,
-               on_run: Callable[[RunOutcome], None] | None, later: tuple[str, ...],
+def _run_study(study: Study, workroot: Path, jobs: int, engine: Callable[..., Engine],
+               later: tuple[str, ...],
                draw: Callable[[StudyResult], T] | None) -> tuple[StudyResult, T | None]:
     model = study.variant()
     parameters = study.parameter_values()
@@ -87,19 +93,21 @@ def _run_study(study: Study, workroot: Path, jobs: int,
                 partial(_cross_checks, model, parameters), simulate.MODULES))
         elif _only_checks_simulate(study, model):  # scipy too, while AUTO runs
             later = (*later, *simulate.MODULES)
-        return _stages(study, model, parameters, workroot, jobs, on_run, later, draw, checker)
+        return _stages(study, model, parameters, workroot, jobs, engine, later, draw, checker)
 
 
 def _stages(study: Study, model, parameters: dict[str, float], workroot: Path, jobs: int,
-            on_run: Callable[[RunOutcome], None] | None, later: tuple[str, ...],
+            new_engine: Callable[..., Engine], later: tuple[str, ...],
             draw: Callable[[StudyResult], T] | None, checker: Standby | None
             ) -> tuple[StudyResult, T | None]:
-    """The stages of :func:`run_and_draw`; the cross-checks by ``checker`` if given."""
+    """The stages of :func:`run_and_draw`; AUTO by ``new_engine(model, workroot,
+    timeout=...)`` (an :class:`Engine` with the caller's jobs and callbacks); the cross-checks
+    by ``checker`` if given."""
     numerics = Numerics.from_settings(study.auto)
     continuations: list[ContinuationResult] = []
     engine = None
     if study.continuations:
-        engine = Engine(model, workroot, jobs=jobs, timeout=numerics.timeout, on_run=on_run)
+        engine = new_engine(model, workroot, timeout=numerics.timeout)
     found_boundaries = []
     for spec in study.continuations:
         assert engine is not None

@@ -6,6 +6,7 @@ import h5py
 import numpy as np
 from click.testing import CliRunner
 
+from whirl_cli.auto import runner
 from whirl_cli.cli import cli
 from whirl_cli.output import store
 
@@ -43,10 +44,12 @@ def test_store_round_trip(tmp_path):
     ran = runner.invoke(cli, ["run", str(STUDIES / "linear_datum_airspeed.yaml"), "-o",
                               str(output), "--no-plots"])
     assert ran.exit_code == 0, ran.output
-    # whirl run ends with the table whirl summary prints from the file (issue 17, item 4)
+    # whirl run ends with the table whirl summary prints from the file, on stdout (a result:
+    # `> log` keeps it), its progress on stderr
     table = runner.invoke(cli, ["summary", str(output)]).stdout
     assert table.startswith("airspeed (one-parameter): 1 special point\n")
-    assert ran.stderr.endswith(table)
+    assert ran.stdout.endswith(table) and table not in ran.stderr
+    assert " points " in ran.stderr and " points " not in ran.stdout  # a line per AUTO run
     first = store.read(output)
     copy = store.write(first, tmp_path / "copy.h5")
     second = store.read(copy)
@@ -74,9 +77,8 @@ def test_run_reports_paths_as_written(tmp_path):
     output = folder / "[v2].h5"
     ran = CliRunner().invoke(cli, ["run", str(study), "-o", str(output), "--no-plots"])
     assert ran.exit_code == 0, ran.output
-    lines = ran.stderr.splitlines()
-    assert lines[0].endswith(f": {study} -> {output}")
-    assert f"wrote {output}" in lines
+    assert ran.stderr.splitlines()[0].endswith(f": {study} -> {output}")
+    assert f"wrote {output}" in ran.stdout.splitlines()
 
 
 def test_validate_models_and_doctor():
@@ -100,3 +102,28 @@ def test_validate_reports_bad_study_word_for_word(tmp_path):
     assert result.output == "case2.yaml:5: nonlinearity.K2: expected a number, got 'ten'\n"
     run = CliRunner().invoke(cli, ["run", str(bad), "-o", str(tmp_path / "x.h5")])
     assert run.exit_code == 1 and not (tmp_path / "x.h5").exists()
+
+
+def test_a_run_stuck_until_its_timeout_says_so_meanwhile(tmp_path, monkeypatch):
+    """Newton cannot converge to 1e-30: AUTO spins until the 2 s timeout. Meanwhile a line
+    on stderr says which run is still running (the first after SLOW_NOTICE, here 0.5 s),
+    before the line of its end."""
+    monkeypatch.setattr(runner, "SLOW_NOTICE", 0.5)
+    study = tmp_path / "stuck.yaml"
+    study.write_text((STUDIES / "linear_case2.yaml").read_text()
+                     + "auto: {tolerance: 1.0e-30, newton_max_iterations: 1, timeout: 2}\n")
+    ran = CliRunner().invoke(cli, ["run", str(study), "-o", str(tmp_path / "r.h5"),
+                                   "--no-plots", "-j", "1"])
+    assert ran.exit_code == 1, ran.output
+    lines = ran.stderr.splitlines()
+    notices = [k for k, line in enumerate(lines) if "still running after 0.5 s" in line]
+    assert notices and "still running after 1 s" in lines[notices[0] + 1], lines
+    name = lines[notices[0]].split()[0]
+    ended = next(k for k, line in enumerate(lines) if line.split()[:2] == [name, "TIMEOUT"])
+    assert ended > notices[0] + 1
+    assert "still running" not in ran.stdout
+
+
+def test_slow_notices_double_up_to_the_timeout():
+    assert runner.slow_notices(60) == [10, 20, 40]
+    assert runner.slow_notices(10) == []

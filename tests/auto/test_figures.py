@@ -120,3 +120,23 @@ def test_results_of_figures_are_sweep_results(tmp_path, name):
     result = CliRunner().invoke(cli, ["sweep", str(tmp_path / "studies"), "-o",
                                       str(tmp_path / "r"), "--no-plots"])
     assert result.exit_code == 0 and "2 up to date" in result.output
+
+
+def test_piped_figures_say_when_each_study_starts_and_ends(tmp_path):
+    """Not on a terminal (a pipe, a batch log) there is no progress bar: a line as each study
+    starts, before its line as it ends, so a long first study is not silence."""
+    import subprocess
+
+    from ..robustness.helpers import WHIRL, environment
+
+    copy_studies(tmp_path / "studies")
+    folder = sheets(tmp_path / "sheets")
+    done = subprocess.run([str(WHIRL), "figures", str(folder), "-o", str(tmp_path / "figures"),
+                           "--results", str(tmp_path / "results"), "-j", "2"],
+                          env=environment(), capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    lines = done.stderr.splitlines()
+    for name in ("linear-case2", "linear-datum-airspeed"):
+        started = [k for k, line in enumerate(lines) if line.split() == ["start", name]]
+        ended = [k for k, line in enumerate(lines) if line.split()[1:3] == ["ok", name]]
+        assert len(started) == len(ended) == 1 and started[0] < ended[0], lines

@@ -3,6 +3,7 @@ Ctrl-C, and the same results through a Dask cluster."""
 
 from __future__ import annotations
 
+import errno
 import os
 import signal
 import subprocess
@@ -18,7 +19,7 @@ from whirl_cli import __version__
 from whirl_cli.auto.toolchain import auto_version
 from whirl_cli.cli import cli
 from whirl_cli.errors import WhirlError
-from whirl_cli.output import store
+from whirl_cli.output import atomic, store
 from whirl_cli.output.compare import compare_files
 from whirl_cli.output.provenance import code_sha256
 from whirl_cli.sweep.executors import dask_pool
@@ -127,7 +128,10 @@ def test_sweep_runs_in_parallel_resumes_and_reports_failures(tmp_path):
     first = runner.invoke(cli, ["sweep", str(studies), "-o", str(out), "-j", "2"])
     assert first.exit_code == 1, first.output  # the broken study; the others still ran
     assert "broken.yaml:3: colour: unknown key" in first.output
-    assert "sweep: 2 ok, 0 up to date, 1 invalid of 3 studies" in first.output
+    # the summary is the result (stdout: `> log` keeps it), a line per study progress
+    assert first.stdout.startswith("sweep: 2 ok, 0 up to date, 1 invalid of 3 studies")
+    assert "broken.yaml:3: colour: unknown key" in first.stdout
+    assert "ok       linear-case2" in first.stderr and "ok       linear" not in first.stdout
     assert sorted(p.name for p in out.iterdir()) == [
         "linear-case2.h5", "linear-case2_k1_bifurcation.png", "linear-datum-airspeed.h5",
         "linear-datum-airspeed_airspeed_bifurcation.png", "linear-datum-airspeed_linear_V.png"]
@@ -165,6 +169,41 @@ def test_sweep_exits_1_on_a_failed_branch_and_keeps_its_result(tmp_path):
     # resuming reports the stored failure again instead of hiding it
     again = CliRunner().invoke(cli, ["sweep", str(source), "-o", str(out), "--no-plots"])
     assert again.exit_code == 1 and "up to date" in again.output
+
+
+def test_a_full_disk_leaves_no_plot_without_its_result_file(tmp_path, monkeypatch):
+    """The disk fills up at the HDF5 file, after the plots are published (ENOSPC on the write
+    of its bytes): the study is an error with the reason, and none of its new files stays,
+    in a fresh directory and beside the old result a --force rerun was to replace (whose
+    plots the next sweep completes)."""
+    source = copy_studies(tmp_path / "studies", ("linear_case2",))[0]
+    out = tmp_path / "results"
+    write_all = atomic._write_all
+
+    def full(fd: int, data: bytes) -> None:
+        if data.startswith(b"\x89HDF"):  # the result file, not a PNG
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        write_all(fd, data)
+
+    runner = CliRunner()
+    with monkeypatch.context() as patched:
+        patched.setattr(atomic, "_write_all", full)
+        failed = runner.invoke(cli, ["sweep", str(source), "-o", str(out), "-j", "1"])
+    assert failed.exit_code == 1, failed.output
+    assert "No space left on device" in failed.output
+    assert sorted(p.name for p in out.iterdir()) == []
+
+    assert runner.invoke(cli, ["sweep", str(source), "-o", str(out)]).exit_code == 0
+    old = (out / "linear-case2.h5").read_bytes()
+    with monkeypatch.context() as patched:
+        patched.setattr(atomic, "_write_all", full)
+        failed = runner.invoke(cli, ["sweep", str(source), "-o", str(out), "--force"])
+    assert failed.exit_code == 1, failed.output
+    assert sorted(p.name for p in out.iterdir()) == ["linear-case2.h5"]
+    assert (out / "linear-case2.h5").read_bytes() == old
+    completed = runner.invoke(cli, ["sweep", str(source), "-o", str(out)])
+    assert completed.exit_code == 0 and "plots completed" in completed.output, completed.output
+    assert (out / "linear-case2_k1_bifurcation.png").is_file()
 
 
 def start_interruptible_sweep(tmp_path: Path, jobs: int = 1):

@@ -12,6 +12,10 @@ Python's own start-up and the ``.pth`` files of site-packages (the editable inst
 hook among them), a SIGINT meets Python's default handler, which raises KeyboardInterrupt inside
 ``site`` and reports it as a fatal error; no program can handle it there. That moment is
 measured (:func:`interpreter_start`), with a margin.
+
+A batch system's cancel sends SIGTERM to the whole process group: a ``whirl sweep`` (its
+workers and their AUTO runs) gets one at moments spread over a whole sweep, and ``run``,
+``sweep`` and ``figures`` at moments early in their start.
 """
 
 from __future__ import annotations
@@ -25,7 +29,7 @@ from pathlib import Path
 
 import pytest
 
-from .helpers import STUDIES, WHIRL, auto_processes, environment
+from .helpers import ROOT, STUDIES, WHIRL, auto_processes, environment
 
 pytestmark = pytest.mark.auto
 
@@ -143,3 +147,122 @@ def test_sigint_at_any_moment_stops_at_once_without_a_trace(tmp_path):
     print(f"\n  {len(plan)} SIGINTs over a {duration:.1f} s run of {STUDY.name} from "
           f"{first:.3f} s (half to the process group): {counts}")
     assert endings.count("interrupted") >= SPREAD // 2 + TARGETED  # most of them land mid-run
+
+
+# ------------------------------------------------------------------ sweep, process-group SIGTERM
+SWEEP_STUDY = STUDIES / "linear_case2.yaml"  # three short AUTO runs
+SWEEP_COPIES, SWEEP_SIGNALS = 3, 32
+
+
+def sweep_studies(directory: Path) -> Path:
+    """Copies of a short study under other names: a sweep of ``SWEEP_COPIES`` studies."""
+    directory.mkdir()
+    text = SWEEP_STUDY.read_text()
+    old = next(line for line in text.splitlines() if line.startswith("name:"))
+    for k in range(SWEEP_COPIES):
+        (directory / f"copy{k}.yaml").write_text(text.replace(old, f"name: copy-{k}"))
+    return directory
+
+
+def terminate_sweep(cache: Path, scratch: Path, studies: Path, out: Path, delay: float) -> str:
+    """A ``whirl sweep -j 2`` (with plots) sent SIGTERM as a process group ``delay`` s after
+    its start, as a batch system's cancel does; checks how it ended, returns a word for it."""
+    env = environment(cache, TMPDIR=str(scratch))
+    process = subprocess.Popen([str(WHIRL), "sweep", str(studies), "-o", str(out), "-j", "2"],
+                               env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                               text=True, start_new_session=True)
+    try:
+        time.sleep(delay)
+        os.killpg(process.pid, signal.SIGTERM)
+        try:
+            _, stderr = process.communicate(timeout=30)
+        except subprocess.TimeoutExpired:
+            pytest.fail(f"whirl sweep did not stop within 30 s of SIGTERM at {delay:.2f} s; "
+                        f"alive: {session_processes(process.pid)}")
+    finally:
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
+    assert "Traceback" not in stderr and "internal error" not in stderr, (delay, stderr)
+    deadline = time.monotonic() + 2.0
+    while (session_processes(process.pid) or auto_processes(cache)) and \
+            time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert session_processes(process.pid) == [], "a worker outlived the sweep"
+    assert auto_processes(cache) == [], "an AUTO process outlived the sweep"
+    left = sorted(p.name for p in scratch.iterdir())
+    assert not left, f"SIGTERM at {delay:.2f} s left work directories: {left}"
+    names = outputs(out)
+    assert not [n for n in names if n.startswith(".") or "tmp" in n], names
+    for name in names:  # a result file and its plots, or nothing of a study
+        study = name.split("_")[0].removesuffix(".h5")
+        assert f"{study}.h5" in names, f"{name} without its result file ({names})"
+    if process.returncode == 143:
+        assert stderr.rstrip().endswith("interrupted"), (delay, stderr)
+        return "interrupted"
+    # finished (0), or the signal's default action once the command is over (cli.main):
+    # whirl's handler is in place from the first line of entry.main on
+    assert process.returncode in (0, -signal.SIGTERM), (delay, process.returncode, stderr)
+    assert len([n for n in names if n.endswith(".h5")]) == SWEEP_COPIES, (delay, names)
+    return "finished"
+
+
+def test_a_process_group_sigterm_at_any_moment_of_a_sweep_leaves_nothing_behind(tmp_path):
+    cache = Path(os.environ["WHIRL_CACHE_DIR"])
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    studies = sweep_studies(tmp_path / "studies")
+    env = environment(cache, TMPDIR=str(scratch))
+    started = time.monotonic()  # compiles the study's AUTO program once, for every run below
+    done = subprocess.run([str(WHIRL), "sweep", str(studies), "-o", str(tmp_path / "ref"),
+                           "-j", "2"], env=env, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    started = time.monotonic()
+    subprocess.run([str(WHIRL), "sweep", str(studies), "-o", str(tmp_path / "ref2"), "-j", "2"],
+                   env=env, capture_output=True, text=True, timeout=120, check=True)
+    duration = time.monotonic() - started
+    first = 1.5 * interpreter_start(env)  # whirl's own code runs from here on (module doc)
+    rng = random.Random(SEED)
+    delays = [first + (k + rng.random()) / SWEEP_SIGNALS * (duration - first)
+              for k in range(SWEEP_SIGNALS)]
+    endings = [terminate_sweep(cache, scratch, studies, tmp_path / f"out{k}", delay)
+               for k, delay in enumerate(delays)]
+    counts = {word: endings.count(word) for word in sorted(set(endings))}
+    print(f"\n  {len(delays)} process-group SIGTERMs over a {duration:.1f} s sweep: {counts}")
+    assert endings.count("interrupted") >= SWEEP_SIGNALS // 2  # most of them land mid-sweep
+
+
+SHEET = ROOT / "sheets" / "thesis_ch3" / "fig3_13.yaml"
+EARLY_SIGNALS, EARLY_SECONDS = 8, 0.5
+
+
+@pytest.mark.parametrize("command", ["run", "sweep", "figures"])
+def test_a_sigterm_early_in_a_command_ends_it_as_an_interrupt(tmp_path, command):
+    """SIGTERM while the command line is imported and the command sets out (before any AUTO
+    run): whirl's handler, not the signal's default action, ends it: exit 143, "interrupted",
+    no traceback, nothing left in TMPDIR."""
+    cache = Path(os.environ["WHIRL_CACHE_DIR"])
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    env = environment(cache, TMPDIR=str(scratch))
+    first = 1.5 * interpreter_start(env)  # whirl's own code runs from here on (module doc)
+    arguments = {"run": ["run", str(SWEEP_STUDY), "-o", str(tmp_path / "out" / "r.h5")],
+                 "sweep": ["sweep", str(SWEEP_STUDY), "-o", str(tmp_path / "out")],
+                 "figures": ["figures", str(SHEET), "-o", str(tmp_path / "out"),
+                             "--results", str(tmp_path / "results")]}[command]
+    for k in range(EARLY_SIGNALS):
+        delay = first + k / EARLY_SIGNALS * EARLY_SECONDS
+        process = subprocess.Popen([str(WHIRL), *arguments], env=env, stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE, text=True, start_new_session=True)
+        try:
+            time.sleep(delay)
+            os.killpg(process.pid, signal.SIGTERM)
+            stdout, stderr = process.communicate(timeout=30)
+        finally:
+            if process.poll() is None:
+                os.killpg(process.pid, signal.SIGKILL)
+                process.wait()
+        assert process.returncode == 143, (command, delay, process.returncode, stderr)
+        assert stderr.rstrip().endswith("interrupted") and "Traceback" not in stdout + stderr
+        assert list(scratch.iterdir()) == [], (command, delay)
+        assert not list(tmp_path.glob("out/*.h5")), (command, delay)

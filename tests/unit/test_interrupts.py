@@ -274,3 +274,31 @@ def test_a_standby_worker_that_dies_is_an_error_not_a_hang():
         standby.submit(None)
         with pytest.raises(RuntimeError, match="exit code 3"):
             standby.result()
+
+
+def _ended_pid() -> int:
+    """The PID of a process that has ended and been reaped."""
+    import subprocess
+
+    process = subprocess.Popen(["true"], start_new_session=True)
+    process.wait()
+    return process.pid
+
+
+def test_stopping_a_process_that_has_ended_meanwhile_is_no_error(monkeypatch):
+    """A process group's SIGTERM ends a sweep worker (or an AUTO run) between the check that
+    it is alive and the signal whirl sends it: that is no error."""
+    from types import SimpleNamespace
+
+    from whirl_cli.auto.runner import kill_group
+    from whirl_cli.sweep.executors import LocalPool
+
+    kill_group(_ended_pid())
+    pool = LocalPool(1)
+    try:
+        ended = SimpleNamespace(pid=_ended_pid(), is_alive=lambda: True)  # as it was checked
+        monkeypatch.setattr(pool, "workers", lambda: [ended])
+        pool.interrupt()
+        assert pool.cancelled.is_set()
+    finally:
+        pool.shutdown()

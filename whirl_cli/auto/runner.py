@@ -27,7 +27,7 @@ import signal
 import subprocess
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import cache
@@ -63,10 +63,15 @@ def stop_all() -> None:
     with _LIVE_LOCK:
         _STOPPING.set()
         for process in list(_LIVE):
-            try:
-                os.killpg(process.pid, signal.SIGKILL)
-            except (ProcessLookupError, PermissionError):
-                pass
+            kill_group(process.pid)
+
+
+def kill_group(pid: int) -> None:
+    """SIGKILL the process group of the AUTO run ``pid``; one that has ended is no error."""
+    try:
+        os.killpg(pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):  # ended (and reaped) meanwhile
+        pass
 
 
 @contextmanager
@@ -184,14 +189,17 @@ def _describe_signal(returncode: int) -> str:
 
 def run(executable: Path, constants: dict, workdir: Path, name: str,
         restart: Path | None = None, timeout: float = 120.0,
-        data: str | None = None) -> RunOutcome:
+        data: str | None = None, on_slow: Callable[[str, float], None] | None = None
+        ) -> RunOutcome:
     """Run AUTO once in the fresh directory ``workdir``.
 
     ``constants`` are complete (whirl never relies on AUTO defaults it did not choose); ``sv`` is
     set to ``name`` here. ``restart`` is the ``s.`` file to restart from; it is copied into
     ``workdir`` and named through the ``s`` constant. ``data``: the text of an AUTO data file
     to start from instead (rows ``t u1 .. uNDIM``, used with IRS=0), written into ``workdir``
-    and named through the ``dat`` constant.
+    and named through the ``dat`` constant. ``on_slow(name, seconds)`` is called when the run
+    is still running after each of :func:`slow_notices` (a run stuck until its timeout is
+    not silent meanwhile).
     """
     workdir.mkdir(parents=True, exist_ok=False)
     constants = dict(_merged(constants, _extra_constants(name)), sv=name)
@@ -218,14 +226,14 @@ def run(executable: Path, constants: dict, workdir: Path, name: str,
                                        start_new_session=True)
             _LIVE.add(process)
         try:
-            returncode = process.wait(timeout=timeout)
+            returncode = _wait(process, timeout, name, on_slow)
             timed_out = False
         except subprocess.TimeoutExpired:
-            os.killpg(process.pid, signal.SIGKILL)
+            kill_group(process.pid)
             process.wait()
             returncode, timed_out = None, True
         except BaseException:  # KeyboardInterrupt: never leave AUTO running
-            os.killpg(process.pid, signal.SIGKILL)
+            kill_group(process.pid)
             process.wait()
             raise
         finally:
@@ -242,6 +250,31 @@ def run(executable: Path, constants: dict, workdir: Path, name: str,
     n_points = _count_points(workdir / f"b.{name}")
     status, message = _classify(returncode, timed_out, stdout, n_points, labels, timeout)
     return RunOutcome(name, status, message, workdir, text, returncode, wall, n_points, labels)
+
+
+def slow_notices(timeout: float) -> list[float]:
+    """Seconds at which a run still running is reported: 10, 20, 40, ... before ``timeout``."""
+    notices, seconds = [], SLOW_NOTICE
+    while seconds < timeout:
+        notices.append(seconds)
+        seconds *= 2
+    return notices
+
+
+#: Seconds of a run before the first "still running" notice.
+SLOW_NOTICE = 10.0
+
+
+def _wait(process: subprocess.Popen, timeout: float, name: str,
+          on_slow: Callable[[str, float], None] | None) -> int:
+    """``process.wait(timeout)`` (TimeoutExpired past it), calling ``on_slow`` on the way."""
+    start = time.monotonic()
+    for notice in slow_notices(timeout) if on_slow is not None else ():
+        try:
+            return process.wait(timeout=max(0.0, notice - (time.monotonic() - start)))
+        except subprocess.TimeoutExpired:
+            on_slow(name, notice)
+    return process.wait(timeout=max(0.0, timeout - (time.monotonic() - start)))
 
 
 def _classify(returncode: int | None, timed_out: bool, stdout: str, n_points: int,

@@ -76,12 +76,14 @@ class Engine:
     background runs only on slots no foreground run waits for)."""
 
     def __init__(self, model: Model, workroot: Path, jobs: int = 1, timeout: float = 120.0,
-                 on_run: Callable[[runner.RunOutcome], None] | None = None) -> None:
+                 on_run: Callable[[runner.RunOutcome], None] | None = None,
+                 on_slow: Callable[[str, float], None] | None = None) -> None:
         self.model = model
         self.workroot = Path(workroot)
         self.jobs = max(1, jobs)
         self.timeout = timeout
         self.on_run = on_run
+        self.on_slow = on_slow
         self.executable = toolchain.compile_equations(lambda: fortran_source(model), model.name,
                                                  source_key=source_key(model))
         self.outcomes: dict[str, runner.RunOutcome] = {}
@@ -106,7 +108,7 @@ class Engine:
         with self._slots.held(background):
             outcome = runner.run(self.executable.path, constants, self.workroot / spec.name,
                                  spec.name.replace("/", "."), restart=restart_file,
-                                 timeout=self.timeout, data=spec.data)
+                                 timeout=self.timeout, data=spec.data, on_slow=self.on_slow)
         self.outcomes[outcome.name] = outcome
         self.specs[outcome.name] = spec
         if self.on_run is not None:

@@ -11,8 +11,10 @@
 3. the files are published with SIGINT and SIGTERM held back (an interrupt arriving then is
    delivered once the set is complete): the plots first, the HDF5 file last. Its root
    attribute ``plots`` lists the plot files published with it. Each file appears complete or
-   not at all (:func:`whirl_cli.output.atomic.publish`), so even a SIGKILL can leave at most plots
-   without their HDF5 file, never an HDF5 file without its plots; a sweep treats a study
+   not at all (:func:`whirl_cli.output.atomic.publish`); if one cannot be written (a full
+   disk), the plots already published are removed again, also with ``overwrite`` (an old
+   HDF5 file then stays, without the plots it had: none of the new result stays). So only a
+   SIGKILL can leave plots without their HDF5 file; a sweep treats a study
    without its HDF5 file as not run, and completes the plots of an up-to-date file that lacks
    some (:func:`missing_plots`);
 4. with ``overwrite``, the plots the old HDF5 file recorded that the new result does not
@@ -112,10 +114,9 @@ def publish_study(result: StudyResult, output: Path, kinds: Sequence[str],
             for (_, data), path in zip(plots, targets, strict=True):
                 written.append(atomic.publish(data, path, overwrite, what="the plot"))
             written.append(store.write(result, output, overwrite=overwrite))
-        except BaseException:
-            if not overwrite:  # they did not exist before: leave no plots without their file
-                for path in written:
-                    path.unlink(missing_ok=True)
+        except BaseException:  # e.g. a full disk: none of the new result's files stays
+            for path in written:
+                path.unlink(missing_ok=True)
             raise
         for path in stale:
             path.unlink(missing_ok=True)

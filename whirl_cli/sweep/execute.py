@@ -15,14 +15,17 @@ from __future__ import annotations
 
 import pickle
 import shutil
+import signal
+import sys
 import tempfile
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Executor, Future, as_completed, wait
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 from ..errors import WhirlError
-from ..interrupts import quiet_worker
+from ..interrupts import catching, held_signals, quiet_worker
 from ..output.study_files import publish_plots, publish_study
 from ..results import StudyResult
 from ..study import Study
@@ -34,29 +37,51 @@ _CANCELLED = None
 
 
 def _init_worker(cancelled) -> None:
-    """Initializer of local worker processes: :func:`whirl_cli.interrupts.quiet_worker` (SIGINT
-    ignored except inside :func:`whirl_cli.pipeline.run_study`, whose own handler kills the
-    running AUTO processes and raises; SIGTERM default; death with the sweep process), and
-    ``cancelled`` (an Event) makes tasks still queued return at once."""
+    """Initializer of local worker processes: :func:`whirl_cli.interrupts.quiet_worker` with
+    SIGTERM ignored as SIGINT is (a process group's SIGTERM, a batch system's cancel, must not
+    end a worker inside the pool's queue code, where it would leave a lock held and the
+    parent waiting: the parent, which receives it too, ends its workers), except inside
+    :func:`compute`, which removes its work directory and returns the interrupt; death with
+    the sweep process; and ``cancelled`` (an Event) makes tasks still queued return at once."""
     global _CANCELLED
     _CANCELLED = cancelled
-    quiet_worker()
+    quiet_worker(sigterm=signal.SIG_IGN)
 
 
 def compute(study: Study) -> StudyResult:
     """Run ``study`` (AUTO runs one at a time) in a fresh temporary directory, removed
-    afterwards; the worker-side task of a sweep."""
+    afterwards; the worker-side task of a sweep. In a local worker SIGINT and SIGTERM raise
+    :class:`whirl_cli.interrupts.Interrupted` inside it (the work directory is made and
+    removed with them held: none is left behind)."""
     from ..pipeline import run_study
 
-    if _CANCELLED is not None and _CANCELLED.is_set():
-        raise KeyboardInterrupt("sweep cancelled")
-    workroot = Path(tempfile.mkdtemp(prefix=f"whirl-sweep-{study.name}-"))
-    try:
-        return run_study(study, workroot, jobs=1)
-    except BaseException as error:  # run_study's threads have ended (interrupts.thread_map)
-        raise portable(error) from None
-    finally:
-        shutil.rmtree(workroot, ignore_errors=True)
+    with catching():
+        if _CANCELLED is not None and _CANCELLED.is_set():
+            raise KeyboardInterrupt("sweep cancelled")
+        if _CANCELLED is not None and not sys.stderr.isatty():  # a local worker, no progress bar
+            _progress(f"{'start':<8} {study.name}")
+        workroot = None
+        try:
+            with held_signals():
+                workroot = Path(tempfile.mkdtemp(prefix=f"whirl-sweep-{study.name}-"))
+            return run_study(study, workroot, jobs=1, on_slow=partial(_still_running, study.name))
+        except BaseException as error:  # run_study's threads have ended (interrupts.thread_map)
+            raise portable(error) from None
+        finally:
+            with held_signals():  # an interrupt meanwhile is raised once it is removed
+                if workroot is not None:
+                    shutil.rmtree(workroot, ignore_errors=True)
+
+
+def _still_running(study: str, run: str, seconds: float) -> None:
+    """A line on the sweep's stderr: an AUTO run of ``study`` still running after ``seconds``."""
+    _progress(f"  {study}: AUTO run {run} still running after {seconds:g} s")
+
+
+def _progress(line: str) -> None:
+    """``line`` on the sweep's stderr, from a worker (one write: lines never interleave)."""
+    sys.stderr.write(line + "\n")
+    sys.stderr.flush()
 
 
 def portable(error: BaseException) -> BaseException:

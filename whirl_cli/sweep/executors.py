@@ -37,10 +37,14 @@ def prepare_workers(items: Sequence[SweepItem]) -> None:
             model.rhs_numpy(np.zeros(model.n_states), params)
 
 
+#: Seconds the workers of a broken pool get to end their studies and remove their directories.
+BROKEN_GRACE = 2.0
+
+
 class LocalPool(ProcessPoolExecutor):
     """A process pool of ``jobs`` workers whose studies can be interrupted.
 
-    Workers ignore SIGINT except inside ``run_study`` (see
+    Workers ignore SIGINT and SIGTERM except inside a study (see
     :func:`whirl_cli.sweep.execute._init_worker`);
     ``interrupt`` sets the shared cancel flag (queued tasks return at once) and sends them
     SIGINT (a terminal's Ctrl-C reaches them directly, ``kill -INT`` on the parent does not).
@@ -65,24 +69,33 @@ class LocalPool(ProcessPoolExecutor):
             future.result()
 
     def close(self, timeout: float) -> None:
-        """Shut down after an interrupt without risking a hang: workers not gone after
-        ``timeout`` s (a worker killed inside the pool's queue code leaves the others
-        waiting on its lock) are terminated; by then they run no study."""
+        """Shut down without risking a hang: workers not gone after ``timeout`` s are killed;
+        by then they run no study. If the pool broke (a worker died), its manager has sent
+        the others SIGTERM, which ends a study at once but is ignored by an idle worker (see
+        :func:`whirl_cli.sweep.execute._init_worker`): they get ``BROKEN_GRACE`` s."""
         workers = self.workers()
+        manager = getattr(self, "_executor_manager_thread", None)
+        if getattr(self, "_broken", False):
+            timeout = min(timeout, BROKEN_GRACE)
         self.shutdown(wait=False)
         deadline = time.monotonic() + timeout
         for process in workers:
             process.join(max(0.0, deadline - time.monotonic()))
         for process in workers:
             if process.is_alive():
-                process.terminate()
+                process.kill()
                 process.join(5)
+        if manager is not None:
+            manager.join(5)
 
     def interrupt(self) -> None:
         self.cancelled.set()
         for process in self.workers():
             if process.is_alive():
-                os.kill(process.pid, signal.SIGINT)
+                try:
+                    os.kill(process.pid, signal.SIGINT)
+                except ProcessLookupError:  # ended meanwhile (a process group's SIGTERM),
+                    pass                    # and reaped by the pool's manager thread
 
 
 @contextmanager
@@ -93,11 +106,8 @@ def local_pool(jobs: int) -> Iterator[Executor]:
     try:
         pool.start()
         yield pool
-    except BaseException:  # every task has returned (see _stop_running)
+    finally:  # after an interrupt every task has returned (see _stop_running)
         pool.close(timeout=10.0)
-        raise
-    else:
-        pool.shutdown(wait=True)
 
 
 @contextmanager

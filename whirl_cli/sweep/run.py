@@ -16,13 +16,14 @@ from .report import Reporter, Tally
 
 def run_sweep(paths: Sequence[str | os.PathLike[str]], out_dir: Path, jobs: int = 1,
               dask_address: str | None = None, force: bool = False, plots: bool = True,
-              console=None, on_outcome: Callable[[Outcome, int], None] | None = None
-              ) -> Tally:
+              console=None, on_outcome: Callable[[Outcome, int], None] | None = None,
+              on_summary: Callable[[str], None] | None = None) -> Tally:
     """Plan, execute and report a sweep (what ``whirl sweep`` does): the tally of outcomes.
 
     ``on_outcome`` is called in this process after each outcome is reported, with the number
     of studies still running or waiting for a worker (fewer than ``jobs``: a worker is idle).
-    The summary is printed in every case; a KeyboardInterrupt propagates after it.
+    The summary is given to ``on_summary`` (None: printed with the progress, on ``console``)
+    in every case; a KeyboardInterrupt propagates after it.
     """
     items = plan(paths, out_dir, force, plots)
     pending = sum(item.action == RUN for item in items)
@@ -51,6 +52,10 @@ def run_sweep(paths: Sequence[str | os.PathLike[str]], out_dir: Path, jobs: int 
         interrupted = True
         raise
     finally:
-        reporter.console.print(reporter.tally.summary(interrupted), markup=False, soft_wrap=True)
+        summary = reporter.tally.summary(interrupted)
+        if on_summary is None:
+            reporter.console.print(summary, markup=False, soft_wrap=True)
+        else:
+            on_summary(summary)
     return reporter.tally
 

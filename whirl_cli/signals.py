@@ -1,0 +1,36 @@
+"""The exception SIGINT and SIGTERM raise in whirl, and SIGTERM's handler from the first moment.
+
+Only :mod:`signal` is imported here: :func:`whirl_cli.entry.main` installs
+:func:`raise_interrupted` for SIGTERM before it imports anything else, so that a batch system's
+cancel ends whirl as Ctrl-C does (Python's own handler raises KeyboardInterrupt for SIGINT)
+instead of by the signal's default action, however early it lands.
+"""
+
+from __future__ import annotations
+
+import signal
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGINT or SIGTERM during :func:`whirl_cli.auto.runner.interruptible`: every running AUTO
+    process is killed. 128 + ``signum`` is whirl's exit status."""
+
+    def __init__(self, signum: int = signal.SIGINT) -> None:
+        super().__init__(signal.Signals(signum).name)
+        self.signum = int(signum)
+
+    def __reduce__(self):
+        """Pickle by the signal number (the default would re-create it from its message, the
+        signal's name, which is no signal number): an interrupt raised in a worker process
+        must reach the parent intact, or the process pool breaks."""
+        return type(self), (self.signum,)
+
+
+def raise_interrupted(signum: int, _frame: object) -> None:
+    """A signal handler: raise :class:`Interrupted` for ``signum``."""
+    raise Interrupted(signum)
+
+
+def terminate_as_interrupt() -> None:
+    """From now on SIGTERM raises :class:`Interrupted`, as SIGINT raises KeyboardInterrupt."""
+    signal.signal(signal.SIGTERM, raise_interrupted)
