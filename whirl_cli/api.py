@@ -77,11 +77,13 @@ def run_and_save(study: Study | str | os.PathLike[str], path: str | os.PathLike[
     """:func:`run`, then :func:`save` with the study's ``plot_state``: the same files, but
     the plots drawn while the cross-checks run (:func:`whirl_cli.pipeline.run_and_draw`):
     what ``whirl run`` does."""
+    from .output.guard import ready
     from .output.study_files import drawn_plots, publish_study
     from .pipeline import run_and_draw
 
     study = study if isinstance(study, Study) else load_study(study)
     path, kinds = Path(path), tuple(plots)
+    ready(path, overwrite, study.path)  # an output whirl may not write: refused before work
     draw = partial(drawn_plots, kinds=kinds, stem=path.stem, state=study.plot_state,
                    jobs=jobs)
     with _workroot(study, keep_runs) as workroot:

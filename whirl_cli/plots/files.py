@@ -156,8 +156,9 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
     limits and Hz. A kind without data draws nothing (:func:`missing_data` says why).
     Names are made filesystem-safe; repeats get ``_2``, ``_3``, ... (:func:`plot_names`).
     Each file is rendered in memory and published complete or not at all (an existing file
-    of the same name is replaced). ``whirl run`` and ``whirl sweep`` publish a study's plots
-    together with its HDF5 file instead (:mod:`whirl_cli.output.study_files`).
+    of the same name is replaced if it is a PNG image, and nothing is written if one is not:
+    :func:`whirl_cli.output.guard.check`). ``whirl run`` and ``whirl sweep`` publish a
+    study's plots together with its HDF5 file instead (:mod:`whirl_cli.output.study_files`).
     """
     out_dir = Path(out_dir)
     rendered = render_study_plots(result, kinds, stem, state, dpi, view)
@@ -166,8 +167,11 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
     except OSError as exc:
         raise OutputError(f"cannot create plot directory {out_dir}: {exc}") from exc
     from ..output.atomic import publish
+    from ..output.guard import IMAGE, check
 
-    return sorted(publish(data, out_dir / name, overwrite=True, what="the plot")
+    for name, _ in rendered:  # a PNG is replaced, never a link, directory, device, FIFO
+        check(out_dir / name, IMAGE, overwrite=True)
+    return sorted(publish(data, out_dir / name, overwrite=True, what="the plot", own=IMAGE)
                   for name, data in rendered)
 
 
