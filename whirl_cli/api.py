@@ -95,21 +95,25 @@ def run_and_save(study: Study | str | os.PathLike[str], path: str | os.PathLike[
 
 @contextmanager
 def _workroot(study: Study, keep_runs: str | os.PathLike[str] | None) -> Iterator[Path]:
-    """AUTO's working directory for ``study``: a new temporary one, removed afterwards, or
-    one kept under ``keep_runs``."""
+    """AUTO's working directory for ``study``: a new temporary one, removed afterwards (also
+    when an interrupt held while it is made is raised), or one kept under ``keep_runs``.
+    Nothing is made for an unknown AUTO engine."""
+    from .auto.toolchain import engine_name
     from .interrupts import held_signals
 
-    with held_signals():  # the work directory is made and removed whole
-        if keep_runs:
-            Path(keep_runs).mkdir(parents=True, exist_ok=True)
-            workroot = Path(tempfile.mkdtemp(prefix=f"{study.name}-", dir=keep_runs))
-        else:
-            workroot = Path(tempfile.mkdtemp(prefix="whirl-"))
+    engine_name()  # WHIRL_AUTO_ENGINE checked first
+    workroot = None
     try:
+        with held_signals():  # the work directory is made and removed whole
+            if keep_runs:
+                Path(keep_runs).mkdir(parents=True, exist_ok=True)
+                workroot = Path(tempfile.mkdtemp(prefix=f"{study.name}-", dir=keep_runs))
+            else:
+                workroot = Path(tempfile.mkdtemp(prefix="whirl-"))
         yield workroot
     finally:
         with held_signals():
-            if not keep_runs:
+            if workroot is not None and not keep_runs:
                 shutil.rmtree(workroot, ignore_errors=True)
 
 

@@ -75,6 +75,13 @@ def test_a_whirl_result_is_still_replaced_but_not_a_plot_that_is_not_a_file(tmp_
     assert stat.S_ISFIFO(os.lstat(plot).st_mode) and output.read_bytes() == kept
 
 
+def test_an_unknown_engine_leaves_no_output_directory(tmp_path):
+    """Before: the output directory was made before the engine was known to be wrong."""
+    done = run(AIRSPEED, "-o", tmp_path / "new" / "r.h5", env={"WHIRL_AUTO_ENGINE": "zzz"})
+    assert done.exit_code == 1 and "WHIRL_AUTO_ENGINE='zzz'" in done.output
+    assert os.listdir(tmp_path) == []
+
+
 def test_a_read_only_output_is_found_before_any_work(tmp_path):
     """Before: a read-only file system was found after every AUTO run."""
     mount = tmp_path / "ro"

@@ -4,6 +4,7 @@ output directory is checked before any work; AUTO's work directory never leaks."
 from __future__ import annotations
 
 import os
+import signal
 import stat
 import subprocess
 import sys
@@ -15,6 +16,7 @@ from pathlib import Path
 import h5py
 import pytest
 
+from whirl_cli import api
 from whirl_cli.errors import OutputError
 from whirl_cli.figures.build import stored_key
 from whirl_cli.output import atomic, guard, store, study_files
@@ -212,6 +214,37 @@ def test_the_output_directory_is_made_only_when_published(tmp_path, monkeypatch)
     assert os.listdir(tmp_path) == []
     study_files.publish_study(small_result(), out, ())
     assert store.read(out).study_name == "mine"
+
+
+# --------------------------------------------------------------------- AUTO's work directory
+def test_an_interrupt_while_the_work_directory_is_made_removes_it(tmp_path, monkeypatch):
+    """Before: the held interrupt was raised before the clean-up block began: the directory
+    stayed (once in 64 Ctrl-C)."""
+    import tempfile
+
+    made, real = [], tempfile.mkdtemp
+
+    def mkdtemp(*args, **kwargs):
+        made.append(real(*args, dir=tmp_path, **{k: v for k, v in kwargs.items()
+                                                 if k != "dir"}))
+        os.kill(os.getpid(), signal.SIGINT)  # arrives while held
+        return made[-1]
+
+    monkeypatch.setattr(tempfile, "mkdtemp", mkdtemp)
+    study = api.load(ROOT / "studies" / "thesis_ch3" / "linear_case2.yaml")
+    with pytest.raises(KeyboardInterrupt), api._workroot(study, None):
+        pytest.fail("the interrupt is raised before the work starts")
+    assert made and os.listdir(tmp_path) == []
+
+
+def test_an_unknown_engine_makes_nothing(tmp_path, monkeypatch):
+    from whirl_cli.errors import ToolchainError
+
+    monkeypatch.setenv("WHIRL_AUTO_ENGINE", "zzz")
+    study = api.load(ROOT / "studies" / "thesis_ch3" / "linear_case2.yaml")
+    with pytest.raises(ToolchainError), api._workroot(study, tmp_path / "runs"):
+        pass
+    assert not (tmp_path / "runs").exists()
 
 
 # --------------------------------------------------------------------- concurrent publishers
