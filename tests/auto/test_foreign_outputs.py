@@ -10,7 +10,7 @@ import pytest
 from click.testing import CliRunner
 
 from whirl_cli.cli import cli
-from whirl_cli.output import store
+from whirl_cli.output import store, study_files
 
 from ..conftest import STUDIES
 from ..unit.test_output_guard import KINDS, fingerprint, make
@@ -105,3 +105,12 @@ def test_a_full_output_is_found_before_any_work(tmp_path):
     finally:
         os.system(f"umount {mount}")
 
+
+def test_plots_keep_the_output_stem(tmp_path):
+    """Before: ``-o "o/résultat 1.h5"`` wrote ``o/r_sultat_1_...png``."""
+    output = tmp_path / "o" / "résultat 1.h5"
+    assert run(AIRSPEED, "-o", output).exit_code == 0
+    assert sorted(os.listdir(output.parent)) == [
+        "résultat 1.h5", "résultat 1_airspeed_bifurcation.png", "résultat 1_linear_V.png"]
+    assert study_files.recorded_plots(output) == ("résultat 1_airspeed_bifurcation.png",
+                                                  "résultat 1_linear_V.png")

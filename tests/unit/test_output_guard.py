@@ -170,6 +170,13 @@ def test_a_figure_key_is_not_read_from_a_fifo(tmp_path):
     assert found == [None]
 
 
+def test_plot_names_keep_the_stem(tmp_path):
+    """Before: ``-o "o/résultat 1.h5"`` wrote ``r_sultat_1_...``."""
+    result = store.read(LEGACY)
+    names = plot_names(result, ("bifurcation", "period"), "résultat 1")
+    assert names and all(name.startswith("résultat 1_") for name in names)
+
+
 # --------------------------------------------------------------------- the output directory
 def test_an_unwritable_or_full_directory_is_found_up_front(tmp_path, monkeypatch):
     path = tmp_path / "new" / "deeper" / "r.h5"

@@ -154,7 +154,8 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
     Titles name the study and the parameters it fixes (:mod:`~whirl_cli.plots.captions`,
     from the study stored with ``result``), slices by the study's labels; ``view`` sets axis
     limits and Hz. A kind without data draws nothing (:func:`missing_data` says why).
-    Names are made filesystem-safe; repeats get ``_2``, ``_3``, ... (:func:`plot_names`).
+    The stem is kept as given; in the rest of a name, characters other than ``A-Za-z0-9._+-``
+    become ``_``; repeats get ``_2``, ``_3``, ... (:func:`plot_names`).
     Each file is rendered in memory and published complete or not at all (an existing file
     of the same name is replaced if it is a PNG image, and nothing is written if one is not:
     :func:`whirl_cli.output.guard.check`). ``whirl run`` and ``whirl sweep`` publish a
@@ -245,7 +246,7 @@ def _named_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: s
     taken: list[Path] = []
     jobs = []
     for name, make in _figure_jobs(result, kinds, stem, state, view):
-        path = _unique(Path(_safe_name(name)), taken)
+        path = _unique(Path(_file_stem(stem) + _safe_name(name.removeprefix(stem))), taken)
         taken.append(path)
         jobs.append((path.name, make))
     return jobs
@@ -410,6 +411,12 @@ def _state_for(continuation: ContinuationResult, state: str | None) -> str | Non
 
 def _safe_name(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9._+-]", "_", name)
+
+
+def _file_stem(stem: str) -> str:
+    """The output's stem as the plots' names begin: kept as the user gave it (letters of any
+    script, spaces), but for what no file name can hold (``/``, NUL), which becomes ``_``."""
+    return re.sub(r"[/\0]", "_", stem)
 
 
 def _unique(path: Path, taken: list[Path]) -> Path:
