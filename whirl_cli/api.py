@@ -82,11 +82,13 @@ def run_and_save(study: Study | str | os.PathLike[str], path: str | os.PathLike[
     """:func:`run`, then :func:`save` with the study's ``plot_state``: the same files, but
     the plots drawn while the cross-checks run (:func:`whirl_cli.pipeline.run_and_draw`):
     what ``whirl run`` does."""
+    from .output.guard import ready
     from .output.study_files import drawn_plots, publish_study
     from .pipeline import run_and_draw
 
     study = study if isinstance(study, Study) else load_study(study)
     path, kinds = Path(path), tuple(plots)
+    ready(path, overwrite, study.path)  # an output whirl may not write: refused before work
     draw = partial(drawn_plots, kinds=kinds, stem=path.stem, state=study.plot_state,
                    jobs=jobs)
     with _workroot(study, keep_runs) as workroot:
@@ -98,21 +100,25 @@ def run_and_save(study: Study | str | os.PathLike[str], path: str | os.PathLike[
 
 @contextmanager
 def _workroot(study: Study, keep_runs: str | os.PathLike[str] | None) -> Iterator[Path]:
-    """AUTO's working directory for ``study``: a new temporary one, removed afterwards, or
-    one kept under ``keep_runs``."""
+    """AUTO's working directory for ``study``: a new temporary one, removed afterwards (also
+    when an interrupt held while it is made is raised), or one kept under ``keep_runs``.
+    Nothing is made for an unknown AUTO engine."""
+    from .auto.toolchain import engine_name
     from .interrupts import held_signals
 
-    with held_signals():  # the work directory is made and removed whole
-        if keep_runs:
-            Path(keep_runs).mkdir(parents=True, exist_ok=True)
-            workroot = Path(tempfile.mkdtemp(prefix=f"{study.name}-", dir=keep_runs))
-        else:
-            workroot = Path(tempfile.mkdtemp(prefix="whirl-"))
+    engine_name()  # WHIRL_AUTO_ENGINE checked first
+    workroot = None
     try:
+        with held_signals():  # the work directory is made and removed whole
+            if keep_runs:
+                Path(keep_runs).mkdir(parents=True, exist_ok=True)
+                workroot = Path(tempfile.mkdtemp(prefix=f"{study.name}-", dir=keep_runs))
+            else:
+                workroot = Path(tempfile.mkdtemp(prefix="whirl-"))
         yield workroot
     finally:
         with held_signals():
-            if not keep_runs:
+            if workroot is not None and not keep_runs:
                 shutil.rmtree(workroot, ignore_errors=True)
 
 

@@ -87,13 +87,9 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     study = load_study(study_file)  # first: a bad study is refused fast, before any import
 
     output = output or Path(f"{study.name}.h5")
-    if output.exists() and not overwrite:
-        raise OutputError(f"{output}: output exists; pass --overwrite to replace it")
-    try:
-        output.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as error:
-        raise OutputError(f"{output}: cannot create the output directory "
-                          f"({error.strerror or error})") from None
+    from .output.guard import ready
+
+    ready(output, overwrite, study.path)  # before any work; the directory is made at the end
 
     def report(outcome) -> None:
         # an MX is only said to be a problem at the end: at a period blow-up it is expected

@@ -50,7 +50,8 @@ def test_without_overwrite_an_existing_plot_is_not_replaced(tmp_path):
     plot.write_bytes(b"someone's figure")
     refused = run(AIRSPEED, "-o", tmp_path / "r.h5")
     assert refused.exit_code == 1
-    assert f"{plot}: output exists; pass --overwrite" in refused.output
+    assert f"{plot}: a file that is not PNG, not a PNG image; whirl never replaces it" \
+        in refused.output  # not even with --overwrite
     assert plot.read_bytes() == b"someone's figure"
     assert names(tmp_path) == ["r_linear_V.png"]  # nothing else was written
 
@@ -93,14 +94,19 @@ def test_a_file_appearing_meanwhile_leaves_no_plots_behind(airspeed, tmp_path, m
     _, result = airspeed
     real = store.write
 
+    other = tmp_path / "other.h5"
+    real(result, other)
+    another_run = other.read_bytes()
+    other.unlink()
+
     def appear_first(result, path, overwrite=False):
-        path.write_bytes(b"another run")
+        path.write_bytes(another_run)
         return real(result, path, overwrite)
 
     monkeypatch.setattr(store, "write", appear_first)
     with pytest.raises(OutputError, match="output exists"):
         study_files.publish_study(result, tmp_path / "r.h5", ("bifurcation", "linear"))
-    assert names(tmp_path) == ["r.h5"] and (tmp_path / "r.h5").read_bytes() == b"another run"
+    assert names(tmp_path) == ["r.h5"] and (tmp_path / "r.h5").read_bytes() == another_run
 
 
 @pytest.mark.parametrize("where", ["render_tasks", "_rendered"])  # planning, one figure

@@ -26,7 +26,7 @@ from click.testing import CliRunner
 from whirl_cli import pipeline
 from whirl_cli.cli import cli
 from whirl_cli.errors import OutputError
-from whirl_cli.output import atomic, store
+from whirl_cli.output import atomic, guard, store
 from whirl_cli.results import StudyResult
 
 from .helpers import STUDIES, WHIRL, auto_processes, environment
@@ -114,9 +114,15 @@ def test_sigkill_at_random_moments_never_leaves_a_partial_file(tmp_path):
 
 
 # ------------------------------------------------------------------------------ the writer
-def small_result() -> StudyResult:
-    return StudyResult(study_name="s", model="m", continuations=(), linear_sweeps=(), runs=(),
-                       attributes={"study_yaml": "name: s\n", "note": "x" * 100_000})
+def small_result(name: str = "s") -> StudyResult:
+    return StudyResult(study_name=name, model="m", continuations=(), linear_sweeps=(), runs=(),
+                       attributes={"study_yaml": f"name: {name}\n", "note": "x" * 100_000})
+
+
+def whirl_file(path: Path, name: str = "old") -> bytes:
+    """A whirl result file at ``path`` (whirl replaces no other file); its bytes."""
+    store.write(small_result(name), path)
+    return path.read_bytes()
 
 
 class Boom(BaseException):
@@ -137,9 +143,8 @@ def test_a_write_that_fails_at_any_step_leaves_the_old_file_or_nothing(
     if not tmpfile:
         monkeypatch.delattr(os, "O_TMPFILE")
     path = tmp_path / "r.h5"
-    old = b"previous content"
     if overwrite:
-        path.write_bytes(old)
+        old = whirl_file(path)
     if step == "write":
         def half(fd, data):
             os.write(fd, data[:len(data) // 2])
@@ -201,7 +206,7 @@ def test_the_writer_never_replaces_a_file_without_overwrite(tmp_path, monkeypatc
         store.write(small_result(), path)
     # the file appears between the check and the link (another process): still refused
     with pytest.raises(OutputError, match="output exists; pass --overwrite"):
-        atomic._publish(b"other", path, overwrite=False)
+        atomic._publish(b"other", path, False, guard.RESULT)
     assert path.read_bytes() == before
     store.write(small_result(), path, overwrite=True)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.h5"]
@@ -238,11 +243,11 @@ def test_an_unwritable_directory_is_an_output_error(tmp_path):
 def test_whirl_run_never_overwrites_without_overwrite(tmp_path, monkeypatch):
     study = STUDIES / "linear_datum_airspeed.yaml"
     output = tmp_path / "r.h5"
-    output.write_bytes(b"not even HDF5")
+    before = whirl_file(output)
     runner = CliRunner()
     refused = runner.invoke(cli, ["run", str(study), "-o", str(output)])
     assert refused.exit_code == 1 and "output exists; pass --overwrite" in refused.output
-    assert output.read_bytes() == b"not even HDF5"
+    assert output.read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.h5"]
 
     # the file appears while the study runs (e.g. a second `whirl run`): refused at the end
@@ -251,13 +256,13 @@ def test_whirl_run_never_overwrites_without_overwrite(tmp_path, monkeypatch):
 
     def racing(*args, **kwargs):
         done = real(*args, **kwargs)
-        output.write_bytes(b"written meanwhile")
+        output.write_bytes(before)
         return done
 
     monkeypatch.setattr(pipeline, "run_and_draw", racing)
     raced = runner.invoke(cli, ["run", str(study), "-o", str(output), "--no-plots"])
     assert raced.exit_code == 1 and "output exists; pass --overwrite" in raced.output
-    assert output.read_bytes() == b"written meanwhile"
+    assert output.read_bytes() == before
     monkeypatch.setattr(pipeline, "run_and_draw", real)
 
     replaced = runner.invoke(cli, ["run", str(study), "-o", str(output), "--overwrite",

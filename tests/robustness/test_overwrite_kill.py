@@ -44,20 +44,22 @@ CHILD = textwrap.dedent("""
 
 
 def test_sigkill_before_any_step_of_an_overwrite_leaves_old_new_or_nothing(tmp_path):
+    old = tmp_path / "old.h5"  # whirl replaces only a whirl result file
+    store.write(small_result("old"), old)
     outcomes, k = [], 0
     while True:
         k += 1
         directory = tmp_path / f"kill{k}"
         directory.mkdir()
         path = directory / "r.h5"
-        path.write_bytes(b"the old, complete file")
+        path.write_bytes(old.read_bytes())
         done = subprocess.run([sys.executable, "-c", CHILD, str(path), str(k)],
                               capture_output=True, text=True, timeout=60)
         names = sorted(p.name for p in directory.iterdir())
         assert names in ([], ["r.h5"]), f"killed before call {k}: {names}"
         if not names:
             outcomes.append("none")
-        elif path.read_bytes() == b"the old, complete file":
+        elif path.read_bytes() == old.read_bytes():
             outcomes.append("old")
         else:
             assert store.read(path).study_name == "new"  # complete
@@ -75,21 +77,22 @@ def test_sigkill_before_any_step_of_an_overwrite_leaves_old_new_or_nothing(tmp_p
         list(zip(calls, outcomes, strict=False))
 
 
-def small_result() -> StudyResult:
-    return StudyResult(study_name="mine", model="m", continuations=(), linear_sweeps=(),
-                       runs=(), attributes={"study_yaml": "name: mine\n"})
+def small_result(name: str = "mine") -> StudyResult:
+    return StudyResult(study_name=name, model="m", continuations=(), linear_sweeps=(),
+                       runs=(), attributes={"study_yaml": f"name: {name}\n"})
 
 
 def test_an_overwrite_replaces_a_file_another_writer_links_in_between(tmp_path, monkeypatch):
     path = tmp_path / "r.h5"
-    path.write_bytes(b"old")
+    store.write(small_result("other"), path)  # whirl replaces only a whirl result file
+    other = path.read_bytes()
     real_unlink, removed = os.unlink, []
 
     def unlink(name, *args, **kwargs):  # another writer links its file right after ours went
         real_unlink(name, *args, **kwargs)
         removed.append(name)
         if len(removed) < 3:
-            path.write_bytes(b"another writer's")
+            path.write_bytes(other)
     monkeypatch.setattr(atomic.os, "unlink", unlink)
     store.write(small_result(), path, overwrite=True)
     assert removed == ["r.h5"] * 3
@@ -99,9 +102,9 @@ def test_an_overwrite_replaces_a_file_another_writer_links_in_between(tmp_path, 
     # a writer that keeps losing the race gives up with a message, leaving the other's file
     def always(name, *args, **kwargs):
         real_unlink(name, *args, **kwargs)
-        path.write_bytes(b"another writer's")
+        path.write_bytes(other)
     monkeypatch.setattr(atomic.os, "unlink", always)
     with pytest.raises(OutputError, match="r.h5: not replaced: other processes keep writing"):
         store.write(small_result(), path, overwrite=True)
-    assert path.read_bytes() == b"another writer's"
+    assert path.read_bytes() == other
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.h5"]

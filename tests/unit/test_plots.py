@@ -413,7 +413,7 @@ def test_save_study_plots_writes_pngs_only(tmp_path, continuation):
 
 def test_save_study_plots_selected_kind_and_overwrite(tmp_path, continuation):
     result = StudyResult("study", "classical", (continuation,), (make_sweep(),), ())
-    (tmp_path / "run_linear_K1.png").write_bytes(b"old")
+    (tmp_path / "run_linear_K1.png").write_bytes(PNG_MAGIC + b"old")  # an older plot
     paths = save_study_plots(result, ("linear",), tmp_path, "run")
     assert paths == [tmp_path / "run_linear_K1.png"]
     assert paths[0].read_bytes()[:8] == PNG_MAGIC

@@ -106,6 +106,7 @@ def make_figures(paths: Sequence[str | os.PathLike[str]], out_dir: Path, results
     long ones still run; those left after the sweep are drawn ``jobs`` at a time (what a
     sheet shows does not depend on when or where it is drawn)."""
     from ..output.atomic import publish
+    from ..output.guard import PAGE
     from ..sweep.run import run_sweep
 
     sheets, refused = load_sheets(paths)
@@ -131,7 +132,8 @@ def make_figures(paths: Sequence[str | os.PathLike[str]], out_dir: Path, results
     outcomes += [FigureOutcome(sheet, None, sheet.problem) for sheet in refused]
     outcomes.sort(key=lambda o: figure_order(o.sheet.figure))
     page = index_html([_entry(o, out_dir) for o in outcomes], "whirl figures")
-    publish(page.encode("utf-8"), out_dir / "index.html", overwrite=True, what="the index")
+    publish(page.encode("utf-8"), out_dir / "index.html", overwrite=True, what="the index",
+            own=PAGE)
     return outcomes
 
 
@@ -220,12 +222,14 @@ class _Artist:
 
     def _published(self, sheet: Sheet, image: bytes | None, problem: str) -> FigureOutcome:
         from ..output.atomic import publish
+        from ..output.guard import IMAGE
 
         if image is None:
             return FigureOutcome(sheet, None, problem)
         _make_folder(self.out_dir)
         target = self.out_dir / f"{sheet.stem}.png"
-        return FigureOutcome(sheet, publish(image, target, overwrite=True, what="the figure"))
+        return FigureOutcome(sheet, publish(image, target, overwrite=True, what="the figure",
+                                            own=IMAGE))
 
 
 def _render(figure, dpi: int, metadata: dict[str, str]) -> bytes:
@@ -256,7 +260,10 @@ def figure_key(sheet: Sheet, outputs: Sequence[Path], dpi: int) -> str:
 
 
 def stored_key(path: Path) -> str | None:
-    """The :data:`KEY` text chunk of the PNG at ``path`` (None: no file, not a PNG, no key)."""
+    """The :data:`KEY` text chunk of the PNG at ``path`` (None: no regular file, not a PNG,
+    no key)."""
+    if not os.path.isfile(path):  # a FIFO would block the read
+        return None
     try:
         data = path.read_bytes()
     except OSError:

@@ -108,6 +108,7 @@ from ..results import (
     UnsafeInterval,
 )
 from .atomic import publish
+from .guard import RESULT, check
 from .mapping import (
     Damaged,
     Field,
@@ -377,18 +378,18 @@ def write(result: StudyResult, path: Path, overwrite: bool = False) -> Path:
     The file is built in memory and appears at ``path`` complete or not at all: it is written to
     an unnamed file in the output directory (Linux ``O_TMPFILE``) and linked into place, so even
     SIGKILL leaves no partial file and no temporary file behind. Without ``overwrite`` the link
-    fails if ``path`` exists (also if it appeared meanwhile); with it, the old file is removed
+    fails if ``path`` exists (also if it appeared meanwhile); with it, the old file, if a whirl
+    result file (never anything else: :mod:`whirl_cli.output.guard`), is removed
     and the new one linked in its place (a SIGKILL in between leaves neither, see
     :func:`whirl_cli.output.atomic._link_unnamed`). Where ``O_TMPFILE`` is unavailable a
     hidden named temporary is written and renamed into place (a SIGKILL before the rename
     leaves it).
     """
     path = Path(path)
-    if path.exists() and not overwrite:
-        raise OutputError(f"{path}: output exists; pass --overwrite to replace it")
+    check(path, RESULT, overwrite)
     if not path.parent.is_dir():
         raise OutputError(f"{path}: the output directory {path.parent} does not exist")
-    return publish(_image(result), path, overwrite, what="the output")
+    return publish(_image(result), path, overwrite, what="the output", own=RESULT)
 
 
 def _image(result: StudyResult) -> bytes:

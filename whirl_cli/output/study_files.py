@@ -7,7 +7,10 @@
    bug), the HDF5 file is still published, alone, and the error reported (the result is not
    lost, and a sweep draws the missing plots again next time);
 2. without ``overwrite`` nothing is written if the HDF5 file or any of the plot files exists
-   (one message naming the first such file);
+   (one message naming the first such file); with it, nothing is written unless each one
+   that exists is whirl's kind of file (:mod:`whirl_cli.output.guard`: a whirl result file,
+   a PNG image; never a link, a directory, a device, a FIFO); both checked, and the files
+   published, with the output directory locked against other whirl processes;
 3. the files are published with SIGINT and SIGTERM held back (an interrupt arriving then is
    delivered once the set is complete): the plots first, the HDF5 file last. Its root
    attribute ``plots`` lists the plot files published with it. Each file appears complete or
@@ -19,11 +22,12 @@
    some (:func:`missing_plots`);
 4. with ``overwrite``, the plots the old HDF5 file recorded that the new result does not
    draw are removed once the new file is in place (no stale figure of an old result stays
-   beside the new one).
+   beside the new one; the lock makes the old file the one the last publisher replaced).
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -32,6 +36,7 @@ from ..errors import OutputError
 from ..interrupts import forked_map, held_signals
 from ..results import StudyResult
 from . import atomic, store
+from .guard import IMAGE, RESULT, check, refusal
 
 #: Root attribute of the HDF5 file: names of the plot files published with it.
 PLOTS_ATTRIBUTE = "plots"
@@ -94,52 +99,96 @@ def publish_study(result: StudyResult, output: Path, kinds: Sequence[str],
     """Write ``result`` to ``output`` and its plots of ``kinds`` next to it (``<output
     stem>_*.png``; bifurcation diagrams of ``state``, None: the first dof; drawn in ``jobs``
     processes, unless ``drawn`` holds them already: :func:`drawn_plots` of the same
-    ``kinds``), as one unit; see the module doc."""
+    ``kinds``), as one unit; see the module doc. The output directory is made here (and
+    removed again if nothing could be published into it)."""
     output = Path(output)
     if drawn is None:
         drawn = drawn_plots(result, kinds, output.stem, state, jobs)
-    plots, plot_error = drawn.plots, drawn.error
+    made: list[Path] = []
+    try:
+        with held_signals():
+            made = _made_directories(output)
+        with atomic.locked(output.parent):  # one publisher at a time: its file, its plots
+            return Published(_publish_unit(result, output, drawn.plots, overwrite),
+                             drawn.error)
+    except BaseException:
+        for directory in reversed(made):  # only if still empty
+            try:
+                directory.rmdir()
+            except OSError:
+                break
+        raise
+
+
+def _made_directories(output: Path) -> list[Path]:
+    """Make ``output``'s directory and its missing parents; the ones made, outermost first."""
+    missing, directory = [], output.parent
+    while not os.path.lexists(directory) and directory != directory.parent:
+        missing.append(directory)
+        directory = directory.parent
+    try:
+        output.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise OutputError(f"{output}: cannot create the output directory "
+                          f"({error.strerror or error})") from None
+    return missing[::-1]
+
+
+def _publish_unit(result: StudyResult, output: Path, plots: tuple[tuple[str, bytes], ...],
+                  overwrite: bool) -> tuple[Path, ...]:
+    """Steps 2-4 of the module doc, with the output directory locked: nothing is written
+    unless every file may be (:func:`whirl_cli.output.guard.check`), and the stale plots are
+    those of the result file found here."""
     targets = [output.parent / name for name, _ in plots]
-    if not overwrite:
-        for path in [output, *targets]:
-            if path.exists():
-                raise OutputError(f"{path}: output exists; pass --overwrite to replace it")
+    check(output, RESULT, overwrite)
+    for path in targets:
+        check(path, IMAGE, overwrite)
     names = [name for name, _ in plots]
     stale = [output.parent / name for name in recorded_plots(output)
-             if name not in names] if overwrite else []
+             if name not in names and _plain(name)] if overwrite else []
     result = replace(result, attributes={**result.attributes, PLOTS_ATTRIBUTE: names})
     written: list[Path] = []
     with held_signals():
         try:
             for (_, data), path in zip(plots, targets, strict=True):
-                written.append(atomic.publish(data, path, overwrite, what="the plot"))
+                written.append(atomic.publish(data, path, overwrite, what="the plot",
+                                              own=IMAGE))
             written.append(store.write(result, output, overwrite=overwrite))
         except BaseException:  # e.g. a full disk: none of the new result's files stays
             for path in written:
                 path.unlink(missing_ok=True)
             raise
         for path in stale:
-            path.unlink(missing_ok=True)
-    return Published(tuple(written), plot_error)
+            if not refusal(path, IMAGE):  # a plot whirl wrote, nothing put in its place
+                path.unlink(missing_ok=True)
+    return tuple(written)
+
+
+def _plain(name: str) -> bool:
+    """A file name alone (no directory part, not ``.`` or ``..``): what a plot's name is."""
+    return name not in ("", ".", "..") and "/" not in name and "\0" not in name
 
 
 def publish_plots(output: Path, kinds: Sequence[str], state: str | None = None
                   ) -> tuple[Path, ...]:
     """Draw the plots of ``kinds`` of the existing result ``output`` next to it (replacing
-    files of the same names; ``state`` as for :func:`publish_study`): how a sweep completes an
-    up-to-date study's plots."""
+    files of the same names if they are PNG images; ``state`` as for :func:`publish_study`):
+    how a sweep completes an up-to-date study's plots."""
     from ..plots.files import render_study_plots
 
     rendered = render_study_plots(store.read(output), tuple(kinds), Path(output).stem, state)
+    targets = [Path(output).parent / name for name, _ in rendered]
+    for path in targets:
+        check(path, IMAGE, overwrite=True)
     with held_signals():
-        return tuple(atomic.publish(data, Path(output).parent / name, True, what="the plot")
-                     for name, data in rendered)
+        return tuple(atomic.publish(data, path, True, what="the plot", own=IMAGE)
+                     for (_, data), path in zip(rendered, targets, strict=True))
 
 
 def recorded_plots(output: Path) -> tuple[str, ...]:
     """The plot file names an existing result file records (empty if it records none, is
     absent or unreadable)."""
-    if not Path(output).exists():
+    if not os.path.isfile(output):  # absent, or nothing to open (a FIFO would block)
         return ()
     try:
         import h5py

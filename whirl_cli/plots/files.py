@@ -154,10 +154,12 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
     Titles name the study and the parameters it fixes (:mod:`~whirl_cli.plots.captions`,
     from the study stored with ``result``), slices by the study's labels; ``view`` sets axis
     limits and Hz. A kind without data draws nothing (:func:`missing_data` says why).
-    Names are made filesystem-safe; repeats get ``_2``, ``_3``, ... (:func:`plot_names`).
+    The stem is kept as given; in the rest of a name, characters other than ``A-Za-z0-9._+-``
+    become ``_``; repeats get ``_2``, ``_3``, ... (:func:`plot_names`).
     Each file is rendered in memory and published complete or not at all (an existing file
-    of the same name is replaced). ``whirl run`` and ``whirl sweep`` publish a study's plots
-    together with its HDF5 file instead (:mod:`whirl_cli.output.study_files`).
+    of the same name is replaced if it is a PNG image, and nothing is written if one is not:
+    :func:`whirl_cli.output.guard.check`). ``whirl run`` and ``whirl sweep`` publish a
+    study's plots together with its HDF5 file instead (:mod:`whirl_cli.output.study_files`).
     """
     out_dir = Path(out_dir)
     rendered = render_study_plots(result, kinds, stem, state, dpi, view)
@@ -166,8 +168,11 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
     except OSError as exc:
         raise OutputError(f"cannot create plot directory {out_dir}: {exc}") from exc
     from ..output.atomic import publish
+    from ..output.guard import IMAGE, check
 
-    return sorted(publish(data, out_dir / name, overwrite=True, what="the plot")
+    for name, _ in rendered:  # a PNG is replaced, never a link, directory, device, FIFO
+        check(out_dir / name, IMAGE, overwrite=True)
+    return sorted(publish(data, out_dir / name, overwrite=True, what="the plot", own=IMAGE)
                   for name, data in rendered)
 
 
@@ -241,7 +246,7 @@ def _named_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: s
     taken: list[Path] = []
     jobs = []
     for name, make in _figure_jobs(result, kinds, stem, state, view):
-        path = _unique(Path(_safe_name(name)), taken)
+        path = _unique(Path(_file_stem(stem) + _safe_name(name.removeprefix(stem))), taken)
         taken.append(path)
         jobs.append((path.name, make))
     return jobs
@@ -406,6 +411,12 @@ def _state_for(continuation: ContinuationResult, state: str | None) -> str | Non
 
 def _safe_name(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9._+-]", "_", name)
+
+
+def _file_stem(stem: str) -> str:
+    """The output's stem as the plots' names begin: kept as the user gave it (letters of any
+    script, spaces), but for what no file name can hold (``/``, NUL), which becomes ``_``."""
+    return re.sub(r"[/\0]", "_", stem)
 
 
 def _unique(path: Path, taken: list[Path]) -> Path:
