@@ -123,6 +123,8 @@ def _decide(study: Study, output: Path, force: bool) -> tuple[str, str, tuple[st
         return RUN, "forced", ()
     if not output.exists():
         return RUN, "new", ()
+    if output.is_symlink() or not output.is_file():  # never opened: a FIFO would block
+        return RUN, "not a result file", ()
     try:
         stored = stored_state(output)
     except (OSError, KeyError, ValueError) as error:

@@ -8,9 +8,10 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from ..auto.runner import interruptible
+from ..output.guard import RESULT, check, writable
 from .execute import Outcome, execute
 from .executors import dask_pool, local_pool, prepare_workers
-from .plan import RUN, plan
+from .plan import RUN, SweepItem, plan
 from .report import Reporter, Tally
 
 
@@ -27,6 +28,7 @@ def run_sweep(paths: Sequence[str | os.PathLike[str]], out_dir: Path, jobs: int 
     """
     items = plan(paths, out_dir, force, plots)
     pending = sum(item.action == RUN for item in items)
+    _refuse_outputs([item for item in items if item.action == RUN])
     if pending:
         Path(out_dir).mkdir(parents=True, exist_ok=True)
     reporter = Reporter(len(items), console)
@@ -58,4 +60,14 @@ def run_sweep(paths: Sequence[str | os.PathLike[str]], out_dir: Path, jobs: int 
         else:
             on_summary(summary)
     return reporter.tally
+
+
+def _refuse_outputs(runs: Sequence[SweepItem]) -> None:
+    """Before any work: OutputError if a result file a sweep would write is not whirl's to
+    replace (a link, directory, device, another program's file) or its folder cannot take
+    files (read-only, full)."""
+    for item in runs:
+        check(item.output, RESULT, overwrite=True)
+    if runs:
+        writable(runs[0].output)
 
