@@ -313,7 +313,7 @@ class _Checker:
     # -------------------------------------------------------------- references
     def _references(self) -> None:
         model = self.model
-        parameters = {n for p in model.parameters for n in (p.name,)}
+        parameters = {p.name for p in model.parameters}
         states = {d.name for d in model.dofs} | {_rate(d) for d in model.dofs}
         known = parameters | states
         state_free = set(parameters)
@@ -342,10 +342,8 @@ class _Checker:
         missing = [d for d in dofs if d not in model.forces]
         if missing:
             self._add(("forces",), f"no force for dof {', '.join(missing)} (write 0 if none)")
-        for key in ("hub",):
-            path = getattr(model, key)
-            if path is not None:
-                self._path((key,), path, states)
+        if model.hub is not None:
+            self._path(("hub",), model.hub, states)
         for i, group in enumerate(model.mode_groups):
             unknown = [d for d in group.dofs if d not in dofs]
             if unknown:
@@ -370,7 +368,7 @@ class _Checker:
             return
         for i, row in enumerate(rows):
             for j, expression in enumerate(row):
-                loc = ("mass", i, j) if isinstance(self.model.mass[0], tuple) else ("mass", i)
+                loc = _mass_loc(self.model, i, j)
                 unknown = sorted(expression.names - known)
                 if unknown:
                     self._add(loc, _unknown(unknown))
@@ -411,7 +409,7 @@ class _Checker:
         for i, row in enumerate(rows):
             mass.append([])
             for j, expression in enumerate(row):
-                loc = ("mass", i, j) if isinstance(model.mass[0], tuple) else ("mass", i)
+                loc = _mass_loc(model, i, j)
                 try:
                     mass[i].append(evaluate(expression, point))
                 except ArithmeticError as error:
@@ -496,6 +494,11 @@ def _mass_rows(model: ModelFile) -> list[list[Expression]] | None:
         return None
     zero = parse(0)
     return [[e if i == j else zero for j in range(n)] for i, e in enumerate(model.mass)]
+
+
+def _mass_loc(model: ModelFile, i: int, j: int) -> tuple:
+    """Where entry (i, j) of the mass matrix stands in the file (a diagonal list: item i)."""
+    return ("mass", i, j) if isinstance(model.mass[0], tuple) else ("mass", i)
 
 
 def _is_linear_combination(expression: Expression, states: list[str]) -> bool:
