@@ -46,7 +46,19 @@ def _show_version(ctx: click.Context, _param: click.Parameter, value: bool) -> N
         ctx.exit()
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+class _Whirl(click.Group):
+    """whirl's commands: one interrupted by SIGINT or SIGTERM says "interrupted" alone (click
+    would print a blank line before its Abort) and exits with 128 + the signal's number."""
+
+    def invoke(self, ctx: click.Context):
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt as interrupt:
+            click.echo("interrupted", err=True)
+            raise click.exceptions.Exit(128 + getattr(interrupt, "signum", 2)) from None
+
+
+@click.group(cls=_Whirl, context_settings={"help_option_names": ["-h", "--help"]})
 @click.option("--version", is_flag=True, expose_value=False, is_eager=True,
               callback=_show_version, help="Show the version and exit.")
 def cli() -> None:
@@ -524,7 +536,7 @@ def main() -> None:
 
 def _main() -> None:
     try:
-        cli.main(standalone_mode=False)
+        status = cli.main(standalone_mode=False)  # an exit status only where one is raised
     except click.exceptions.Abort as error:  # click's wrapper of a KeyboardInterrupt
         click.echo("interrupted", err=True)
         sys.exit(128 + getattr(error.__cause__, "signum", 2))  # SIGINT 130, SIGTERM 143
@@ -540,3 +552,5 @@ def _main() -> None:
         click.echo(f"whirl: internal error: {type(error).__name__}: {error} "
                    "(set WHIRL_DEBUG=1 for the traceback and please report it)", err=True)
         sys.exit(1)
+    if isinstance(status, int) and status:  # click's Exit: an interrupted command (_Whirl)
+        sys.exit(status)

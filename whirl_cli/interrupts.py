@@ -129,11 +129,26 @@ def end_processes(processes) -> None:
         process.join(5)
 
 
-#: Signals that arrived while :func:`catching` is in force, the first one being raised.
-_pending: list[int] = []
-#: Signals whose :class:`Interrupted` a ``__del__`` or weakref callback dropped: raised again
-#: by the next signal, at the next :func:`check`, or when the :func:`catching` block ends.
-_swallowed: list[int] = []
+class _Block:
+    """The state of one :func:`catching` block: the signals that arrived while it was in
+    force (the first one being raised), and those whose :class:`Interrupted` a ``__del__`` or
+    weakref callback dropped (raised again by the next signal, at the next :func:`check`, or
+    when the block ends)."""
+
+    def __init__(self) -> None:
+        self.pending: list[int] = []
+        self.swallowed: list[int] = []
+
+    def take(self) -> int:
+        """The first signal still to be raised (after which nothing is)."""
+        signum = (self.swallowed or self.pending)[0]
+        self.pending.clear()
+        self.swallowed.clear()
+        return signum
+
+
+#: The :func:`catching` blocks in force, innermost last (each with its own signals).
+_blocks: list[_Block] = []
 
 
 @contextmanager
@@ -146,55 +161,54 @@ def catching(on_first: Callable[[], None] | None = None) -> Iterator[None]:
     can land in one, e.g. while matplotlib draws or a finished process is collected), printing
     "Exception ignored". So such a signal is remembered and raised again at the first chance:
     the next signal, the next :func:`check` (:func:`thread_map` and :func:`forked_map` check
-    after every item, so a study stops within one item), or when the block would end
-    normally: an interrupt is never lost."""
+    after every item, so a study stops within one item), when a block nested inside begins,
+    or when the block would end normally: an interrupt is never lost. A nested block keeps
+    its own signals: it raises only those that arrived while it was the innermost."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    _pending.clear()
-    _swallowed.clear()
+    check()  # an outer block's swallowed interrupt first
+    block = _Block()
 
     def handler(signum: int, frame: object) -> None:
-        first = not _pending
-        _pending.append(signum)
+        first = not block.pending
+        block.pending.append(signum)
         if first and on_first is not None:
             on_first()
-        if first or _swallowed:
-            _swallowed.clear()
+        if first or block.swallowed:
+            block.swallowed.clear()
             raise Interrupted(signum)
 
     def unraisable(hook: sys.UnraisableHookArgs) -> None:  # the "Exception ignored" print
         if isinstance(hook.exc_value, Interrupted):  # ours: raised again (see above)
-            _swallowed.append(hook.exc_value.signum)
+            _blocks[-1].swallowed.append(hook.exc_value.signum)
         else:
             default(hook)
 
     previous = {number: signal.signal(number, handler) for number in HELD}
     default, sys.unraisablehook = sys.unraisablehook, unraisable
+    _blocks.append(block)
     try:
         yield
     except Interrupted:
-        _pending.clear()  # delivered
-        _swallowed.clear()
+        block.pending.clear()  # delivered
+        block.swallowed.clear()
         raise
     finally:
+        _blocks.remove(block)
         sys.unraisablehook = default
         for number, old in previous.items():
             signal.signal(number, old)
-    if _pending:  # swallowed on its way (see above): raise it now
-        signum = _pending[0]
-        _pending.clear()
-        _swallowed.clear()
-        raise Interrupted(signum)
+    if block.pending:  # swallowed on its way (see above): raise it now
+        raise Interrupted(block.take())
 
 
 def check() -> None:
     """Raise now, in the main thread, an interrupt that a ``__del__`` or weakref callback
-    swallowed inside :func:`catching` (a no-op otherwise)."""
-    if _swallowed and threading.current_thread() is threading.main_thread():
-        signum = _swallowed[0]
-        _swallowed.clear()
-        raise Interrupted(signum)
+    swallowed inside the innermost :func:`catching` block (a no-op otherwise)."""
+    if _blocks and _blocks[-1].swallowed and \
+            threading.current_thread() is threading.main_thread():
+        raise Interrupted(_blocks[-1].take())
 
 
 @contextmanager

@@ -312,7 +312,8 @@ def test_a_signal_stops_cleanly_and_kills_auto(tmp_path, signum, status):
             process.wait()
     assert process.returncode == status, (stdout, stderr)
     assert stopped < 10, f"took {stopped:.1f} s to stop"
-    assert stderr.rstrip().endswith("interrupted") and "Traceback" not in stdout + stderr
+    assert stderr.endswith("\ninterrupted\n") and "Traceback" not in stdout + stderr
+    assert "\n\n" not in stderr, stderr  # no blank line before "interrupted"
     assert wait_for_no_auto(cache, 2.0) == []
     assert not (tmp_path / "r.h5").exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["slow.yaml", "tmp"]

@@ -302,3 +302,61 @@ def test_stopping_a_process_that_has_ended_meanwhile_is_no_error(monkeypatch):
         assert pool.cancelled.is_set()
     finally:
         pool.shutdown()
+
+
+def test_a_signal_an_outer_block_swallowed_is_raised_when_an_inner_block_begins():
+    """Nested blocks (``whirl run`` around AUTO's): an inner block must not drop the outer
+    one's swallowed interrupt; it is raised at once, before the inner block runs."""
+    reached = []
+    with pytest.raises(Interrupted) as caught:
+        with catching():
+            interrupt_inside_a_weakref_callback()
+            reached.append("the outer block went on")
+            with catching():
+                reached.append("the inner block ran")
+            reached.append("after the inner block")
+    assert reached == ["the outer block went on"] and caught.value.signum == signal.SIGINT
+
+
+def test_an_inner_block_neither_raises_nor_drops_an_outer_blocks_signal():
+    """An interrupt the outer block delivered, which its code caught to go on (a clean-up),
+    is the outer block's: an inner block does not raise it, nor forget it (the outer block
+    raises it when it ends); the inner block's own first signal calls its ``on_first``."""
+    calls, reached = [], []
+    with pytest.raises(Interrupted) as caught:
+        with catching():
+            with pytest.raises(Interrupted):
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(1)
+            with catching(on_first=lambda: calls.append("stop")):
+                reached.append("the inner block ran")
+            reached.append("after the inner block")
+    assert reached == ["the inner block ran", "after the inner block"]
+    assert caught.value.signum == signal.SIGTERM and calls == []
+    with pytest.raises(Interrupted) as caught:
+        with catching():
+            with pytest.raises(Interrupted):
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(1)
+            with catching(on_first=lambda: calls.append("stop")):
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(1)
+    assert caught.value.signum == signal.SIGINT and calls == ["stop"]
+    with catching():  # nothing pending afterwards
+        check()
+
+
+def test_an_interrupted_command_says_interrupted_on_one_line(monkeypatch, capsys, tmp_path):
+    """click closes a terminal's ``^C`` echo with a blank line before its Abort; whirl says
+    "interrupted" alone (the exit status says which signal)."""
+    from whirl_cli import cli, study
+
+    def interrupted(*_args, **_kwargs):
+        raise Interrupted(signal.SIGTERM)
+
+    monkeypatch.setattr(study, "load_study", interrupted)
+    monkeypatch.setattr(sys, "argv", ["whirl", "validate", str(tmp_path / "x.yaml")])
+    with pytest.raises(SystemExit) as end:
+        cli._main()
+    assert end.value.code == 143
+    assert capsys.readouterr().err == "interrupted\n"
