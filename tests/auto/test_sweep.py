@@ -101,6 +101,21 @@ def test_plan_decides_run_skip_and_invalid(tmp_path):
     assert second.name == "linear_datum_airspeed.yaml"
 
 
+def test_plan_reruns_an_up_to_date_output_that_is_not_whole(tmp_path):
+    """An output whose continuations were deleted is not an up-to-date result read as
+    empty: the study runs again."""
+    studies = tmp_path / "studies"
+    first, _ = copy_studies(studies)
+    out = tmp_path / "results"
+    out.mkdir()
+    study = plan([first], out)[0].study
+    fake_output(out / "linear-case2.h5", study.sha256)
+    with h5py.File(out / "linear-case2.h5", "r+") as handle:
+        handle.create_group("runs").create_group("k1.main_down")
+    assert [(i.action, i.reason) for i in plan([first], out, plots=False)] == [
+        (RUN, "unreadable output (Damaged)")]
+
+
 def test_find_studies_errors_and_order(tmp_path):
     with pytest.raises(WhirlError, match="no such file or directory"):
         find_studies([tmp_path / "missing"])

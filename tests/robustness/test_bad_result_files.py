@@ -6,6 +6,7 @@ error"."""
 from __future__ import annotations
 
 import shutil
+from dataclasses import dataclass
 from pathlib import Path
 
 import h5py
@@ -14,7 +15,7 @@ import pytest
 from click.testing import CliRunner
 
 from whirl_cli.cli import cli
-from whirl_cli.output.store import read
+from whirl_cli.output.store import read, write
 
 from .helpers import ROOT, whirl
 
@@ -99,6 +100,17 @@ BRANCH = "continuations/k1/branches/main_down"
 POINTS = "continuations/k1/special_points"
 SWEEP = "linear/sweeps/V"
 LINEAR = ROOT / "tests" / "regression" / "references" / "linear_datum_airspeed.h5"
+PERIODIC = "continuations/k1/branches/periodic_1"
+
+
+@dataclass(frozen=True)
+class New:
+    """A committed result written again by this whirl."""
+
+    committed: Path
+
+
+NEW, NEW_LINEAR = New(REFERENCE), New(LINEAR)
 
 
 def _replace(handle: h5py.File, key: str, change) -> None:
@@ -156,15 +168,35 @@ DAMAGES = {
                           "attribute 'kind' missing"),
     "names missing": (REFERENCE, _no_attribute(f"{BRANCH}/parameters", "names"),
                       f"/{BRANCH}/parameters", "attribute 'names' missing"),
+    # a whole group deleted reads as nothing of its kind unless the file says it held one:
+    # an older file by its AUTO runs, a file of this whirl by what each group records
+    "continuations deleted": (REFERENCE, _delete("continuations"), "/continuations",
+                              "missing"),
+    "continuations deleted, new file": (NEW, _delete("continuations"), "/continuations",
+                                        "missing"),
+    "a continuation deleted": (NEW_LINEAR, _delete("continuations/airspeed"),
+                               "/continuations", "0 of its 1 members"),
+    "orbits deleted": (NEW, _delete(f"{PERIODIC}/orbits"), f"/{PERIODIC}/orbits", "missing"),
+    "an orbit deleted": (NEW, _delete(f"{PERIODIC}/orbits/9"), f"/{PERIODIC}/orbits",
+                         "7 of its 8 members"),
+    "cross-checks deleted": (NEW, _delete("continuations/k1/cross_checks"),
+                             "/continuations/k1/cross_checks", "missing"),
+    "linear sweeps deleted": (NEW_LINEAR, _delete("linear/sweeps"), "/linear/sweeps",
+                              "missing"),
+    "linear group deleted": (NEW_LINEAR, _delete("linear"), "/linear", "missing"),
 }
 
 
 def damaged(name: str, directory: Path) -> tuple[Path, str, str]:
-    """A copy of a committed result in ``directory`` with the damage ``name`` done to it,
-    the HDF5 path whirl must name and words its reason must hold."""
+    """A copy of a committed result in ``directory`` (as this whirl writes it, for a
+    :class:`New` source) with the damage ``name`` done to it, the HDF5 path whirl must name
+    and words its reason must hold."""
     source, damage, where, words = DAMAGES[name]
-    path = directory / f"{name.replace(' ', '_')}.h5"
-    shutil.copyfile(source, path)
+    path = directory / f"{name.replace(' ', '_').replace(',', '')}.h5"
+    if isinstance(source, New):
+        write(read(source.committed), path)
+    else:
+        shutil.copyfile(source, path)
     with h5py.File(path, "r+") as handle:
         damage(handle)
     return path, where, words

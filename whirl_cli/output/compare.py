@@ -771,10 +771,12 @@ def _datasets(path: Path, roots: tuple[str, ...]) -> dict[str, np.ndarray]:
                 if isinstance(item, h5py.Dataset):
                     found[where] = decoded(item[()])
                 for key, value in item.attrs.items():
-                    found[f"{where}/@{key}"] = decoded(value)
+                    if key not in store.CONTENTS:
+                        found[f"{where}/@{key}"] = decoded(value)
 
             for key, value in handle[root].attrs.items():
-                found[f"/{root}/@{key}"] = decoded(value)
+                if key not in store.CONTENTS:
+                    found[f"/{root}/@{key}"] = decoded(value)
             handle[root].visititems(visit)
     return found
 

@@ -63,7 +63,8 @@ Layout (units in a ``units`` attribute on every physical dataset)::
 The groups holding collections (continuations, branches, orbits, explorations, sweeps,
 boundaries, loci, polygons, contour lines, simulations, runs) track the creation order of their
 members, so a round trip keeps the order of the study and its results; older files list (and
-read) by name.
+read) by name. Each collection records the number of its members (attribute ``whirl_count``),
+every other group their names (``whirl_parts``); reading checks both (older files lack them).
 
 Every dataclass field's place in that layout is declared once, below (:data:`BRANCH`,
 :data:`SPECIAL_POINT`, ...), and both :func:`write` and :func:`read` go by those declarations
@@ -117,6 +118,7 @@ from .mapping import (
     read_record,
     read_table,
     text,
+    texts,
     write_record,
     write_table,
 )
@@ -421,8 +423,54 @@ def _image(result: StudyResult) -> bytes:
         runs = _collection(handle, "runs")
         for record in result.runs:
             write_record(runs.create_group(record.name), record, RUN)
+        _record_contents(handle)
         handle.flush()
         return handle.id.get_file_image()
+
+
+#: Attributes each group of a file gets last (files of this whirl): the names of its members,
+#: or, for a collection (:func:`_collection`), their number. :func:`_check_contents` holds the
+#: file to them, so that a deleted group or dataset is found, never read as none.
+PARTS, COUNT = "whirl_parts", "whirl_count"
+#: Both (what comparing two files leaves out: older files lack them).
+CONTENTS = frozenset({PARTS, COUNT})
+
+
+def _record_contents(handle: h5py.File) -> None:
+    def record(group: h5py.Group) -> None:
+        if _is_collection(group):
+            group.attrs[COUNT] = len(group)
+        else:
+            group.attrs[PARTS] = sorted(group)
+
+    record(handle["/"])
+    handle.visititems(lambda _name, item: record(item) if isinstance(item, h5py.Group)
+                      else None)
+
+
+def _is_collection(group: h5py.Group) -> bool:
+    """Whether ``group`` holds a collection: it tracks the order of its members."""
+    order = group.id.get_create_plist().get_link_creation_order()
+    return bool(order & h5py.h5p.CRT_ORDER_TRACKED)
+
+
+def check_contents(handle: h5py.File) -> None:
+    """:class:`Damaged` where a group lacks a member it was written with (its :data:`PARTS`)
+    or has fewer or more members than written (its :data:`COUNT`), or, in an older file
+    without them, where AUTO runs are recorded but no continuations."""
+    def check(group: h5py.Group) -> None:
+        for name in texts(np.atleast_1d(group.attrs.get(PARTS, ()))):
+            member(group, name)
+        if COUNT in group.attrs and len(group) != int(group.attrs[COUNT]):
+            raise Damaged(group.name, f"{len(group)} of its {int(group.attrs[COUNT])} "
+                          "members")
+
+    check(handle["/"])
+    handle.visititems(lambda _name, item: check(item) if isinstance(item, h5py.Group)
+                      else None)
+    if len(handle.get("runs", ())) and "continuations" not in handle:
+        raise Damaged("/continuations", f"missing (the file records {len(handle['runs'])} "
+                      "AUTO runs of continuations)")
 
 
 # ------------------------------------------------------------------------------ reading
@@ -430,8 +478,7 @@ def _members(group, old_order=None) -> list[str]:
     """Names of the members of ``group`` in the order they were written (files since whirl
     tracks it, see :func:`_collection`); in older files by name, or sorted by ``old_order``."""
     names = list(group)  # h5py lists by creation order where it is tracked, else by name
-    tracked = isinstance(group, h5py.Group) and \
-        group.id.get_create_plist().get_link_creation_order() & h5py.h5p.CRT_ORDER_TRACKED
+    tracked = isinstance(group, h5py.Group) and _is_collection(group)
     return names if tracked or old_order is None else sorted(names, key=old_order)
 
 
@@ -560,6 +607,7 @@ def read(path: Path) -> StudyResult:
         if schema not in READABLE:
             raise OutputError(f"{path}: a whirl result file of schema {schema}; this whirl "
                               f"reads schemas {', '.join(map(str, READABLE))}")
+        check_contents(handle)
         continuations = tuple(_read_continuation(name, group)
                               for name, group in handle.get("continuations", {}).items())
         sweeps = tuple(LinearSweep(**read_record(group, LINEAR_SWEEP))
@@ -569,7 +617,7 @@ def read(path: Path) -> StudyResult:
         grid = _read_grid(handle["linear/grid"]) if "linear/grid" in handle else None
         boundaries = tuple(_read_boundary(name, group)
                            for name, group in handle.get("boundaries", {}).items())
-        skip = {"whirl_schema", "study_name", "model"}
+        skip = {"whirl_schema", "study_name", "model", PARTS}
         attributes = {k: (text(v) if isinstance(v, bytes | str) else v)
                       for k, v in handle.attrs.items() if k not in skip}
         parameters = read_table(member(handle, "parameters"), ParameterValue, PARAMETER) \

@@ -22,6 +22,7 @@ from .. import __version__
 from ..auto.toolchain import auto_version
 from ..errors import StudyError, WhirlError
 from ..output.provenance import code_sha256
+from ..output.store import check_contents
 from ..output.study_files import missing_plots
 from ..study import Study, load_study
 from ..verdict import is_problem
@@ -156,12 +157,14 @@ class StoredState:
 
 def stored_state(output: Path) -> StoredState:
     """The provenance and stored problems of an existing result file, read with h5py (root
-    attributes, branch attributes and cross-check outcomes only, not the data)."""
+    attributes, branch attributes and cross-check outcomes only, not the data);
+    :class:`whirl_cli.output.mapping.Damaged` if a group it was written with is missing."""
     def text(value) -> str:
         return value.decode() if isinstance(value, bytes) else str(value)
 
     problems: list[str] = []
     with h5py.File(output, "r") as handle:
+        check_contents(handle)  # a file not whole is not up to date (Damaged)
         attrs = handle.attrs
         for name, group in handle.get("continuations", {}).items():
             for branch, sub in group.get("branches", {}).items():
