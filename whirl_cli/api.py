@@ -88,7 +88,7 @@ def run_and_save(study: Study | str | os.PathLike[str], path: str | os.PathLike[
 
     study = study if isinstance(study, Study) else load_study(study)
     path, kinds = Path(path), tuple(plots)
-    ready(path, overwrite, study.path)  # an output whirl may not write: refused before work
+    ready(path, overwrite, study.path, plots=bool(kinds))  # refused before any work
     draw = partial(drawn_plots, kinds=kinds, stem=path.stem, state=study.plot_state,
                    jobs=jobs)
     with _workroot(study, keep_runs) as workroot:

@@ -101,7 +101,8 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     output = output or Path(f"{study.name}.h5")
     from .output.guard import ready
 
-    ready(output, overwrite, study.path)  # before any work; the directory is made at the end
+    # before any work; the directory is made at the end
+    ready(output, overwrite, study.path, plots=plots and bool(study.plots))
 
     def report(outcome) -> None:
         # an MX is only said to be a problem at the end: at a period blow-up it is expected

@@ -48,6 +48,27 @@ def test_run_refuses_what_is_not_whirls(tmp_path, kind, overwrite):
         ["r.h5"] + (["elsewhere"] if kind == "symlink" else []))
 
 
+#: What a plot path that is not whirl's is called where the result file's words differ.
+PLOT_WORDS = {"text": "a file that is not PNG", "hdf5": "a file that is not PNG"}
+
+
+@pytest.mark.parametrize("overwrite", [(), ("--overwrite",)])
+@pytest.mark.parametrize("kind", KINDS)
+def test_run_refuses_a_plot_path_that_is_not_whirls_before_any_work(tmp_path, kind,
+                                                                    overwrite):
+    """Before: a plot path was checked only when the plots were published, after every AUTO
+    run."""
+    plot = tmp_path / "r_airspeed_bifurcation.png"
+    words = PLOT_WORDS.get(kind, make(kind, plot))
+    before = fingerprint(plot)
+    done = run(AIRSPEED, "-o", tmp_path / "r.h5", *overwrite)
+    refused_before_work(done, words)
+    assert f"{plot}: " in done.output and "not a PNG image" in done.output
+    assert fingerprint(plot) == before
+    assert sorted(os.listdir(tmp_path)) == sorted(
+        [plot.name] + (["elsewhere"] if kind == "symlink" else []))
+
+
 def test_run_refuses_to_write_over_its_study(tmp_path):
     study = tmp_path / "same.yaml"
     study.write_text(AIRSPEED.read_text())

@@ -342,3 +342,28 @@ def test_a_sweep_refuses_a_foreign_result_path_before_any_work(tmp_path, kind):
         assert target.read_text() == "mine"
     else:
         assert stat.S_ISFIFO(target.lstat().st_mode) if kind == "fifo" else target.is_dir()
+
+
+@pytest.mark.parametrize("kind", ["text", "fifo", "directory"])
+def test_a_sweep_refuses_a_foreign_plot_path_before_any_work(tmp_path, kind):
+    """As for its result files, ``whirl sweep`` checks the plot paths it would write
+    (``<study>_*.png``) before it starts."""
+    studies = tmp_path / "studies"
+    studies.mkdir()
+    (studies / "a.yaml").write_text((ROOT / "studies" / "thesis_ch3" / "linear_case2.yaml")
+                                    .read_text())
+    results = tmp_path / "results"
+    results.mkdir()
+    target = results / "linear-case2_k1_bifurcation.png"
+    if kind == "text":
+        target.write_text("mine")
+    elif kind == "fifo":
+        os.mkfifo(target)
+    else:
+        target.mkdir()
+    done = subprocess.run([str(Path(sys.executable).with_name("whirl")), "sweep", str(studies),
+                           "-o", str(results)], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 1, done.stderr
+    assert f"{target}: " in done.stderr and "whirl never replaces it" in done.stderr
+    assert "Traceback" not in done.stderr and "start" not in done.stderr
+    assert sorted(p.name for p in results.iterdir()) == [target.name]

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 import stat
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -167,8 +168,43 @@ def _unwritable(directory: Path) -> str:
     return ""
 
 
-def ready(output: Path, overwrite: bool, study: str | os.PathLike[str] = "") -> None:
+def ready(output: Path, overwrite: bool, study: str | os.PathLike[str] = "",
+          plots: bool = False) -> None:
     """Refuse, before any work, an ``output`` result file whirl may not write:
-    :func:`check` (with :data:`RESULT`, never ``study``) and :func:`writable`."""
+    :func:`check` (with :data:`RESULT`, never ``study``), with ``plots`` also
+    :func:`plots_ready`, and :func:`writable`."""
     check(output, RESULT, overwrite, study)
+    if plots:
+        plots_ready(output, study)
     writable(output)
+
+
+#: What a plot's file name holds after its output's stem and ``_`` (others become ``_``).
+PLOT_CHARACTERS = "A-Za-z0-9._+-"
+
+
+def plot_stem(stem: str) -> str:
+    """The output's stem as its plots' names begin: kept as given (letters of any script,
+    spaces), but for what no file name can hold (``/``, NUL), which becomes ``_``."""
+    return re.sub(r"[/\0]", "_", stem)
+
+
+def plot_paths(output: Path) -> list[Path]:
+    """The entries of ``output``'s directory named as its plots are (``<stem>_*.png``),
+    whatever they are; none if the directory does not exist."""
+    named = re.compile(re.escape(plot_stem(output.stem)) + f"_[{PLOT_CHARACTERS}]*\\.png")
+    try:
+        entries = os.listdir(output.parent)
+    except (FileNotFoundError, NotADirectoryError):
+        return []
+    return [output.parent / name for name in sorted(entries) if named.fullmatch(name)]
+
+
+def plots_ready(output: Path, study: str | os.PathLike[str] = "") -> None:
+    """Raise :class:`OutputError` before any work if a file named as one of ``output``'s
+    plots is one whirl would not replace (:func:`refusal` with :data:`IMAGE`): which plots a
+    result draws is known only once it is computed, so every such name is checked."""
+    for path in plot_paths(output):
+        reason = refusal(path, IMAGE, study)
+        if reason:
+            raise OutputError(message(path, reason, IMAGE))

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import OutputError, WhirlError
+from ..output.guard import PLOT_CHARACTERS, plot_stem
 from ..results import Branch, ContinuationResult, PointType, StudyResult
 from .captions import Captions, captions
 from .diagrams import bifurcation_diagram, period_plot, phase_plane, projections_figure
@@ -246,7 +247,7 @@ def _named_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: s
     taken: list[Path] = []
     jobs = []
     for name, make in _figure_jobs(result, kinds, stem, state, view):
-        path = _unique(Path(_file_stem(stem) + _safe_name(name.removeprefix(stem))), taken)
+        path = _unique(Path(plot_stem(stem) + _safe_name(name.removeprefix(stem))), taken)
         taken.append(path)
         jobs.append((path.name, make))
     return jobs
@@ -410,13 +411,7 @@ def _state_for(continuation: ContinuationResult, state: str | None) -> str | Non
 
 
 def _safe_name(name: str) -> str:
-    return re.sub(r"[^A-Za-z0-9._+-]", "_", name)
-
-
-def _file_stem(stem: str) -> str:
-    """The output's stem as the plots' names begin: kept as the user gave it (letters of any
-    script, spaces), but for what no file name can hold (``/``, NUL), which becomes ``_``."""
-    return re.sub(r"[/\0]", "_", stem)
+    return re.sub(f"[^{PLOT_CHARACTERS}]", "_", name)
 
 
 def _unique(path: Path, taken: list[Path]) -> Path:

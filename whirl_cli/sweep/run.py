@@ -8,7 +8,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from ..auto.runner import interruptible
-from ..output.guard import RESULT, check, writable
+from ..output.guard import RESULT, check, plots_ready, writable
 from .execute import Outcome, execute
 from .executors import dask_pool, local_pool, prepare_workers
 from .plan import RUN, SweepItem, plan
@@ -28,7 +28,7 @@ def run_sweep(paths: Sequence[str | os.PathLike[str]], out_dir: Path, jobs: int 
     """
     items = plan(paths, out_dir, force, plots)
     pending = sum(item.action == RUN for item in items)
-    _refuse_outputs([item for item in items if item.action == RUN])
+    _refuse_outputs([item for item in items if item.action == RUN], plots)
     if pending:
         Path(out_dir).mkdir(parents=True, exist_ok=True)
     reporter = Reporter(len(items), console)
@@ -62,12 +62,14 @@ def run_sweep(paths: Sequence[str | os.PathLike[str]], out_dir: Path, jobs: int 
     return reporter.tally
 
 
-def _refuse_outputs(runs: Sequence[SweepItem]) -> None:
-    """Before any work: OutputError if a result file a sweep would write is not whirl's to
-    replace (a link, directory, device, another program's file) or its folder cannot take
-    files (read-only, full)."""
+def _refuse_outputs(runs: Sequence[SweepItem], plots: bool) -> None:
+    """Before any work: OutputError if a result file a sweep would write, or (``plots``) a
+    file named as one of its plots, is not whirl's to replace (a link, directory, device,
+    another program's file) or its folder cannot take files (read-only, full)."""
     for item in runs:
         check(item.output, RESULT, overwrite=True)
+        if plots and item.study.plots:
+            plots_ready(item.output)
     if runs:
         writable(runs[0].output)
 
