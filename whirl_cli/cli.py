@@ -336,7 +336,7 @@ def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None,
                           f"({error.strerror or error})") from None
     view = View(xlim=xlim, ylim=ylim, hz=hz, artefacts=artefacts)
     for path in save_study_plots(result, kinds, output_dir, result_file.stem, state,
-                                 view=view):
+                                 view=view, result_file=result_file):
         click.echo(f"wrote {path}")
 
 

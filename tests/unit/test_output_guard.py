@@ -367,3 +367,47 @@ def test_a_sweep_refuses_a_foreign_plot_path_before_any_work(tmp_path, kind):
     assert f"{target}: " in done.stderr and "whirl never replaces it" in done.stderr
     assert "Traceback" not in done.stderr and "start" not in done.stderr
     assert sorted(p.name for p in results.iterdir()) == [target.name]
+
+
+# ------------------------------------------------------------ plots of two results colliding
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("order", ["shorter stem first", "longer stem first"])
+def test_a_plot_another_result_recorded_is_never_replaced(tmp_path, order):
+    """Study ``a`` with continuation ``b_c`` and study ``a_b`` with continuation ``c`` both
+    draw ``a_b_c_bifurcation.png``: whichever is published second is refused (with or
+    without --overwrite), the first one's plot and files are left as they were."""
+    name = "a_b_c_bifurcation.png"
+    first, second = ("a", "a_b") if order == "shorter stem first" else ("a_b", "a")
+    study_files.publish_study(small_result(first), tmp_path / f"{first}.h5", (),
+                              drawn=study_files.Drawn(((name, PNG + b"first"),)))
+    before = sorted(os.listdir(tmp_path)), (tmp_path / name).read_bytes()
+    for overwrite in (False, True):
+        with pytest.raises(OutputError) as refused:
+            study_files.publish_study(small_result(second), tmp_path / f"{second}.h5", (),
+                                      overwrite, drawn=study_files.Drawn(
+                                          ((name, PNG + b"second"),)))
+        assert str(refused.value) == (f"{tmp_path / name}: a plot of {tmp_path / first}.h5, "
+                                      f"not of {tmp_path / second}.h5; whirl never "
+                                      "replaces it")
+        assert (sorted(os.listdir(tmp_path)), (tmp_path / name).read_bytes()) == before
+
+
+def test_whirl_plot_does_not_replace_a_plot_another_result_recorded(tmp_path):
+    """``whirl plot x.h5`` (continuation k1) draws ``x_k1_bifurcation.png``, which the
+    result ``x_k1.h5`` beside it recorded as its own."""
+    result = tmp_path / "x.h5"
+    result.write_bytes(LEGACY.read_bytes())
+    name = "x_k1_bifurcation.png"
+    study_files.publish_study(small_result("other"), tmp_path / "x_k1.h5", (),
+                              drawn=study_files.Drawn(((name, PNG + b"other"),)))
+    with pytest.raises(OutputError, match=f"a plot of {tmp_path / 'x_k1.h5'}"):
+        save_study_plots(store.read(result), ("bifurcation",), tmp_path, "x",
+                         result_file=result)
+    assert (tmp_path / name).read_bytes() == PNG + b"other"
+    # its own plots are still replaced
+    save_study_plots(store.read(result), ("bifurcation",), tmp_path / "own", "x",
+                     result_file=result)
+    save_study_plots(store.read(result), ("bifurcation",), tmp_path / "own", "x",
+                     result_file=result)

@@ -36,7 +36,7 @@ from ..errors import OutputError
 from ..interrupts import forked_map, held_signals
 from ..results import StudyResult
 from . import atomic, store
-from .guard import IMAGE, RESULT, check, refusal
+from .guard import IMAGE, RESULT, check, plot_stem, refusal
 
 #: Root attribute of the HDF5 file: names of the plot files published with it.
 PLOTS_ATTRIBUTE = "plots"
@@ -142,10 +142,11 @@ def _publish_unit(result: StudyResult, output: Path, plots: tuple[tuple[str, byt
     targets = [output.parent / name for name, _ in plots]
     check(output, RESULT, overwrite)
     for path in targets:
-        check(path, IMAGE, overwrite)
+        check_plot(path, output, overwrite)
     names = [name for name, _ in plots]
     stale = [output.parent / name for name in recorded_plots(output)
-             if name not in names and _plain(name)] if overwrite else []
+             if name not in names and _plain(name)
+             and owner(output.parent / name, output) is None] if overwrite else []
     result = replace(result, attributes={**result.attributes, PLOTS_ATTRIBUTE: names})
     written: list[Path] = []
     with held_signals():
@@ -179,10 +180,46 @@ def publish_plots(output: Path, kinds: Sequence[str], state: str | None = None
     rendered = render_study_plots(store.read(output), tuple(kinds), Path(output).stem, state)
     targets = [Path(output).parent / name for name, _ in rendered]
     for path in targets:
-        check(path, IMAGE, overwrite=True)
+        check_plot(path, Path(output), overwrite=True)
     with held_signals():
         return tuple(atomic.publish(data, path, True, what="the plot", own=IMAGE)
                      for (_, data), path in zip(rendered, targets, strict=True))
+
+
+def check_plot(path: Path, output: Path, overwrite: bool) -> None:
+    """Raise :class:`OutputError` unless the plot ``path`` of the result file ``output`` may
+    be written: :func:`whirl_cli.output.guard.check` (a PNG image, with ``overwrite``), and
+    no other whirl result file beside it records ``path`` as its plot (two results' plot
+    names can meet: ``a`` with continuation ``b_c`` and ``a_b`` with ``c``)."""
+    other = owner(path, output)
+    if other is not None:
+        raise OutputError(f"{path}: a plot of {other}, not of {output}; whirl never "
+                          "replaces it")
+    check(path, IMAGE, overwrite)
+
+
+def owner(path: Path, output: Path) -> Path | None:
+    """The whirl result file beside the existing file ``path``, other than ``output``, that
+    records it as one of its plots (None if none does). Only results whose stem begins
+    ``path``'s name can: few are opened."""
+    if not os.path.lexists(path):
+        return None
+    directory = Path(path).parent
+    for name in sorted(os.listdir(directory)):
+        other = directory / name
+        if not Path(path).name.startswith(plot_stem(other.stem) + "_") or \
+                _same_file(other, output) or refusal(other, RESULT):
+            continue
+        if Path(path).name in recorded_plots(other):
+            return other
+    return None
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
 
 
 def recorded_plots(output: Path) -> tuple[str, ...]:

@@ -106,8 +106,8 @@ def available_kinds(result: StudyResult) -> tuple[str, ...]:
 
 
 def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path, stem: str,
-                     state: str | None = None, dpi: int = 150, view: View = View()
-                     ) -> list[Path]:
+                     state: str | None = None, dpi: int = 150, view: View = View(),
+                     result_file: Path | None = None) -> list[Path]:
     """Write a study's figures as PNG files into ``out_dir``; return the paths, sorted.
 
     ``kinds`` (any of :data:`PLOT_KINDS`):
@@ -158,8 +158,9 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
     The stem is kept as given; in the rest of a name, characters other than ``A-Za-z0-9._+-``
     become ``_``; repeats get ``_2``, ``_3``, ... (:func:`plot_names`).
     Each file is rendered in memory and published complete or not at all (an existing file
-    of the same name is replaced if it is a PNG image, and nothing is written if one is not:
-    :func:`whirl_cli.output.guard.check`). ``whirl run`` and ``whirl sweep`` publish a
+    of the same name is replaced if it is a PNG image, and nothing is written if one is not,
+    or if a whirl result file other than ``result_file`` beside it records it as its plot:
+    :func:`whirl_cli.output.study_files.check_plot`). ``whirl run`` and ``whirl sweep`` publish a
     study's plots together with its HDF5 file instead (:mod:`whirl_cli.output.study_files`).
     """
     out_dir = Path(out_dir)
@@ -169,10 +170,11 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
     except OSError as exc:
         raise OutputError(f"cannot create plot directory {out_dir}: {exc}") from exc
     from ..output.atomic import publish
-    from ..output.guard import IMAGE, check
+    from ..output.guard import IMAGE
+    from ..output.study_files import check_plot
 
     for name, _ in rendered:  # a PNG is replaced, never a link, directory, device, FIFO
-        check(out_dir / name, IMAGE, overwrite=True)
+        check_plot(out_dir / name, result_file or out_dir / f"{stem}.h5", overwrite=True)
     return sorted(publish(data, out_dir / name, overwrite=True, what="the plot", own=IMAGE)
                   for name, data in rendered)
 
