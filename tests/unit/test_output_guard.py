@@ -191,8 +191,11 @@ def test_an_unwritable_or_full_directory_is_found_up_front(tmp_path, monkeypatch
         f_bavail, f_frsize = 3, 4096
 
     monkeypatch.setattr(guard.os, "statvfs", lambda path: Full)
-    with pytest.raises(OutputError, match=r"only 0.0 MiB free"):
+    with pytest.raises(OutputError) as refused:
         guard.writable(path)
+    # what is free and what is needed, in numbers that say it (not "0.0 MiB")
+    assert str(refused.value) == (f"{path}: only 12 KiB free in {tmp_path}; whirl needs at "
+                                  "least 16 MiB there for a result file and its plots")
 
 
 def test_a_read_only_file_system_is_found_up_front(tmp_path):

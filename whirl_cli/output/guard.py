@@ -21,7 +21,10 @@ from pathlib import Path
 
 from ..errors import OutputError
 
-#: Free space below which an output directory is refused up front (bytes).
+#: Free space below which an output directory is refused up front (bytes): what one study
+#: may write, with room (the largest result files of the shipped studies, two-parameter
+#: boundaries, take about 6 MB, their plots well under 1 MB). A floor, not an estimate: how
+#: many points AUTO stores is known only once it has run (``max_steps`` bounds it loosely).
 MINIMUM_FREE = 16 * 2**20
 
 #: Errors of a file system without ``O_TMPFILE`` (then the permission is asked instead).
@@ -146,8 +149,19 @@ def writable(output: Path, minimum_free: int = MINIMUM_FREE) -> None:
         return
     free = space.f_bavail * space.f_frsize
     if free < minimum_free:
-        raise OutputError(f"{output}: only {free / 2**20:.1f} MiB free in {where} (whirl "
-                          f"needs at least {minimum_free / 2**20:.0f} MiB)")
+        raise OutputError(f"{output}: only {_size(free)} free in {where}; whirl needs at "
+                          f"least {_size(minimum_free)} there for a result file and its plots")
+
+
+def _size(count: int) -> str:
+    """A number of bytes in words: ``512 bytes``, ``12.0 KiB``, ``3.5 MiB``, ``16 MiB``."""
+    if count < 1024:
+        return f"{count} bytes"
+    for unit, scale in (("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
+        if count >= scale:
+            value = count / scale
+            return f"{value:.0f} {unit}" if value == int(value) else f"{value:.1f} {unit}"
+    raise AssertionError(count)
 
 
 def _unwritable(directory: Path) -> str:
