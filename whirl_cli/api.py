@@ -35,7 +35,7 @@ if TYPE_CHECKING:
 
     from .output.study_files import Published
 
-__all__ = ["draw", "load", "read", "run", "run_and_save", "save", "special_points"]
+__all__ = ["draw", "export", "load", "read", "run", "run_and_save", "save", "special_points"]
 
 
 def load(path: str | os.PathLike[str]) -> Study:
@@ -127,6 +127,17 @@ def read(path: str | os.PathLike[str]) -> StudyResult:
     from .output import store
 
     return store.read(Path(path))
+
+
+def export(result: StudyResult, path: str | os.PathLike[str], branches: bool = False,
+           overwrite: bool = False) -> tuple[Path, ...]:
+    """Write ``result`` for other tools, the format chosen by ``path``'s suffix: ``.mat``
+    (MATLAB/Octave), ``.nc`` (NetCDF-4, needs ``whirl[export]``) or ``.csv`` (the special
+    points; with ``branches`` also one file per branch beside it). Returns the paths
+    written (:func:`whirl_cli.export.export`)."""
+    from .export import export as write
+
+    return write(result, path, branches=branches, overwrite=overwrite)
 
 
 def special_points(result: StudyResult, dofs: Sequence[str] | None = None):

@@ -164,6 +164,28 @@ def summary(result_file: Path, output_format: str) -> None:
     click.echo(render(result, output_format, dofs), nl=False)
 
 
+# ------------------------------------------------------------------------------------ export
+@cli.command()
+@click.argument("result_file", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("-o", "--output", required=True, type=click.Path(path_type=Path),
+              help="The file to write; its suffix chooses the format: .mat (MATLAB/Octave), "
+                   ".nc (NetCDF-4, xarray) or .csv (the special points).")
+@click.option("--branches", is_flag=True,
+              help="CSV: also one file per branch, <output stem>_<continuation>_<branch>.csv.")
+@click.option("--overwrite", is_flag=True, help="Replace existing output files.")
+def export(result_file: Path, output: Path, branches: bool, overwrite: bool) -> None:
+    """Write the contents of a result file for MATLAB/Octave, xarray/NetCDF tools or CSV."""
+    from . import api
+    from .export import format_of
+
+    format_of(output)  # a suffix it cannot write: refused before the file is read
+    if not result_file.exists():
+        raise OutputError(f"{result_file}: no such file")
+    for path in api.export(api.read(result_file), output, branches=branches,
+                           overwrite=overwrite):
+        _tell(f"wrote {path}")
+
+
 # ------------------------------------------------------------------------------------ check
 @cli.command()
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
