@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from .errors import WhirlError
+from .jobs import jobs_or_default
 from .results import StudyResult
 from .study import Study, load_study
 
@@ -43,14 +44,15 @@ def load(path: str | os.PathLike[str]) -> Study:
     return load_study(path)
 
 
-def run(study: Study | str | os.PathLike[str], jobs: int = 1,
+def run(study: Study | str | os.PathLike[str], jobs: int | None = None,
         on_run: Callable[[Any], None] | None = None,
         keep_runs: str | os.PathLike[str] | None = None,
         preload: tuple[str, ...] = (),
         on_slow: Callable[[str, float], None] | None = None) -> StudyResult:
     """Run every continuation, linear analysis and cross-check of ``study`` (a Study or a
-    path); ``jobs`` AUTO runs at once; ``on_run`` is called with each AUTO run's outcome as it
-    ends, ``on_slow`` with a run's name and seconds when it still runs after 10 s, 20 s, ...
+    path); ``jobs`` AUTO runs at once (None: as ``whirl run``, one per CPU); ``on_run`` is
+    called with each AUTO run's outcome as it ends, ``on_slow`` with a run's name and seconds
+    when it still runs after 10 s, 20 s, ...
     AUTO works in a temporary directory, removed afterwards, or kept under ``keep_runs``.
     ``preload``: modules needed afterwards, imported while AUTO runs (e.g.
     :data:`whirl_cli.plots.MODULES` before :func:`save` draws plots)."""
@@ -58,22 +60,24 @@ def run(study: Study | str | os.PathLike[str], jobs: int = 1,
 
     study = study if isinstance(study, Study) else load_study(study)
     with _workroot(study, keep_runs) as workroot:
-        return run_study(study, workroot, jobs=jobs, on_run=on_run, preload=preload,
-                         on_slow=on_slow)
+        return run_study(study, workroot, jobs=jobs_or_default(jobs), on_run=on_run,
+                         preload=preload, on_slow=on_slow)
 
 
 def save(result: StudyResult, path: str | os.PathLike[str], plots: Sequence[str] = (),
-         overwrite: bool = False, state: str | None = None, jobs: int = 1) -> Published:
+         overwrite: bool = False, state: str | None = None, jobs: int | None = None
+         ) -> Published:
     """Write ``result`` to the HDF5 file ``path`` and its ``plots`` (kinds of
-    :data:`whirl_cli.plots.files.PLOT_KINDS`, drawn in ``jobs`` processes) next to it, as one
-    unit (all or nothing)."""
+    :data:`whirl_cli.plots.files.PLOT_KINDS`, drawn in ``jobs`` processes, None: one per CPU)
+    next to it, as one unit (all or nothing)."""
     from .output.study_files import publish_study
 
-    return publish_study(result, Path(path), tuple(plots), overwrite, state=state, jobs=jobs)
+    return publish_study(result, Path(path), tuple(plots), overwrite, state=state,
+                         jobs=jobs_or_default(jobs))
 
 
 def run_and_save(study: Study | str | os.PathLike[str], path: str | os.PathLike[str],
-                 plots: Sequence[str] = (), overwrite: bool = False, jobs: int = 1,
+                 plots: Sequence[str] = (), overwrite: bool = False, jobs: int | None = None,
                  on_run: Callable[[Any], None] | None = None,
                  keep_runs: str | os.PathLike[str] | None = None,
                  preload: tuple[str, ...] = (),
@@ -87,7 +91,7 @@ def run_and_save(study: Study | str | os.PathLike[str], path: str | os.PathLike[
     from .pipeline import run_and_draw
 
     study = study if isinstance(study, Study) else load_study(study)
-    path, kinds = Path(path), tuple(plots)
+    path, kinds, jobs = Path(path), tuple(plots), jobs_or_default(jobs)
     ready(path, overwrite, study.path)  # an output whirl may not write: refused before work
     draw = partial(drawn_plots, kinds=kinds, stem=path.stem, state=study.plot_state,
                    jobs=jobs)

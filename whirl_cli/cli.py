@@ -14,6 +14,7 @@ from pathlib import Path
 import click
 
 from .errors import OutputError, WhirlError
+from .jobs import MAX_JOBS, default_jobs
 
 
 def _version() -> str:
@@ -71,7 +72,7 @@ def _output_file(ctx: click.Context, param: click.Parameter, value: str | None) 
 @click.argument("study_file", type=click.Path(dir_okay=False, path_type=Path))
 @click.option("-o", "--output", callback=_output_file,
               help="HDF5 result file [default: <study name>.h5 in the current directory].")
-@click.option("-j", "--jobs", type=click.IntRange(1, 64), default=min(os.cpu_count() or 1, 64),
+@click.option("-j", "--jobs", type=click.IntRange(1, MAX_JOBS), default=default_jobs(),
               show_default=True,
               help="AUTO runs (and time simulations, and plots) in parallel.")
 @click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
