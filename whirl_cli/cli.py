@@ -49,21 +49,38 @@ def _show_version(ctx: click.Context, _param: click.Parameter, value: bool) -> N
 
 class _Whirl(click.Group):
     """whirl's command group: a reader of standard output that leaves early (``whirl models |
-    head``) ends the command quietly, with status 0, not as an error."""
+    head``) is no error; the command goes on to its own end and exit status (its output from
+    then on goes nowhere)."""
 
-    def make_context(self, info_name, args, parent=None, **extra) -> click.Context:
-        try:  # whirl --help: printed while the arguments are parsed
-            return super().make_context(info_name, args, parent, **extra)
-        except BrokenPipeError:
-            _reader_left()
-            raise click.exceptions.Exit(0) from None
+    def main(self, *args, **kwargs):
+        if not isinstance(sys.stdout, _ReaderMayLeave):
+            sys.stdout = _ReaderMayLeave(sys.stdout)
+        return super().main(*args, **kwargs)
 
-    def invoke(self, ctx: click.Context):
+
+class _ReaderMayLeave:
+    """Standard output whose reader may close it: a write or flush that finds the pipe
+    closed sends everything from then on to /dev/null instead of raising."""
+
+    def __init__(self, stream) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
         try:
-            return super().invoke(ctx)
+            return self._stream.write(text)
         except BrokenPipeError:
             _reader_left()
-            return None
+            return len(text)
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            _reader_left()
+            self._stream.flush()
+
+    def __getattr__(self, name: str):
+        return getattr(self._stream, name)
 
 
 def _reader_left() -> None:

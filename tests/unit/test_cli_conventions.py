@@ -34,6 +34,16 @@ def test_a_reader_that_closes_the_pipe_early_is_not_an_error(args):
         assert errors == b""
 
 
+def test_a_command_that_fails_still_says_so_when_its_reader_left():
+    """``whirl compare A B | head``: the reader's leaving does not hide the drift."""
+    airspeed = ROOT / "tests" / "regression" / "references" / "linear_datum_airspeed.h5"
+    process = subprocess.Popen([sys.executable, "-m", "whirl_cli", "compare", REFERENCE,
+                                airspeed], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    process.stdout.close()
+    _, errors = process.communicate(timeout=120)
+    assert process.returncode == 1 and b"differ (" in errors, errors
+
+
 def test_a_study_on_standard_input():
     text = (STUDIES / "linear_case2.yaml").read_text()
     done = whirl("validate", "-", input=text)
