@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from .errors import WhirlError
+from .jobs import jobs_or_default
 from .results import StudyResult
 from .study import Study, load_study
 
@@ -35,7 +36,7 @@ if TYPE_CHECKING:
 
     from .output.study_files import Published
 
-__all__ = ["draw", "load", "read", "run", "run_and_save", "save", "special_points"]
+__all__ = ["draw", "export", "load", "read", "run", "run_and_save", "save", "special_points"]
 
 
 def load(path: str | os.PathLike[str]) -> Study:
@@ -43,14 +44,15 @@ def load(path: str | os.PathLike[str]) -> Study:
     return load_study(path)
 
 
-def run(study: Study | str | os.PathLike[str], jobs: int = 1,
+def run(study: Study | str | os.PathLike[str], jobs: int | None = None,
         on_run: Callable[[Any], None] | None = None,
         keep_runs: str | os.PathLike[str] | None = None,
         preload: tuple[str, ...] = (),
         on_slow: Callable[[str, float], None] | None = None) -> StudyResult:
     """Run every continuation, linear analysis and cross-check of ``study`` (a Study or a
-    path); ``jobs`` AUTO runs at once; ``on_run`` is called with each AUTO run's outcome as it
-    ends, ``on_slow`` with a run's name and seconds when it still runs after 10 s, 20 s, ...
+    path); ``jobs`` AUTO runs at once (None: as ``whirl run``, one per CPU); ``on_run`` is
+    called with each AUTO run's outcome as it ends, ``on_slow`` with a run's name and seconds
+    when it still runs after 10 s, 20 s, ...
     AUTO works in a temporary directory, removed afterwards, or kept under ``keep_runs``.
     ``preload``: modules needed afterwards, imported while AUTO runs (e.g.
     :data:`whirl_cli.plots.MODULES` before :func:`save` draws plots)."""
@@ -58,22 +60,24 @@ def run(study: Study | str | os.PathLike[str], jobs: int = 1,
 
     study = study if isinstance(study, Study) else load_study(study)
     with _workroot(study, keep_runs) as workroot:
-        return run_study(study, workroot, jobs=jobs, on_run=on_run, preload=preload,
-                         on_slow=on_slow)
+        return run_study(study, workroot, jobs=jobs_or_default(jobs), on_run=on_run,
+                         preload=preload, on_slow=on_slow)
 
 
 def save(result: StudyResult, path: str | os.PathLike[str], plots: Sequence[str] = (),
-         overwrite: bool = False, state: str | None = None, jobs: int = 1) -> Published:
+         overwrite: bool = False, state: str | None = None, jobs: int | None = None
+         ) -> Published:
     """Write ``result`` to the HDF5 file ``path`` and its ``plots`` (kinds of
-    :data:`whirl_cli.plots.files.PLOT_KINDS`, drawn in ``jobs`` processes) next to it, as one
-    unit (all or nothing)."""
+    :data:`whirl_cli.plots.files.PLOT_KINDS`, drawn in ``jobs`` processes, None: one per CPU)
+    next to it, as one unit (all or nothing)."""
     from .output.study_files import publish_study
 
-    return publish_study(result, Path(path), tuple(plots), overwrite, state=state, jobs=jobs)
+    return publish_study(result, Path(path), tuple(plots), overwrite, state=state,
+                         jobs=jobs_or_default(jobs))
 
 
 def run_and_save(study: Study | str | os.PathLike[str], path: str | os.PathLike[str],
-                 plots: Sequence[str] = (), overwrite: bool = False, jobs: int = 1,
+                 plots: Sequence[str] = (), overwrite: bool = False, jobs: int | None = None,
                  on_run: Callable[[Any], None] | None = None,
                  keep_runs: str | os.PathLike[str] | None = None,
                  preload: tuple[str, ...] = (),
@@ -87,7 +91,7 @@ def run_and_save(study: Study | str | os.PathLike[str], path: str | os.PathLike[
     from .pipeline import run_and_draw
 
     study = study if isinstance(study, Study) else load_study(study)
-    path, kinds = Path(path), tuple(plots)
+    path, kinds, jobs = Path(path), tuple(plots), jobs_or_default(jobs)
     ready(path, overwrite, study.path, plots=bool(kinds))  # refused before any work
     draw = partial(drawn_plots, kinds=kinds, stem=path.stem, state=study.plot_state,
                    jobs=jobs)
@@ -127,6 +131,17 @@ def read(path: str | os.PathLike[str]) -> StudyResult:
     from .output import store
 
     return store.read(Path(path))
+
+
+def export(result: StudyResult, path: str | os.PathLike[str], branches: bool = False,
+           overwrite: bool = False) -> tuple[Path, ...]:
+    """Write ``result`` for other tools, the format chosen by ``path``'s suffix: ``.mat``
+    (MATLAB/Octave), ``.nc`` (NetCDF-4, needs ``whirl[export]``) or ``.csv`` (the special
+    points; with ``branches`` also one file per branch beside it). Returns the paths
+    written (:func:`whirl_cli.export.export`)."""
+    from .export import export as write
+
+    return write(result, path, branches=branches, overwrite=overwrite)
 
 
 def special_points(result: StudyResult, dofs: Sequence[str] | None = None):

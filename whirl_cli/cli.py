@@ -14,6 +14,7 @@ from pathlib import Path
 import click
 
 from .errors import OutputError, WhirlError
+from .jobs import MAX_JOBS, default_jobs
 
 
 def _version() -> str:
@@ -47,8 +48,16 @@ def _show_version(ctx: click.Context, _param: click.Parameter, value: bool) -> N
 
 
 class _Whirl(click.Group):
-    """whirl's commands: one interrupted by SIGINT or SIGTERM says "interrupted" alone (click
-    would print a blank line before its Abort) and exits with 128 + the signal's number."""
+    """whirl's commands: a reader of standard output that leaves early (``whirl models |
+    head``) is no error (the command goes on to its own end and exit status, its output from
+    then on going nowhere); one interrupted by SIGINT or SIGTERM says "interrupted" alone
+    (click would print a blank line before its Abort) and exits with 128 + the signal's
+    number."""
+
+    def main(self, *args, **kwargs):
+        if not isinstance(sys.stdout, _ReaderMayLeave):
+            sys.stdout = _ReaderMayLeave(sys.stdout)
+        return super().main(*args, **kwargs)
 
     def invoke(self, ctx: click.Context):
         try:
@@ -58,18 +67,100 @@ class _Whirl(click.Group):
             raise click.exceptions.Exit(128 + getattr(interrupt, "signum", 2)) from None
 
 
+class _ReaderMayLeave:
+    """Standard output whose reader may close it: a write or flush that finds the pipe
+    closed sends everything from then on to /dev/null instead of raising."""
+
+    def __init__(self, stream) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            _reader_left()
+            return len(text)
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            _reader_left()
+            self._stream.flush()
+
+    def __getattr__(self, name: str):
+        return getattr(self._stream, name)
+
+
+def _reader_left() -> None:
+    """Standard output from here on goes nowhere (its reader closed the pipe), so that no
+    later write or the flush at exit fails."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, sys.stdout.fileno())
+    finally:
+        os.close(devnull)
+
+
+#: Every option can also come from the environment: WHIRL_<COMMAND>_<OPTION>, e.g.
+#: WHIRL_RUN_JOBS=4, WHIRL_SWEEP_OUTPUT_DIR=results (:func:`_environment_names`).
+ENV_PREFIX = "WHIRL"
+
+
 @click.group(cls=_Whirl, context_settings={"help_option_names": ["-h", "--help"]})
 @click.option("--version", is_flag=True, expose_value=False, is_eager=True,
               callback=_show_version, help="Show the version and exit.")
 def cli() -> None:
-    """Nonlinear whirl-flutter continuation studies with AUTO-07p: YAML in, HDF5 and plots out."""
+    """Nonlinear whirl-flutter continuation studies with AUTO-07p: YAML in, HDF5 and plots out.
+
+    STUDY_FILE may be - (the study's YAML on standard input). Every option can also be set
+    in the environment as WHIRL_<COMMAND>_<OPTION> (e.g. WHIRL_RUN_JOBS=4). Shell completion:
+    eval "$(_WHIRL_COMPLETE=bash_source whirl)" (zsh_source, fish_source for those shells).
+    """
+
+
+#: What ``-`` names as a study file: the YAML on standard input.
+STDIN = "-"
+
+
+def _load(study_file: Path):
+    """The study at ``study_file``, or on standard input where it is ``-`` (messages name
+    it ``<stdin>``; a model file it names is read relative to the working directory)."""
+    from .study import load_study, validate_text
+
+    if str(study_file) != STDIN:
+        return load_study(study_file)
+    from .errors import StudyError
+    from .study import MAX_BYTES
+
+    raw = sys.stdin.buffer.read(MAX_BYTES + 1)
+    if len(raw) > MAX_BYTES:
+        raise StudyError(f"<stdin>: the study is too large (more than {MAX_BYTES} bytes)")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise StudyError(f"<stdin>: not UTF-8 text (byte 0x{raw[error.start]:02x} at offset "
+                         f"{error.start})") from None
+    return validate_text(text, "<stdin>")
+
+
+def _not_stdout(what: str, instead: str = ""):
+    """An ``-o`` callback refusing ``-`` (standard output) for an option naming ``what``
+    (no file or directory named ``-`` is made); ``instead``: what to use for that."""
+    def callback(ctx: click.Context, param: click.Parameter, value):
+        if value is not None and str(value) == STDIN:
+            raise OutputError(f"-o -: whirl {ctx.info_name} writes {what}, not to standard "
+                              f"output; name it{instead}")
+        return value
+    return callback
 
 
 # ------------------------------------------------------------------------------------ run
 def _output_file(ctx: click.Context, param: click.Parameter, value: str | None) -> Path | None:
-    """``-o``: a file path (not empty, not an existing directory)."""
+    """``-o``: a file path (not empty, not an existing directory, not ``-``)."""
     if value is None:
         return None
+    _not_stdout("an HDF5 file", " (e.g. -o out/study.h5)")(ctx, param, value)
     if not value.strip():
         raise OutputError(f"-o/--output: expected the path of the HDF5 file, got {value!r}")
     path = Path(value)
@@ -83,7 +174,7 @@ def _output_file(ctx: click.Context, param: click.Parameter, value: str | None) 
 @click.argument("study_file", type=click.Path(dir_okay=False, path_type=Path))
 @click.option("-o", "--output", callback=_output_file,
               help="HDF5 result file [default: <study name>.h5 in the current directory].")
-@click.option("-j", "--jobs", type=click.IntRange(1, 64), default=min(os.cpu_count() or 1, 64),
+@click.option("-j", "--jobs", type=click.IntRange(1, MAX_JOBS), default=default_jobs(),
               show_default=True,
               help="AUTO runs (and time simulations, and plots) in parallel.")
 @click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
@@ -93,10 +184,9 @@ def _output_file(ctx: click.Context, param: click.Parameter, value: str | None) 
               help="Keep AUTO's working directories (constants, b./s./d. files) here.")
 def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots: bool,
         keep_runs: Path | None) -> None:
-    """Run every continuation and linear analysis of STUDY_FILE."""
-    from .study import load_study
-
-    study = load_study(study_file)  # first: a bad study is refused fast, before any import
+    """Run every continuation and linear analysis of STUDY_FILE (- reads it from standard
+    input)."""
+    study = _load(study_file)  # first: a bad study is refused fast, before any import
 
     output = output or Path(f"{study.name}.h5")
     from .output.guard import ready
@@ -177,6 +267,30 @@ def summary(result_file: Path, output_format: str) -> None:
     click.echo(render(result, output_format, dofs), nl=False)
 
 
+# ------------------------------------------------------------------------------------ export
+@cli.command()
+@click.argument("result_file", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("-o", "--output", required=True, type=click.Path(path_type=Path),
+              callback=_not_stdout("files", " (the special points as CSV on standard output: "
+                                   "whirl summary --format csv)"),
+              help="The file to write; its suffix chooses the format: .mat (MATLAB/Octave), "
+                   ".nc (NetCDF-4, xarray) or .csv (the special points).")
+@click.option("--branches", is_flag=True,
+              help="CSV: also one file per branch, <output stem>_<continuation>_<branch>.csv.")
+@click.option("--overwrite", is_flag=True, help="Replace existing output files.")
+def export(result_file: Path, output: Path, branches: bool, overwrite: bool) -> None:
+    """Write the contents of a result file for MATLAB/Octave, xarray/NetCDF tools or CSV."""
+    from . import api
+    from .export import format_of
+
+    format_of(output)  # a suffix it cannot write: refused before the file is read
+    if not result_file.exists():
+        raise OutputError(f"{result_file}: no such file")
+    for path in api.export(api.read(result_file), output, branches=branches,
+                           overwrite=overwrite):
+        _tell(f"wrote {path}")
+
+
 # ------------------------------------------------------------------------------------ check
 @cli.command()
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
@@ -221,11 +335,10 @@ def check(result_file: Path) -> None:
 @cli.command()
 @click.argument("study_file", type=click.Path(dir_okay=False, path_type=Path))
 def validate(study_file: Path) -> None:
-    """Check STUDY_FILE against the schema and the model; exit 0 if valid, 1 if not."""
-    from .study import load_study
-
-    study = load_study(study_file)
-    click.echo(f"{study_file}: ok (model {study.variant().name}, "
+    """Check STUDY_FILE against the schema and the model; exit 0 if valid, 1 if not (- reads
+    it from standard input)."""
+    study = _load(study_file)
+    click.echo(f"{study.path}: ok (model {study.variant().name}, "
                f"{len(study.continuations)} continuation(s))")
 
 
@@ -297,6 +410,7 @@ def _limits(ctx: click.Context, param: click.Parameter, value):
               help="Plot kind (repeatable) [default: every kind the file has the data for]; "
                    "a kind it lacks the data for is an error.")
 @click.option("-o", "--output-dir", type=click.Path(file_okay=False, path_type=Path),
+              callback=_not_stdout("PNG files into a directory"),
               help="Directory for the PNG files [default: next to RESULT_FILE].")
 @click.option("--state", help="State the bifurcation diagrams draw [default: the study's "
               "plot_state, else the model's first dof].")
@@ -415,6 +529,7 @@ def doctor() -> None:
                 type=click.Path(exists=True, path_type=Path))
 @click.option("-o", "--output-dir", "out_dir", type=click.Path(file_okay=False, path_type=Path),
               default=Path("results"), show_default=True,
+              callback=_not_stdout("result files into a directory"),
               help="Directory for <study name>.h5 and the plots.")
 @click.option("-j", "--jobs", type=click.IntRange(1, 256), default=os.cpu_count() or 1,
               show_default=True, help="Studies run in parallel (local worker processes).")
@@ -447,6 +562,7 @@ def sweep(paths: tuple[Path, ...], out_dir: Path, jobs: int, dask_address: str |
 @click.argument("paths", nargs=-1, required=True, type=click.Path(path_type=Path))
 @click.option("-o", "--out-dir", type=click.Path(file_okay=False, path_type=Path),
               default=Path("figures"), show_default=True,
+              callback=_not_stdout("figures into a directory"),
               help="Directory for fig<n>.png and index.html.")
 @click.option("--results", "results_dir", type=click.Path(file_okay=False, path_type=Path),
               default=Path("results"), show_default=True,
@@ -518,6 +634,20 @@ def compare(file_a: Path, file_b: Path, rtol: float | None, atol: float | None,
     if differences:
         raise WhirlError(f"{file_a} and {file_b} differ ({len(differences)} difference(s))")
     click.echo(f"{file_a} and {file_b} agree")
+
+
+def _environment_names(group: click.Group) -> None:
+    """Let every option of every command of ``group`` come from the environment variable
+    ``WHIRL_<COMMAND>_<LONG OPTION>`` (``-`` as ``_``), e.g. ``WHIRL_SUMMARY_FORMAT=csv``,
+    ``WHIRL_RUN_PLOTS=0``; the command line wins over the environment."""
+    for name, command in group.commands.items():
+        for param in command.params:
+            if isinstance(param, click.Option) and param.envvar is None:
+                option = max(param.opts, key=len).lstrip("-")
+                param.envvar = f"{ENV_PREFIX}_{name}_{option}".upper().replace("-", "_")
+
+
+_environment_names(cli)
 
 
 def main() -> None:

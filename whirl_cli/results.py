@@ -8,10 +8,66 @@ SI units with physical time: angles in rad, rates in rad/s, periods in s, eigenv
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, is_dataclass
 from enum import IntEnum
 
 import numpy as np
+
+
+def _brief(value) -> str:
+    """A field's value in a short repr: an array as its shape and type, a collection of
+    results as its length, long text cut."""
+    if isinstance(value, np.ndarray):
+        return f"<{' x '.join(map(str, value.shape)) or 'scalar'} {value.dtype}>"
+    if isinstance(value, tuple | list) and value and is_dataclass(value[0]):
+        return f"<{len(value)} {type(value[0]).__name__}>"
+    if isinstance(value, dict) and len(repr(value)) > 60:
+        return f"<{len(value)} entries>"
+    text = repr(value)
+    return text if len(text) <= 60 else f"{text[:56]}...{text[-1]}"
+
+
+def _brief_repr(self) -> str:
+    """``Class(field=value, ...)`` with arrays and collections summarised (:func:`_brief`)."""
+    shown = ", ".join(f"{f.name}={_brief(getattr(self, f.name))}" for f in fields(self)
+                      if f.repr)
+    return f"{type(self).__name__}({shown})"
+
+
+def _tally(codes) -> str:
+    """The special points among point type ``codes``, counted by type in order of first
+    appearance: "2 HB, 1 BP" ("none")."""
+    counts: dict[str, int] = {}
+    for code in np.asarray(codes).ravel():
+        try:
+            kind = PointType(int(code))
+        except ValueError:
+            counts[str(int(code))] = counts.get(str(int(code)), 0) + 1
+            continue
+        if kind.is_special:
+            counts[kind.name] = counts.get(kind.name, 0) + 1
+    return ", ".join(f"{n} {name}" for name, n in counts.items()) or "none"
+
+
+def _named(members, name: str, what: tuple[str, str], owner: str):
+    """The member of ``members`` called ``name``; KeyError listing the names there are
+    (``what``: the members' noun, singular and plural)."""
+    for member in members:
+        if member.name == name:
+            return member
+    known = ", ".join(repr(m.name) for m in members) or "none"
+    raise KeyError(f"no {what[0]} {name!r} in {owner} ({what[1]}: {known})")
+
+
+def _html_table(caption: str, header: tuple[str, ...], rows) -> str:
+    """A small HTML table (the notebook view of a result)."""
+    from html import escape
+
+    head = "".join(f"<th>{escape(h)}</th>" for h in header)
+    body = "".join("<tr>" + "".join(f"<td>{escape(str(c))}</td>" for c in row) + "</tr>"
+                   for row in rows)
+    return (f"<table><caption style='text-align:left'><b>{escape(caption)}</b></caption>"
+            f"<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
 
 
 class PointType(IntEnum):
@@ -68,6 +124,20 @@ class PointType(IntEnum):
                             PointType.MX)
 
 
+def _type_name(code) -> str:
+    try:
+        return PointType(int(code)).name
+    except ValueError:
+        return str(int(code))
+
+
+def _is_special(code) -> bool:
+    try:
+        return PointType(int(code)).is_special
+    except ValueError:
+        return True
+
+
 class BranchKind:
     """Values of :attr:`Branch.kind`."""
 
@@ -94,6 +164,8 @@ class Orbit:
     period: float  # s, NaN for equilibria
     time: np.ndarray
     states: np.ndarray
+
+    __repr__ = _brief_repr
 
 
 #: :attr:`Branch.end` of a branch that used up its study's ``max_steps`` (AUTO's NMX) before
@@ -184,6 +256,35 @@ class Branch:
     def is_periodic(self) -> bool:
         return self.kind == BranchKind.PERIODIC
 
+    def __repr__(self) -> str:
+        return (f"Branch({self.name!r}, kind={self.kind!r}, points={len(self)}, "
+                f"parameters={self.parameter_names!r}, special points: "
+                f"{_tally(self.point_type)}, status={self.status!r})")
+
+    def _repr_html_(self) -> str:
+        rows = [(k, _type_name(self.point_type[k]), *(f"{v:.6g}" for v in self.parameters[k]),
+                 "yes" if self.stable[k] else "no") for k in range(len(self))
+                if _is_special(self.point_type[k])]
+        return _html_table(f"branch {self.name} ({self.kind}, {len(self)} points, "
+                           f"{self.status}): special points",
+                           ("point", "type", *self.parameter_names, "stable"), rows)
+
+    def to_dataframe(self):
+        """The branch as a pandas DataFrame: one row per point, one column per quantity and
+        state (``K_theta [N m/rad]``, ``theta max [rad]``, ``eigenvalue 1 [1/s]``, ...)."""
+        from .export.frames import dataframe
+        from .export.tables import branch_table
+
+        return dataframe(branch_table(self))
+
+    def to_xarray(self):
+        """The branch as an xarray Dataset over the dimensions ``point``, ``parameter``,
+        ``state`` and ``mode`` (as ``whirl export -o OUT.nc`` writes it)."""
+        from .export.frames import dataset
+        from .export.tables import branch_table
+
+        return dataset(branch_table(self))
+
 
 @dataclass(frozen=True)
 class SpecialPoint:
@@ -254,6 +355,8 @@ class LinearSweep:
     datum: float | None = None
     multiples: bool = False
 
+    __repr__ = _brief_repr
+
 
 @dataclass(frozen=True)
 class LinearGrid:
@@ -275,6 +378,8 @@ class LinearGrid:
     oscillatory: np.ndarray
     flutter: tuple[np.ndarray, ...]
     divergence: tuple[np.ndarray, ...]
+
+    __repr__ = _brief_repr
 
 
 @dataclass(frozen=True)
@@ -306,6 +411,8 @@ class Boundary:
     intervals: tuple[UnsafeInterval, ...]
     polygons: tuple[np.ndarray, ...]
     slices: tuple[float, ...]
+
+    __repr__ = _brief_repr
 
 
 @dataclass(frozen=True)
@@ -372,6 +479,8 @@ class FreeplayAmplitudes:
     #: (the linear flutter onset freeplay cycles undercut; empty where not computed)
     onset: np.ndarray = field(default_factory=lambda: np.empty(0))
 
+    __repr__ = _brief_repr
+
 
 @dataclass(frozen=True)
 class SeedOutcome:
@@ -425,6 +534,8 @@ class Exploration:
     broadband: float
     evidence: str
 
+    __repr__ = _brief_repr
+
 
 @dataclass(frozen=True)
 class ContinuationResult:
@@ -441,6 +552,33 @@ class ContinuationResult:
     freeplay: tuple[FreeplayAmplitudes, ...] = ()
     seeds: tuple[SeedOutcome, ...] = ()
     explorations: tuple[Exploration, ...] = ()
+
+    def branch(self, name: str) -> Branch:
+        """The branch called ``name`` (KeyError, listing the branches, if none is)."""
+        return _named(self.branches, name, ("branch", "branches"), f"continuation {self.name!r}")
+
+    def __getitem__(self, name: str) -> Branch:
+        return self.branch(name)
+
+    def __iter__(self):
+        return iter(self.branches)
+
+    def __contains__(self, name: object) -> bool:
+        return any(b.name == name for b in self.branches)
+
+    def __repr__(self) -> str:
+        return (f"ContinuationResult({self.name!r}, kind={self.kind!r}, branches="
+                f"{[b.name for b in self.branches]!r}, points="
+                f"{sum(len(b) for b in self.branches)}, special points: "
+                f"{_tally([p.point_type for p in self.special_points])})")
+
+    def _repr_html_(self) -> str:
+        rows = [(b.name, b.kind, len(b), _tally(b.point_type), b.status, b.end)
+                for b in self.branches]
+        return _html_table(f"continuation {self.name} ({self.kind}): special points "
+                           f"{_tally([p.point_type for p in self.special_points])}",
+                           ("branch", "kind", "points", "special points", "status", "end"),
+                           rows)
 
 
 @dataclass(frozen=True)
@@ -484,6 +622,8 @@ class Simulation:
     status: int
     message: str
 
+    __repr__ = _brief_repr
+
     @property
     def dof_names(self) -> tuple[str, ...]:
         """The degrees of freedom: the first half of the states (the rest are their rates)."""
@@ -504,3 +644,35 @@ class StudyResult:
     linear_grid: LinearGrid | None = None
     parameters: tuple[ParameterValue, ...] = ()  # the resolved set; () in schema-1 files
     simulations: tuple[Simulation, ...] = ()  # the study's ``simulations:``; () in older files
+
+    def continuation(self, name: str) -> ContinuationResult:
+        """The continuation called ``name`` (KeyError, listing them, if none is)."""
+        return _named(self.continuations, name, ("continuation", "continuations"),
+                      f"study {self.study_name!r}")
+
+    def __getitem__(self, name: str) -> ContinuationResult:
+        return self.continuation(name)
+
+    def __iter__(self):
+        return iter(self.continuations)
+
+    def __contains__(self, name: object) -> bool:
+        return any(c.name == name for c in self.continuations)
+
+    def __repr__(self) -> str:
+        parts = [f"{c.name} ({c.kind}, {len(c.branches)} branches, special points: "
+                 f"{_tally([p.point_type for p in c.special_points])})"
+                 for c in self.continuations]
+        extra = [f"{label}: {', '.join(names)}" for label, names in (
+            ("linear sweeps", [s.parameter for s in self.linear_sweeps]),
+            ("boundaries", [b.name for b in self.boundaries]),
+            ("simulations", [s.name for s in self.simulations])) if names]
+        return (f"StudyResult({self.study_name!r}, model={self.model!r}, continuations: "
+                f"{'; '.join(parts) or 'none'}" + "".join(f", {e}" for e in extra) + ")")
+
+    def _repr_html_(self) -> str:
+        rows = [(c.name, c.kind, len(c.branches), sum(len(b) for b in c.branches),
+                 _tally([p.point_type for p in c.special_points])) for c in self.continuations]
+        return _html_table(f"study {self.study_name} (model {self.model})",
+                           ("continuation", "kind", "branches", "points", "special points"),
+                           rows)

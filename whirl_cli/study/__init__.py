@@ -147,6 +147,7 @@ def _validate(text: str, name: str, path: str, folder: Path,
     if problems:
         raise StudyError(_report(problems, tree, name))
     study._source, study._sha256, study._path = text, hashlib.sha256(encoded).hexdigest(), path
+    study._read = dict(study.__dict__)
     return study
 
 

@@ -9,6 +9,7 @@ validates (:mod:`whirl_cli.study.resolve`).
 
 from __future__ import annotations
 
+import hashlib
 import math
 import operator
 import re
@@ -640,6 +641,8 @@ class Study(_Strict):
     _source: str = PrivateAttr("")
     _sha256: str = PrivateAttr("")
     _path: str = PrivateAttr("")
+    #: the field values ``_source`` describes (a copy with others is described by its own text)
+    _read: dict = PrivateAttr(default_factory=dict)
 
     @model_validator(mode="before")
     @classmethod
@@ -648,13 +651,23 @@ class Study(_Strict):
 
     @property
     def source(self) -> str:
-        """The YAML text the study was read from."""
-        return self._source
+        """The YAML text of this study: the text it was read from, or, for a study whose
+        values are not that text's (a ``model_copy(update=...)``, one built in code), its
+        values written as YAML (what a result stores must describe what was computed)."""
+        return self._source if self._as_read() else _yaml_text(self)
 
     @property
     def sha256(self) -> str:
-        """sha256 (hex) of the UTF-8 YAML text."""
-        return self._sha256
+        """sha256 (hex) of the UTF-8 YAML text :attr:`source`."""
+        if self._as_read():
+            return self._sha256
+        return hashlib.sha256(self.source.encode("utf-8")).hexdigest()
+
+    def _as_read(self) -> bool:
+        """Whether every field holds the value read from :attr:`_source`."""
+        fields, read = self.__dict__, self._read
+        return bool(read) and fields.keys() == read.keys() and all(
+            fields[key] is value or fields[key] == value for key, value in read.items())
 
     @property
     def path(self) -> str:
@@ -698,3 +711,12 @@ class Study(_Strict):
                 if value is not None:  # None: freeplay's K_out unset (the dof's datum)
                     values[name] = float(value)
         return values
+
+
+def _yaml_text(study: Study) -> str:
+    """``study``'s values as study YAML (those at their defaults left out); it validates to
+    the same values."""
+    import yaml
+
+    data = study.model_dump(mode="json", exclude_defaults=True)
+    return yaml.safe_dump(data, sort_keys=False, allow_unicode=True)

@@ -1,0 +1,95 @@
+"""The command line's conventions: a reader that leaves early is no error, ``-`` is standard
+input for a study and never an output name, options come from WHIRL_<COMMAND>_<OPTION>
+variables too, and shell completion works through the console script."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from ..conftest import ROOT, STUDIES
+
+REFERENCE = ROOT / "tests" / "regression" / "references" / "hardening_case2.h5"
+
+
+def whirl(*args, **kwargs) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "whirl_cli", *map(str, args)],
+                          capture_output=True, text=True, timeout=120, **kwargs)
+
+
+@pytest.mark.parametrize("args", [("models",), ("summary", REFERENCE, "--format", "json"),
+                                  ("--help",)])
+def test_a_reader_that_closes_the_pipe_early_is_not_an_error(args):
+    """As ``whirl models | head`` (the reader gone before whirl writes: whirl takes longer
+    to start than the pipe takes to close)."""
+    for _ in range(3):
+        process = subprocess.Popen([sys.executable, "-m", "whirl_cli", *map(str, args)],
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        process.stdout.close()
+        _, errors = process.communicate(timeout=120)
+        assert process.returncode == 0, errors.decode()
+        assert errors == b""
+
+
+def test_a_command_that_fails_still_says_so_when_its_reader_left():
+    """``whirl compare A B | head``: the reader's leaving does not hide the drift."""
+    airspeed = ROOT / "tests" / "regression" / "references" / "linear_datum_airspeed.h5"
+    process = subprocess.Popen([sys.executable, "-m", "whirl_cli", "compare", REFERENCE,
+                                airspeed], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    process.stdout.close()
+    _, errors = process.communicate(timeout=120)
+    assert process.returncode == 1 and b"differ (" in errors, errors
+
+
+def test_a_study_on_standard_input():
+    text = (STUDIES / "linear_case2.yaml").read_text()
+    done = whirl("validate", "-", input=text)
+    assert done.returncode == 0 and done.stdout.startswith("<stdin>: ok (model classical")
+    done = whirl("validate", "-", input="name: x\nmodel: nope\n")
+    assert done.returncode == 1 and done.stderr.startswith("<stdin>:2: model: unknown model")
+    done = subprocess.run([sys.executable, "-m", "whirl_cli", "validate", "-"],
+                          input=b"name: \xff\n", capture_output=True, timeout=120)
+    assert done.returncode == 1
+    assert done.stderr.decode() == "<stdin>: not UTF-8 text (byte 0xff at offset 6)\n"
+
+
+@pytest.mark.parametrize("args, what", [
+    (("run", STUDIES / "linear_case2.yaml", "-o", "-"), "an HDF5 file"),
+    (("export", REFERENCE, "-o", "-"), "files"),
+    (("plot", REFERENCE, "-o", "-"), "PNG files into a directory"),
+    (("sweep", STUDIES / "linear_case2.yaml", "-o", "-"), "result files into a directory"),
+    (("figures", ROOT / "sheets" / "thesis_ch3", "-o", "-"), "figures into a directory"),
+])
+def test_dash_is_never_an_output_name(tmp_path, args, what):
+    done = whirl(*args, cwd=tmp_path)
+    assert done.returncode == 1
+    assert done.stderr.strip().splitlines() == [
+        next(line for line in done.stderr.splitlines() if line.startswith("-o -: whirl "))]
+    assert f"writes {what}, not to standard output" in done.stderr
+    assert not list(tmp_path.iterdir())
+
+
+def test_options_from_the_environment():
+    done = whirl("summary", REFERENCE, env={**os.environ, "WHIRL_SUMMARY_FORMAT": "csv"})
+    assert done.returncode == 0 and done.stdout.startswith("continuation,branch,type,")
+    done = whirl("run", STUDIES / "linear_case2.yaml",
+                 env={**os.environ, "WHIRL_RUN_JOBS": "0"})
+    assert done.returncode == 2 and "0 is not in the range 1<=x<=64" in done.stderr
+    done = whirl("plot", REFERENCE, "--kind", "law",
+                 env={**os.environ, "WHIRL_PLOT_OUTPUT_DIR": "-"})
+    assert done.returncode == 1 and done.stderr.startswith("-o -: whirl plot writes")
+    done = whirl("summary", REFERENCE, "--format", "json",  # the command line wins
+                 env={**os.environ, "WHIRL_SUMMARY_FORMAT": "csv"})
+    assert done.returncode == 0 and done.stdout.startswith("[")
+
+
+def test_shell_completion_through_the_console_script():
+    env = {**os.environ, "_WHIRL_COMPLETE": "bash_complete", "COMP_WORDS": "whirl exp",
+           "COMP_CWORD": "1"}
+    done = subprocess.run([sys.executable, "-c", "import sys; sys.argv[0] = 'whirl'; "
+                           "from whirl_cli.entry import main; main()"],
+                          capture_output=True, text=True, timeout=60, env=env)
+    assert done.returncode == 0 and done.stdout.split() == ["plain,export"]
