@@ -202,13 +202,14 @@ class _Ended:
 def _end(family: _Family, model: Model, hopfs: list[SpecialPoint], bounds: tuple[float, float],
          numerics: Numerics, equilibria: list[Branch], parameters: dict[str, float]) -> _Ended:
     """Assemble ``family``'s pieces and say how it ends: a Hopf point, a period blow-up (a
-    bracketed global bifurcation), the range, ..."""
+    bracketed global bifurcation; never for a family that ends on a Hopf point, whose period
+    is that point's), the range, ..."""
     width = bounds[1] - bounds[0]
     scale = np.asarray(model.state_scale, dtype=float)
     whole, returned_to = _assembled(family, hopfs, width, scale)
     end, returned_to = _periodic_end(whole, model, hopfs, bounds, numerics, family, returned_to)
-    global_point = global_bifurcations.analyse(whole, model, parameters, equilibria,
-                                               family.period, width)
+    global_point = None if returned_to is not None else global_bifurcations.analyse(
+        whole, model, parameters, equilibria, family.period, width)
     if global_point is not None:
         end = f"period blow-up: {PointType(global_point.point_type).name.lower()} approach"
         if whole.status == "mx":  # AUTO's expected failure right at the blow-up
