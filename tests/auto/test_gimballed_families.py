@@ -6,7 +6,10 @@ each claim checked by an independent computation written here:
   periods, and no global bifurcation is reported on it;
 * the families from the Hopf points of the offset equilibria end at a genuine homoclinic orbit:
   the saddle's unstable manifold, integrated with scipy, returns onto the saddle at the value
-  whirl reports, and misses it well to either side.
+  whirl reports, and misses it well to either side;
+* the two mirror-image families of each +/- pair of Hopf points carry the same special points
+  (the model is odd: checked with numpy here), and the mirrored family's orbits are solutions
+  of the model (integrated over a period with scipy, they close).
 """
 
 from __future__ import annotations
@@ -116,3 +119,72 @@ def test_a_genuine_homoclinic_orbit_is_still_reported(combined):
     assert sides[sign] < 1e-4
     for offset in (-5e-4, 5e-4):
         assert _return_distance(study, star + offset, point.state, sign) > 1e-2
+
+
+def test_the_model_is_odd(combined):
+    """f(-y) = -f(y) at random states of a few typical amplitudes (the premise of mirror
+    images)."""
+    study, _ = combined
+    params = _params(study, 0.1)
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        y = rng.normal(scale=0.2, size=8)
+        np.testing.assert_allclose(MODEL.rhs_numpy(-y, params), -MODEL.rhs_numpy(y, params),
+                                   rtol=1e-12, atol=1e-12)
+
+
+def _mirror_pairs(continuation) -> list[tuple]:
+    """(family, its mirror image's family) for each Hopf point on secondary_1a."""
+    hopfs = [p for p in continuation.special_points if p.point_type == PointType.HB]
+    families = [b for b in continuation.branches if b.is_periodic]
+    pairs = []
+    for hopf in (h for h in hopfs if h.branch == "secondary_1a"):
+        (image,) = [h for h in hopfs if h.branch == "secondary_1b"
+                    and abs(h.parameters[0] - hopf.parameters[0]) < 1e-9]
+        pair = [next(f for f in families if f.origin.endswith(f"on {h.branch}")
+                     and abs(f.parameters[0, 0] - h.parameters[0]) < 1e-9)
+                for h in (hopf, image)]
+        pairs.append(tuple(pair))
+    return pairs
+
+
+def test_mirror_image_families_carry_the_same_special_points(combined):
+    """For both +/- pairs of Hopf points on the offset equilibria: the same special point
+    types, parameter values, periods and stability on both families, with mirrored states (the
+    maximum on one is minus the minimum on the other)."""
+    _, continuation = combined
+    pairs = _mirror_pairs(continuation)
+    assert len(pairs) == 2
+    for first, second in pairs:
+        points = [[p for p in continuation.special_points if p.branch == f.name]
+                  for f in (first, second)]
+        assert [p.type_name for p in points[0]] == [p.type_name for p in points[1]]
+        assert points[0] and len(points[0]) == len(points[1])
+        for a, b in zip(*points, strict=True):
+            assert a.parameters[0] == pytest.approx(b.parameters[0], abs=1e-9)
+            assert a.period == pytest.approx(b.period, rel=1e-9)
+            assert (a.stable, a.status) == (b.stable, b.status)
+        np.testing.assert_allclose(first.parameters, second.parameters, atol=1e-12)
+        np.testing.assert_allclose(first.state_max, -second.state_min, atol=1e-12)
+        np.testing.assert_array_equal(first.stable, second.stable)
+
+
+def test_the_mirrored_family_orbits_close_under_the_model(combined):
+    """The stored orbits of the families of secondary_1b with periods under 1 s (the longer
+    ones pass the saddle, too unstable to integrate over a period), integrated from their first
+    point over their period (scipy, rtol 1e-10), come back to it within 1e-5 of the orbit's
+    size."""
+    study, continuation = combined
+    scale = np.asarray(MODEL.state_scale)
+    orbits = [(mirrored.name, o) for _, mirrored in _mirror_pairs(continuation)
+              for o in mirrored.orbits if o.period < 1]
+    assert len(orbits) >= 2
+    for name, orbit in orbits:
+        params = _params(study, float(orbit.parameters[0]))
+        run = solve_ivp(lambda t, y, p=params: MODEL.rhs_numpy(y, p), (0, orbit.period),
+                        orbit.states[0], rtol=1e-10, atol=1e-12)
+        size = np.ptp(orbit.states / scale, axis=0).max()
+        miss = np.linalg.norm((run.y[:, -1] - orbit.states[0]) / scale)
+        print(f"\n  {name} at K1 = {orbit.parameters[0]:.6g}, T = {orbit.period:.4g} s: "
+              f"misses by {miss / size:.1e} of its size")
+        assert miss < 1e-5 * size
