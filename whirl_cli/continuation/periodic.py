@@ -139,8 +139,9 @@ def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
             continue  # the same family, already reached from another Hopf point (or its image)
         side = _mirrored(ended[sources[k]], k, hopfs, image) if k in sources else \
             _end(families[k], model, hopfs, bounds, numerics, equilibria, parameters)
-        if side.returned_to is not None:
-            reached |= {side.returned_to, image.get(side.returned_to, side.returned_to)}
+        if side.returned_to is not None:  # and the image of the family, to the image point
+            reached |= {side.returned_to} | ({image.get(side.returned_to, side.returned_to)}
+                                             if k in image else set())
         ended[k] = side
     kept, found = _collect(engine, name, bounds, parameters, hopfs,
                            [(side.branch, side.blowups()) for k, side in ended.items()
