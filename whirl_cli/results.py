@@ -286,16 +286,23 @@ class Branch:
         return dataset(branch_table(self))
 
 
+#: :attr:`SpecialPoint.status` of a point AUTO labelled that its own check says is not of
+#: that type (e.g. a TR point without a pair of Floquet multipliers on the unit circle).
+REJECTED = "rejected"
+
+
 @dataclass(frozen=True)
 class SpecialPoint:
     """A bifurcation or notable end on a branch.
 
-    ``status``: "located" (AUTO converged on it) or "bracketed" (estimated between points, e.g.
+    ``status``: "located" (AUTO converged on it), "bracketed" (estimated between points, e.g.
     a period blow-up, with ``bracket`` the interval of the principal parameter and ``residual``
-    the relative fit residual). ``criticality``: "supercritical" | "subcritical" | "" (Hopf
-    points: from the periodic family leaving it, else from ``lyapunov``). ``lyapunov``: first
-    Lyapunov coefficient of a Hopf point of equilibria [1/(s unit^2), SI states; < 0
-    supercritical], NaN otherwise (see :mod:`whirl_cli.analysis.normal_form`).
+    the relative fit residual) or :data:`REJECTED` (AUTO labelled it, but its own check says it
+    is not that kind of point; ``note`` says why). ``criticality``: "supercritical" |
+    "subcritical" | "" (Hopf points: from the periodic family leaving it, else from
+    ``lyapunov``). ``lyapunov``: first Lyapunov coefficient of a Hopf point of equilibria
+    [1/(s unit^2), SI states; < 0 supercritical], NaN otherwise (see
+    :mod:`whirl_cli.analysis.normal_form`).
     """
 
     branch: str

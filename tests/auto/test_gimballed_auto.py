@@ -21,7 +21,6 @@ from whirl_cli.analysis import linear
 from whirl_cli.auto import toolchain
 from whirl_cli.auto.codegen import fortran_source
 from whirl_cli.cli import cli
-from whirl_cli.continuation.branches import TORUS_TOLERANCE
 from whirl_cli.models import classical, get_model
 from whirl_cli.models.numeric import numeric_source
 from whirl_cli.output import store
@@ -220,29 +219,3 @@ def test_eight_state_codegen_and_compile_under_a_minute(tmp_path, monkeypatch):
     assert "import sympy" not in numeric and "N_STATES = 8" in numeric
     assert seconds < 60.0
     assert classical.FAMILY.name == "classical"  # the classical model is untouched by it
-
-
-def test_torus_points_store_the_angle_of_their_multipliers_on_the_unit_circle(combined):
-    """Every TR point AUTO reports either has a complex pair of Floquet multipliers on the
-    unit circle (AUTO's own multipliers, within 1e-2) and stores its angle in (0, pi), or has
-    none (all pairs off the circle by more than the tolerance) and says so in its note. The
-    shipped study's one TR (periodic_6, K_theta = 0.102, among folds of cycles near a
-    homoclinic orbit) is of the second kind: the test prints what it found."""
-    _, _, result = combined
-    (continuation,) = result.continuations
-    branches = {b.name: b for b in continuation.branches}
-    torus = [p for p in continuation.special_points if p.point_type == PointType.TR]
-    assert torus, "the shipped study has a TR point (periodic_6 near K_theta = 0.102)"
-    for point in torus:
-        multipliers = branches[point.branch].eigenvalues[point.index]
-        pair = multipliers[np.abs(multipliers.imag) > 1e-9]
-        off = np.abs(np.abs(pair) - 1).min() if pair.size else np.inf
-        print(f"\n  TR at K_theta = {point.parameters[0]:.6g}: multipliers "
-              f"{np.round(multipliers, 4)}; closest complex pair off the circle by {off:.3g}")
-        if off < 1e-2:
-            assert 0 < point.torus_angle < np.pi
-            on_circle = pair[np.argmin(np.abs(np.abs(pair) - 1))]
-            assert point.torus_angle == pytest.approx(abs(np.angle(on_circle)), abs=1e-12)
-        else:
-            assert off > TORUS_TOLERANCE and np.isnan(point.torus_angle)
-            assert "not a torus bifurcation" in point.note

@@ -171,17 +171,19 @@ def test_every_branch_says_how_it_ends():
     assert run_end(ended, {"NMX": 100}, model) == "AUTO end point"
 
 
-@pytest.mark.parametrize("name", ["hardening_case2", "linear_datum_airspeed"])
+@pytest.mark.parametrize("name", ["data/legacy_hardening_case2",
+                                  "regression/references/linear_datum_airspeed"])
 def test_a_schema_1_file_still_reads_and_plots(tmp_path, name):
-    """The committed references were written in schema 1 (no units on special points, no
-    parameter set): they read, with what they lack left empty, and every plot kind draws."""
+    """Files written in schema 1 (no units on special points, no parameter set; a committed
+    reference and an older result): they read, with what they lack left empty, and every plot
+    kind draws."""
     from click.testing import CliRunner
 
     from whirl_cli.cli import cli
 
     from ..conftest import ROOT
 
-    path = ROOT / "tests" / "regression" / "references" / f"{name}.h5"
+    path = ROOT / "tests" / f"{name}.h5"
     with store.opened(path) as handle:
         assert handle.attrs["whirl_schema"] == 1
     result = store.read(path)

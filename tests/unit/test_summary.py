@@ -62,14 +62,31 @@ def expected_rows(path, dofs) -> list[dict]:
                 period = float(points["period"][k])
                 row["period [s]"] = period if math.isfinite(period) else None
                 index = int(points["index"][k])
-                known = ("stability_known" not in branch
-                         or bool(branch["stability_known"][index]))
-                row["stability"] = ("unknown" if not known else
-                                    "stable" if bool(points["stable"][k]) else "unstable")
+                row["stability"] = expected_stability(branch, index, bool(points["stable"][k]),
+                                                      int(points["point_type"][k]))
                 row["criticality"] = text(points["criticality"][k])
                 row["status"] = text(points["status"][k])
                 rows.append(row)
     return rows
+
+
+def expected_stability(branch, index: int, stable: bool, point_type: int) -> str:
+    """"unknown" where the branch has no verdict at the point; on a fold (LP 2, LPC 5) whose
+    nearest known rows before and after it differ, "stable/unstable"; where they agree, their
+    verdict; else the point's own."""
+    flags = np.asarray(branch["stable"][()], dtype=bool)
+    known = (np.asarray(branch["stability_known"][()], dtype=bool)
+             if "stability_known" in branch else np.ones(len(flags), dtype=bool))
+    if not known[index]:
+        return "unknown"
+    rows = np.flatnonzero(known)
+    before, after = rows[rows < index], rows[rows > index]
+    if point_type in (2, 5) and len(before) and len(after):
+        sides = {bool(flags[before[-1]]), bool(flags[after[0]])}
+        if len(sides) == 2:
+            return "stable/unstable"
+        stable = sides.pop()
+    return "stable" if stable else "unstable"
 
 
 def same_rows(got: list[dict], expected: list[dict]) -> None:
@@ -185,6 +202,26 @@ def test_any_model_states_in_their_own_units(tmp_path):
     assert rows[0]["q1 [m]"] == 0.5 and rows[0]["stability"] == "unknown"
     assert rows[1]["period [s]"] == 2.25 and rows[1]["stability"] == "unstable"
     assert "dq1 [m/s]" not in rows[0]
+
+
+def test_a_fold_row_shows_the_stability_of_both_sides():
+    """A fold of cycles between a stable and an unstable side says so, whatever AUTO's flag at
+    the fold itself; between two unstable sides it is unstable; a Hopf point keeps its own."""
+    from whirl_cli.output.summary import summary_rows
+
+    result = oscillator_result()
+    (continuation,) = result.continuations
+    family = replace(continuation.branches[1], stable=np.array([True, False, False]),
+                     stability_known=np.ones(3, bool))
+    fold = replace(continuation.special_points[2], index=1, stable=True)
+    seen = []
+    for first in (True, False):
+        branch = replace(family, stable=np.array([first, False, False]))
+        changed = replace(continuation, branches=(continuation.branches[0], branch),
+                          special_points=(continuation.special_points[0], fold))
+        rows = summary_rows(replace(result, continuations=(changed,)))
+        seen.append([r.stability for r in rows])
+    assert seen == [["unknown", "stable/unstable"], ["unknown", "unstable"]]
 
 
 @pytest.mark.parametrize("content, reason", [

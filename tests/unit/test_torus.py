@@ -25,3 +25,31 @@ def test_a_pair_off_the_unit_circle_is_no_torus():
     near = np.array([1.0, (1 + TORUS_TOLERANCE / 2) * np.exp(1j), (1 + TORUS_TOLERANCE / 2)
                      * np.exp(-1j)])
     assert neimark_sacker_angle(near) == pytest.approx(1.0)
+
+
+def _periodic_with_tr(multipliers: np.ndarray):
+    from whirl_cli.results import Branch, BranchKind, PointType
+
+    rows = 3
+    eigenvalues = np.tile(multipliers, (rows, 1))
+    return Branch("periodic_1", BranchKind.PERIODIC, "test", ("V",), ("m/s",),
+                  ("theta", "psi", "theta_dot", "psi_dot"), ("rad",) * 2 + ("rad/s",) * 2,
+                  np.array([[8.0], [8.1], [8.2]]), np.ones((rows, 4)), -np.ones((rows, 4)),
+                  np.ones(rows), np.full(rows, 0.2), np.zeros(rows, bool),
+                  np.array([0, int(PointType.TR), 0]), np.array([0, 2, 0]), eigenvalues)
+
+
+def test_a_tr_point_without_a_pair_on_the_unit_circle_is_listed_as_rejected():
+    """AUTO's torus test function also changes sign at a neutral saddle (a real pair with
+    product 1): that TR point is listed as rejected, its note says why, and it has no angle;
+    one with a complex pair on the circle is located with its angle."""
+    from whirl_cli.continuation.branches import special_points
+    from whirl_cli.results import REJECTED
+
+    saddle = np.array([1.0, 4.0, 0.25, 0.1])
+    (rejected,) = special_points(_periodic_with_tr(saddle))
+    assert rejected.status == REJECTED and np.isnan(rejected.torus_angle)
+    assert "not a torus bifurcation" in rejected.note
+    torus = np.array([1.0, np.exp(0.7j), np.exp(-0.7j), 0.1])
+    (located,) = special_points(_periodic_with_tr(torus))
+    assert located.status == "located" and located.torus_angle == pytest.approx(0.7)

@@ -4,6 +4,9 @@ When the period of a family grows without bound while the parameter converges to
 spends longer and longer near one or more saddle equilibria. From the family's last points and
 its last stored orbit profile this module
 
+* tells a blow-up from a family that only changes frequency: the period has grown to the
+  family's end (not on a Hopf point: the caller does not ask then) and the longest orbit spends
+  at least :data:`LINGER_SHARE` of its period near saddles;
 * names the equilibria the orbit lingers near: one saddle -> homoclinic, a +/- pair of saddles
   (symmetric model) -> heteroclinic;
 * estimates p* with the saddle scaling law T = C - ln|p - p*| / lambda_u (lambda_u: the saddle's
@@ -26,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..models import Model
-from ..results import Branch, BranchKind, PointType, SpecialPoint
+from ..results import Branch, BranchKind, Orbit, PointType, SpecialPoint
 
 #: A family is in blow-up when its period exceeds this multiple of the reference period.
 BLOWUP_FACTOR = 3.0
@@ -39,6 +42,13 @@ BLOWUP_FACTOR = 3.0
 STALL_FACTOR = 2.0
 #: An orbit lingers near an equilibrium it passes within this fraction of its own size.
 LINGER_FRACTION = 0.05
+#: ... and a period has blown up only if the orbit spends at least this share of it that near
+#: saddles (the share tends to 1 as the period grows without bound; an orbit whose period has
+#: grown because the family has reached another, slower mode spends none).
+LINGER_SHARE = 0.25
+#: The period has grown to the family's end if its last point's is at least this share of the
+#: family's longest.
+END_SHARE = 0.9
 
 
 @dataclass(frozen=True)
@@ -192,18 +202,39 @@ def equilibria_at(value: float, equilibria: list[Branch], amplitudes: np.ndarray
     return found
 
 
+def _distances(model: Model, orbit_states: np.ndarray, state: np.ndarray) -> np.ndarray:
+    """Distance of each orbit point from ``state`` as a fraction of the orbit's size (AUTO's
+    non-dimensional states)."""
+    scale = np.asarray(model.state_scale)
+    points = orbit_states / scale
+    return np.linalg.norm(points - state / scale, axis=1) / np.ptp(points, axis=0).max()
+
+
 def lingering(model: Model, orbit_states: np.ndarray, candidates: list[np.ndarray]
               ) -> list[np.ndarray]:
     """The candidate equilibria the orbit passes within LINGER_FRACTION of its size."""
-    scale = np.asarray(model.state_scale)
-    points = orbit_states / scale
-    size = np.ptp(points, axis=0).max()
-    near = []
-    for state in candidates:
-        distance = np.linalg.norm(points - state / scale, axis=1).min()
-        if distance < LINGER_FRACTION * size:
-            near.append(state)
-    return near
+    return [state for state in candidates
+            if _distances(model, orbit_states, state).min() < LINGER_FRACTION]
+
+
+def time_share(model: Model, orbit: Orbit, states: list[np.ndarray]) -> float:
+    """The share of the orbit's period it spends within LINGER_FRACTION of its size of any of
+    ``states``."""
+    if not states:
+        return 0.0
+    near = np.any([_distances(model, orbit.states, s) < LINGER_FRACTION for s in states],
+                  axis=0)
+    time = np.asarray(orbit.time, dtype=float)
+    inside = np.diff(time)[near[:-1] & near[1:]].sum() \
+        + 0.5 * np.diff(time)[near[:-1] ^ near[1:]].sum()
+    return float(inside / (time[-1] - time[0]))
+
+
+def grows_to_end(family: Branch) -> bool:
+    """True if the family's period has grown to its end (its last point's period is at least
+    END_SHARE of its longest)."""
+    periods = family.period[np.isfinite(family.period)]
+    return bool(len(periods)) and periods[-1] >= END_SHARE * periods.max()
 
 
 def unstable_rate(model: Model, params: np.ndarray, state: np.ndarray) -> float:
@@ -216,35 +247,37 @@ def unstable_rate(model: Model, params: np.ndarray, state: np.ndarray) -> float:
 def analyse(family: Branch, model: Model, parameters: dict[str, float],
             equilibria: list[Branch], reference_period: float, width: float
             ) -> SpecialPoint | None:
-    """The global bifurcation a blowing-up family approaches, as a bracketed special point: one
-    whose period exceeds BLOWUP_FACTOR times ``reference_period``, or one :func:`stalled` with
-    its orbit lingering near a saddle."""
-    blown = in_blowup(family, reference_period)
-    if not blown and not stalled(family, reference_period):
+    """The global bifurcation a blowing-up family approaches, as a bracketed special point, or
+    None. Blowing up: its period has grown beyond BLOWUP_FACTOR times ``reference_period`` (or
+    beyond STALL_FACTOR where AUTO stopped it, :func:`stalled`) and up to its end, and its
+    longest orbit spends at least LINGER_SHARE of its period near saddles. A family that ends
+    on a Hopf point is none: the caller does not ask."""
+    grown = in_blowup(family, reference_period) or stalled(family, reference_period)
+    if not grown or not grows_to_end(family) or not family.orbits:
         return None
     name = family.parameter_names[0]
     last = int(np.nanargmax(family.period))
     value = float(family.parameters[last, 0])
     params = model.parameter_vector({**parameters, name: value})
-    orbit = max(family.orbits, key=lambda o: o.period) if family.orbits else None
+    orbit = max(family.orbits, key=lambda o: o.period)
     amplitudes = np.tile([dof.amplitude for dof in model.dofs], 2)
-    near = lingering(model, orbit.states, equilibria_at(value, equilibria, amplitudes)) \
-        if orbit else []
+    near = lingering(model, orbit.states, equilibria_at(value, equilibria, amplitudes))
     saddles = [(s, unstable_rate(model, params, s)) for s in near]
     saddles = [(s, rate) for s, rate in saddles if rate > 0]
-    if not blown and not saddles:
+    share = time_share(model, orbit, [s for s, _ in saddles])
+    if share < LINGER_SHARE:
         return None
     if len(saddles) >= 2:
         kind, what = PointType.HETEROCLINIC, "heteroclinic"
     else:
         kind, what = PointType.HOMOCLINIC, "homoclinic"
-    rate = max((r for _, r in saddles), default=None)
+    rate = max(r for _, r in saddles)
     fit = fit_blowup(family.parameters[:, 0], family.period, rate, reference_period, width)
     estimate = fit.log_estimate if fit else value
     bracket = np.array(fit.bracket if fit else (value, value))
     described = ", ".join("(" + ", ".join(f"{x:.4g}" for x in s[:2]) + ")" for s, _ in saddles)
-    note = (f"period blow-up ({what} approach): orbit lingers near saddle(s) {described or 'none'}"
-            f"; lambda_u = {rate or float('nan'):.4g} 1/s")
+    note = (f"period blow-up ({what} approach): orbit lingers near saddle(s) {described} "
+            f"({share:.0%} of its period); lambda_u = {rate:.4g} 1/s")
     if fit and np.isnan(fit.residual):
         note += (f"; the parameter oscillates (snaking, saddle-focus): p* ~ {estimate:.8g} "
                  f"between the last folds {bracket[0]:.8g} and {bracket[1]:.8g}")
@@ -252,11 +285,10 @@ def analyse(family: Branch, model: Model, parameters: dict[str, float],
         note += (f"; p* = {fit.log_estimate:.8g} (T = C - ln|p - p*|/lambda_u), "
                  f"{fit.hyperbolic_estimate:.8g} (T = A/|p* - p| + B); "
                  f"relative rms residual {fit.residual:.2g} over {fit.n_points} points")
-    state = saddles[0][0] if saddles else family.state_max[last]
     return SpecialPoint(
         branch=family.name, index=last, point_type=int(kind),
         parameter_names=family.parameter_names, parameters=np.array([estimate]),
         parameter_units=family.parameter_units,
-        state=np.asarray(state, dtype=float), period=float(family.period[last]),
+        state=np.asarray(saddles[0][0], dtype=float), period=float(family.period[last]),
         stable=False, status="bracketed", note=note, bracket=bracket,
         residual=fit.residual if fit else float("nan"))

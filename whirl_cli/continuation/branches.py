@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..models import Model
-from ..results import Branch, PointType, SpecialPoint
+from ..results import REJECTED, Branch, PointType, SpecialPoint
 
 #: The per-point columns of a :class:`Branch` (one row per point); ``torus_angle`` is one
 #: only on torus loci (None elsewhere).
@@ -93,13 +93,13 @@ def neimark_sacker_angle(multipliers: np.ndarray) -> float:
 
 
 def _torus(branch: Branch, index: int) -> dict:
-    """A TR point's ``torus_angle``, and a ``note`` if its multipliers (known) have no pair
-    on the unit circle."""
+    """A TR point's ``torus_angle``; if its multipliers (known) have no pair on the unit
+    circle, the status REJECTED and a ``note`` saying why."""
     multipliers = branch.eigenvalues[index]
     angle = neimark_sacker_angle(multipliers)
     if not np.isfinite(multipliers).any() or np.isfinite(angle):
         return {"torus_angle": angle}
-    return {"torus_angle": angle,
+    return {"torus_angle": angle, "status": REJECTED,
             "note": "no complex pair of Floquet multipliers on the unit circle: AUTO's torus "
                     "test function changed sign without a Neimark-Sacker pair (not a torus "
                     "bifurcation)"}

@@ -22,6 +22,7 @@ from .branches import amplitude, head, join, reverse, special_points
 from .engine import Engine, Numerics, RunSpec, _read
 from .equilibria import equilibrium_constants
 from .homoclinic import locate_homoclinics
+from .mirror import mirror_sources, mirrored_branch, mirrored_point
 
 #: A periodic run from a Hopf point first stops once the orbit has grown to this amplitude
 #: (AUTO's non-dimensional units, the PVLS ``amplitude``).
@@ -97,47 +98,84 @@ def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
     Hopf point is the family reaching that Hopf point (AUTO would go on round the closed family
     again); there the family ends. Families that reach each other's Hopf points are one family,
     kept once. A family whose period blows up ends there, with a bracketed global bifurcation.
+    Of a symmetric model, the family of a Hopf point that mirrors an earlier one is that one's
+    mirror image (:mod:`.mirror`), not computed again.
     """
     model = engine.model
     width = bounds[1] - bounds[0]
     scale = np.asarray(model.state_scale, dtype=float)
     hopfs = [p for p in points if p.point_type == PointType.HB]
+    sources = mirror_sources(model, hopfs, width, parameters)
     runs = {b.name: b.run for b in equilibria}
-    families = []
-    for k, hopf in enumerate(hopfs, 1):
+    families: dict[int, _Family] = {}
+    for k, hopf in enumerate(hopfs):
+        if k in sources:
+            continue
         constants = periodic_constants(model, numerics, parameter, bounds,
                                        hopf.period * model.time_scale)
         constants["UZSTOP"][AMPLITUDE] = GROWN_AMPLITUDE
-        spec = RunSpec(f"{name}/periodic_{k}.0", constants, BranchKind.PERIODIC,
-                       f"HB at {parameter} = {hopf.parameters[0]:.6g} on {hopf.branch}",
-                       (parameter,), restart=(runs[hopf.branch], hopf.label))
-        families.append(_Family(f"periodic_{k}", hopf.period, spec, [], hopf=k - 1,
-                                grows=True))
+        spec = RunSpec(f"{name}/periodic_{k + 1}.0", constants, BranchKind.PERIODIC,
+                       _hopf_origin(hopf), (parameter,), restart=(runs[hopf.branch], hopf.label))
+        families[k] = _Family(f"periodic_{k + 1}", hopf.period, spec, [], hopf=k, grows=True)
 
-    _continue(engine, families, hopfs, width)
+    _continue(engine, list(families.values()), hopfs, width)
     # On too coarse a mesh AUTO can turn back along a family of long orbits and retrace it to
     # its own Hopf point (combined case 5 at 40 mesh intervals): such families are computed
     # once more on a finer mesh, kept if they then do not come back
     again = [replace(f, pieces=[], retries=0, spec=replace(
         f.spec, name=f"{name}/{f.name}m.0",
         constants=dict(f.spec.constants, NTST=RETRACE_MESH_FACTOR * f.spec.constants["NTST"])))
-        for f in families if _back_at_own_hopf(f, hopfs, width, scale)]
+        for f in families.values() if _back_at_own_hopf(f, hopfs, width, scale)]
     _continue(engine, again, hopfs, width)
     for family in again:
         if not _back_at_own_hopf(family, hopfs, width, scale):
             families[family.hopf] = family
 
-    ended: list[_Ended] = []
+    image = {**sources, **{j: k for k, j in sources.items()}}
+    ended: dict[int, _Ended] = {}
     reached: set[int] = set()
-    for family in families:
-        if family.hopf in reached:
-            continue  # the same family, already reached from another Hopf point
-        side = _end(family, model, hopfs, bounds, numerics, equilibria, parameters)
-        if side.returned_to is not None:
-            reached.add(side.returned_to)
-        ended.append(side)
-    return _collect(engine, name, bounds, parameters, hopfs,
-                    [(side.branch, side.blowups()) for side in ended], skip_first=True)
+    for k in range(len(hopfs)):
+        if k in reached or (k in sources and sources[k] not in ended):
+            continue  # the same family, already reached from another Hopf point (or its image)
+        side = _mirrored(ended[sources[k]], k, hopfs, image) if k in sources else \
+            _end(families[k], model, hopfs, bounds, numerics, equilibria, parameters)
+        if side.returned_to is not None:  # and the image of the family, to the image point
+            reached |= {side.returned_to} | ({image.get(side.returned_to, side.returned_to)}
+                                             if k in image else set())
+        ended[k] = side
+    kept, found = _collect(engine, name, bounds, parameters, hopfs,
+                           [(side.branch, side.blowups()) for k, side in ended.items()
+                            if k not in sources], skip_first=True)
+    for k in sorted(set(ended) & set(sources)):
+        source, branch = ended[sources[k]].branch, ended[k].branch
+        found += [mirrored_point(p, branch) for p in found if p.branch == source.name]
+        kept.append(branch)
+    order = {f"periodic_{k + 1}": k for k in ended}
+    kept.sort(key=lambda b: order[b.name])
+    return kept, sorted(found, key=lambda p: order[p.branch])
+
+
+def _hopf_origin(hopf: SpecialPoint) -> str:
+    """The origin of the family of ``hopf``."""
+    return f"HB at {hopf.parameter_names[0]} = {hopf.parameters[0]:.6g} on {hopf.branch}"
+
+
+def _mirrored(side: _Ended, k: int, hopfs: list[SpecialPoint], image: dict[int, int]
+              ) -> _Ended:
+    """The family of Hopf point ``k``, the mirror image of ``side`` (that of k's image)."""
+    returned = None if side.returned_to is None else image.get(side.returned_to,
+                                                               side.returned_to)
+    end = side.branch.end if returned is None else \
+        _return_end(side.branch.parameter_names[0], hopfs, returned, own=returned == k)
+    branch = mirrored_branch(side.branch, f"periodic_{k + 1}", _hopf_origin(hopfs[k]), end)
+    return _Ended(branch, None, returned)
+
+
+def _return_end(parameter: str, hopfs: list[SpecialPoint], returned: int, own: bool) -> str:
+    """The end of a family that returns to Hopf point ``returned`` (``own``: its start)."""
+    hopf = hopfs[returned]
+    which = "its own HB" if own else "HB"
+    return f"returns to {which} at {parameter} = {hopf.parameters[0]:.6g} on {hopf.branch}"
 
 
 def orbit_families(engine: Engine, name: str, parameter: str, bounds: tuple[float, float],
@@ -202,13 +240,14 @@ class _Ended:
 def _end(family: _Family, model: Model, hopfs: list[SpecialPoint], bounds: tuple[float, float],
          numerics: Numerics, equilibria: list[Branch], parameters: dict[str, float]) -> _Ended:
     """Assemble ``family``'s pieces and say how it ends: a Hopf point, a period blow-up (a
-    bracketed global bifurcation), the range, ..."""
+    bracketed global bifurcation; never for a family that ends on a Hopf point, whose period
+    is that point's), the range, ..."""
     width = bounds[1] - bounds[0]
     scale = np.asarray(model.state_scale, dtype=float)
     whole, returned_to = _assembled(family, hopfs, width, scale)
     end, returned_to = _periodic_end(whole, model, hopfs, bounds, numerics, family, returned_to)
-    global_point = global_bifurcations.analyse(whole, model, parameters, equilibria,
-                                               family.period, width)
+    global_point = None if returned_to is not None else global_bifurcations.analyse(
+        whole, model, parameters, equilibria, family.period, width)
     if global_point is not None:
         end = f"period blow-up: {PointType(global_point.point_type).name.lower()} approach"
         if whole.status == "mx":  # AUTO's expected failure right at the blow-up
@@ -423,10 +462,8 @@ def _periodic_end(family: Branch, model: Model, hopfs: list[SpecialPoint],
     if returned is None:
         returned = returned_to
     if returned is not None:
-        hopf = hopfs[returned]
-        which = "its own HB" if returned == state.hopf else "HB"
-        return (f"returns to {which} at {family.parameter_names[0]} = "
-                f"{hopf.parameters[0]:.6g} on {hopf.branch}"), returned
+        return _return_end(family.parameter_names[0], hopfs, returned,
+                           returned == state.hopf), returned
     if family.point_type[-1] == PointType.MX:
         return "no convergence (MX)", None
     if family.period[-1] >= 0.999 * PERIOD_CAP * state.period:

@@ -57,8 +57,9 @@ class Quantity:
 class SummaryRow:
     """One special point as the summary shows it.
 
-    ``stability``: "stable", "unstable" or "unknown" (where the branch has no stability
-    verdict at the point, e.g. on loci); ``period``: s, NaN where there is none.
+    ``stability``: "stable", "unstable", :data:`ONE_SIDE_STABLE` (a fold whose two sides
+    differ) or "unknown" (where the branch has no stability verdict at the point, e.g. on
+    loci); ``period``: s, NaN where there is none.
     """
 
     continuation: str
@@ -145,11 +146,37 @@ def _amplitudes(point: SpecialPoint, branch: Branch | None, dofs: Sequence[str] 
     return tuple(amplitudes)
 
 
+#: The stability shown on a fold (LP, LPC) whose two sides differ.
+ONE_SIDE_STABLE = "stable/unstable"
+
+
 def _stability(point: SpecialPoint, branch: Branch | None) -> str:
-    if branch is not None and 0 <= point.index < len(branch) \
-            and not branch.stability_known[point.index]:
+    """The point's stability; on a fold that of the branch on either side of it (one side
+    stable, the other not, or both the same)."""
+    on_branch = branch is not None and 0 <= point.index < len(branch)
+    if on_branch and not branch.stability_known[point.index]:
         return "unknown"
-    return "stable" if point.stable else "unstable"
+    sides = _sides(branch, point.index) if on_branch and point.point_type in FOLDS else ()
+    if len(sides) == 2:
+        return ONE_SIDE_STABLE if sides[0] != sides[1] else _verdict(sides[0])
+    return _verdict(point.stable)
+
+
+def _verdict(stable: bool) -> str:
+    return "stable" if stable else "unstable"
+
+
+#: Fold points, shown with the stability of both sides.
+FOLDS = (PointType.LP, PointType.LPC)
+
+
+def _sides(branch: Branch, index: int) -> tuple[bool, ...]:
+    """The branch's stability at the nearest row with a known verdict before and after
+    ``index`` (fewer where it has none on a side)."""
+    known = np.flatnonzero(branch.stability_known)
+    before, after = known[known < index], known[known > index]
+    return tuple(bool(branch.stable[rows[k]]) for rows, k in ((before, -1), (after, 0))
+                 if len(rows))
 
 
 # ---------------------------------------------------------------------------- flat records

@@ -1,0 +1,81 @@
+"""Mirror images of a symmetric model (equations invariant under y -> -y): Hopf points in +/-
+pairs, and a periodic family of one mapped onto the other's instead of computed again, so the
+two carry the same special points by construction.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..models import Model
+from ..results import Branch, PointType, SpecialPoint
+from .branches import _joined, typical_amplitudes
+
+#: Mirror Hopf points agree to this fraction of the range in the parameter, this many typical
+#: amplitudes (or relatively) in the state and relatively in the period.
+MIRROR_TOLERANCE = 1e-6
+
+
+def is_odd(model: Model, parameters: np.ndarray, states: list[np.ndarray]) -> bool:
+    """True if the model's right-hand side is odd, f(-y) = -f(y), at ``states`` and at each
+    dof displaced by a typical amplitude (the premise of mapping mirror images)."""
+    amplitudes = typical_amplitudes(model)
+    probes = list(states) + [np.where(np.arange(model.n_states) == k, amplitudes, 0.0)
+                             for k in range(model.n_states)]
+    for y in probes:
+        forward = model.rhs_numpy(np.asarray(y, dtype=float), parameters)
+        backward = model.rhs_numpy(-np.asarray(y, dtype=float), parameters)
+        if not np.allclose(backward, -forward, rtol=1e-9, atol=1e-12 * (1 + abs(forward).max())):
+            return False
+    return True
+
+
+def mirror_sources(model: Model, hopfs: list[SpecialPoint], width: float,
+                   parameters: dict[str, float]) -> dict[int, int]:
+    """{k: j} for every Hopf point k that is the mirror image of an earlier one j (same
+    parameter and period, opposite state off y = 0), where the model is symmetric and its
+    right-hand side odd there; Hopf points on y = 0 are their own images and map to none."""
+    if not model.symmetric:
+        return {}
+    amplitudes = typical_amplitudes(model)
+    sources: dict[int, int] = {}
+    for k, hopf in enumerate(hopfs):
+        for j, other in enumerate(hopfs[:k]):
+            if j in sources or not _mirrors(hopf, other, width, amplitudes):
+                continue
+            name = hopf.parameter_names[0]
+            params = model.parameter_vector({**parameters, name: float(hopf.parameters[0])})
+            if is_odd(model, params, [hopf.state]):
+                sources[k] = j
+            break
+    return sources
+
+
+def _mirrors(a: SpecialPoint, b: SpecialPoint, width: float, amplitudes: np.ndarray) -> bool:
+    """True if ``a`` and ``b`` are each other's mirror images, off y = 0."""
+    sa, sb = a.state / amplitudes, b.state / amplitudes
+    return (np.abs(sa).max() > 1e-3
+            and abs(a.parameters[0] - b.parameters[0]) <= MIRROR_TOLERANCE * width
+            and abs(a.period - b.period) <= MIRROR_TOLERANCE * abs(b.period)
+            and np.allclose(sa, -sb, rtol=MIRROR_TOLERANCE, atol=MIRROR_TOLERANCE))
+
+
+def mirrored_branch(branch: Branch, name: str, origin: str, end: str) -> Branch:
+    """The mirror image of a periodic ``branch``: states negated (the maxima are the negated
+    minima), everything else the same; named ``name``, from ``origin``, ending as ``end``
+    says."""
+    return replace(branch, name=name, origin=origin, end=end,
+                   state_max=-branch.state_min, state_min=-branch.state_max,
+                   message=_joined(branch.message, f"mirror image (y -> -y) of {branch.name}"),
+                   orbits=tuple(replace(o, states=-o.states) for o in branch.orbits))
+
+
+def mirrored_point(point: SpecialPoint, branch: Branch) -> SpecialPoint:
+    """The mirror image of ``point`` on the mirrored ``branch``: a global bifurcation's state
+    (its saddle) negated, a point of the family its maximum there."""
+    state = -point.state if point.point_type in (PointType.HOMOCLINIC, PointType.HETEROCLINIC) \
+        else branch.state_max[point.index]
+    note = f"mirror image of the point on {point.branch} ({point.note})" if point.note else ""
+    return replace(point, branch=branch.name, state=np.array(state, dtype=float), note=note)
