@@ -22,7 +22,7 @@ from whirl_cli.auto import toolchain
 from whirl_cli.auto.codegen import fortran_source
 from whirl_cli.cli import cli
 from whirl_cli.continuation.branches import TORUS_TOLERANCE
-from whirl_cli.models import classical, get_model
+from whirl_cli.models import FAMILIES, get_model
 from whirl_cli.models.numeric import numeric_source
 from whirl_cli.output import store
 from whirl_cli.pipeline import run_study
@@ -219,7 +219,7 @@ def test_eight_state_codegen_and_compile_under_a_minute(tmp_path, monkeypatch):
     assert executable.compiled and Path(executable.path).exists()
     assert "import sympy" not in numeric and "N_STATES = 8" in numeric
     assert seconds < 60.0
-    assert classical.FAMILY.name == "classical"  # the classical model is untouched by it
+    assert FAMILIES["classical"].name == "classical"  # the classical model is untouched by it
 
 
 def test_torus_points_store_the_angle_of_their_multipliers_on_the_unit_circle(combined):
