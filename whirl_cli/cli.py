@@ -222,7 +222,7 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     found = verdict(result, published.plot_error)
     for note in found.notes:
         _say(f"note: {note}")
-    _tell(render(result, "table", study.variant().family.dof_names), end="")
+    _tell(render(result, "table"), end="")
     checks = [x for c in result.continuations for x in c.cross_checks]
     if checks:
         _tell(f"cross-checks by time simulation: {sum(x.passed for x in checks)} of "
@@ -260,11 +260,7 @@ def summary(result_file: Path, output_format: str) -> None:
         raise OutputError(f"{result_file}: no such file")
     if result_file.is_dir():
         raise OutputError(f"{result_file}: is a directory, not a result file")
-    result = api.read(result_file)
-    study = _stored_study(result)
-    dofs = study.variant().family.dof_names if study is not None else None
-
-    click.echo(render(result, output_format, dofs), nl=False)
+    click.echo(render(api.read(result_file), output_format), nl=False)
 
 
 # ------------------------------------------------------------------------------------ export

@@ -126,7 +126,9 @@ def _stages(study: Study, model, parameters: dict[str, float], workroot: Path, j
             return one_parameter(
                 engine, name, spec.parameter, spec.start, tuple(spec.range), values,
                 numerics, branch_points=spec.branch_points, periodic=spec.periodic,
-                orbits_at=spec.orbits_at, start_orbits=starts)
+                orbits_at=spec.orbits_at, start_orbits=starts,
+                start_state=None if spec.start_state is None
+                else seeds.seed_state(model, spec.start_state))
 
         continuation = replace(continued(spec.name, parameters), seeds=outcomes)
         if model.smoothing_parameters:
@@ -268,13 +270,14 @@ def explorations(model, overrides: dict[str, float], spec,
     from .study.schema import EXPLORE_OFFSET
 
     parameter = model.parameter(model.canonical(spec.parameter))
+    first = model.state_names[model.positions[0]]  # the first dof (or first-order state)
     given = spec.explore_initial if spec.explore_initial is not None else {
-        model.dofs[0].name: EXPLORE_OFFSET}
+        first: EXPLORE_OFFSET}
     y0 = seeds.seed_state(model, given)
     names = tuple(s.name for s in model.states)
     units = tuple(s.unit for s in model.states)
     section = names.index(spec.explore_section if spec.explore_section is not None
-                          else model.dofs[0].rate)
+                          else model.dofs[0].rate if model.dofs else first)
 
     def one(k: int) -> Exploration:
         value = spec.explore[k]

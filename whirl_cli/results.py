@@ -628,13 +628,29 @@ class Simulation:
     hub_unit: str
     status: int
     message: str
+    first_order: tuple[str, ...] = ()  # the model's (the file's root attribute)
 
     __repr__ = _brief_repr
 
     @property
     def dof_names(self) -> tuple[str, ...]:
-        """The degrees of freedom: the first half of the states (the rest are their rates)."""
-        return self.state_names[: len(self.state_names) // 2]
+        """The states drawn by default: every state but the dofs' rates."""
+        return positions(self.state_names, self.first_order)
+
+
+def first_order_states(attributes: dict) -> tuple[str, ...]:
+    """The first-order states named by a result file's root attribute ``first_order_states``
+    (comma-separated; absent for a second-order model)."""
+    names = str(attributes.get("first_order_states", ""))
+    return tuple(names.split(",")) if names else ()
+
+
+def positions(state_names: tuple[str, ...], first_order: tuple[str, ...] = ()
+              ) -> tuple[str, ...]:
+    """The states that are not the rate of a dof: the dofs (the first half of the states
+    before the first-order ones) and the first-order states ``first_order`` (the last)."""
+    k = (len(state_names) - len(first_order)) // 2
+    return tuple(state_names[:k]) + tuple(state_names[2 * k:])
 
 
 @dataclass(frozen=True)
@@ -683,3 +699,8 @@ class StudyResult:
         return _html_table(f"study {self.study_name} (model {self.model})",
                            ("continuation", "kind", "branches", "points", "special points"),
                            rows)
+
+    @property
+    def first_order(self) -> tuple[str, ...]:
+        """The model's first-order states (the last states; none for a second-order model)."""
+        return first_order_states(self.attributes)

@@ -11,11 +11,11 @@ import subprocess
 import numpy as np
 import pytest
 
+from tests.strip_theory import coefficients
 from whirl_cli.analysis import linear
 from whirl_cli.auto.codegen import fortran_source
 from whirl_cli.auto.constants import par_layout
 from whirl_cli.models import get_model
-from whirl_cli.models.classical import aerodynamic_coefficients
 from whirl_cli.pipeline import run_study
 from whirl_cli.results import PointType
 from whirl_cli.study import validate_text
@@ -110,7 +110,7 @@ def aerodynamic_stiffness(overrides: dict[str, float]) -> tuple[float, float]:
     import sympy as sp
 
     symbols = {name: sp.Float(value, 30) for name, value in values.items()}
-    k_d, k_c, _ = aerodynamic_coefficients(symbols)
+    k_d, k_c, _ = coefficients(symbols)
     return float(k_d), float(k_c)
 
 

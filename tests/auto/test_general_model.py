@@ -2,7 +2,7 @@
 is full, through ``whirl run`` on the real AUTO, against closed forms and time simulation; and
 the same continuation with every typical amplitude 100 times smaller.
 
-Closed forms (``whirl_cli/models/oscillators.py``; datum k = m = gamma = 1, beta = 0.05): mode
+Closed forms (``models/builtin/oscillators.model.yaml``; datum k = m = gamma = 1, beta = 0.05): mode
 j = 1, 2, 3 of M = m [[2, 1, 0], [1, 2, 1], [0, 1, 2]] has the shape phi_j = (sin(i j pi/4))_i,
 mu_j = 2 + 2 cos(j pi/4), omega_j^2 = k/(m mu_j), and its Hopf point in alpha lies at
 alpha_j = -beta omega_j^2 with the period 2 pi/omega_j. Near it, first-order averaging on mode j
@@ -13,7 +13,6 @@ with A^2 = 4 (alpha_j - alpha) / g_j, so q_i reaches A |phi_ji|.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import numpy as np
@@ -25,7 +24,7 @@ from whirl_cli.analysis.simulate import integrate
 from whirl_cli.auto import toolchain
 from whirl_cli.auto.codegen import fortran_source, source_key
 from whirl_cli.cli import cli
-from whirl_cli.models import oscillators
+from whirl_cli.models import BUILTIN
 from whirl_cli.output import store, study_files
 from whirl_cli.pipeline import run_study
 from whirl_cli.plots import files
@@ -286,17 +285,20 @@ def test_compare_two_runs_agree(cli_run, again, tmp_path):
     assert done.exit_code == 0, done.output
 
 
-def test_typical_amplitudes_scale_nothing_physical(again, monkeypatch, tmp_path):
+def test_typical_amplitudes_scale_nothing_physical(again, tmp_path):
     """The same family declared with every typical amplitude 100 times smaller (AUTO's state
     is q / amplitude, so AUTO sees states 100 times larger): every special point is the same
     (type, alpha to 1e-6 of the range, state, period, l1, criticality). Amplitude thresholds
     are in typical amplitudes, so the families now stop at auto.max_amplitude (1.5) typical
     amplitudes, 1.5 cm instead of the range end; up to there they match averaging as before."""
-    family = oscillators.FAMILY
-    scaled = dataclasses.replace(family, name="oscillators_small", dofs=tuple(
-        dataclasses.replace(d, amplitude=d.amplitude * 1e-2) for d in family.dofs))
-    monkeypatch.setitem(models.FAMILIES, scaled.name, scaled)
-    small = run_study(validate_text(study_text(scaled.name)), tmp_path, jobs=2)
+    text = (BUILTIN / "oscillators.model.yaml").read_text()
+    text = text.replace("name: oscillators", "name: oscillators_small")
+    for k in (1, 2, 3):
+        text = text.replace(f"stiffness: k{k}}}", f"stiffness: k{k}, amplitude: 0.01}}")
+    assert text.count("amplitude: 0.01") == 3
+    (tmp_path / "small.model.yaml").write_text(text)
+    small = run_study(validate_text(study_text(str(tmp_path / "small.model.yaml"))), tmp_path,
+                      jobs=2)
     assert small.model == "oscillators_small_poly"
     ours, theirs = again.continuations[0], small.continuations[0]
     assert len(ours.special_points) == len(theirs.special_points) == 3

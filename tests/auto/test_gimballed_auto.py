@@ -21,7 +21,7 @@ from whirl_cli.analysis import linear
 from whirl_cli.auto import toolchain
 from whirl_cli.auto.codegen import fortran_source
 from whirl_cli.cli import cli
-from whirl_cli.models import classical, get_model
+from whirl_cli.models import FAMILIES, get_model
 from whirl_cli.models.numeric import numeric_source
 from whirl_cli.output import store
 from whirl_cli.pipeline import run_study
@@ -218,4 +218,4 @@ def test_eight_state_codegen_and_compile_under_a_minute(tmp_path, monkeypatch):
     assert executable.compiled and Path(executable.path).exists()
     assert "import sympy" not in numeric and "N_STATES = 8" in numeric
     assert seconds < 60.0
-    assert classical.FAMILY.name == "classical"  # the classical model is untouched by it
+    assert FAMILIES["classical"].name == "classical"  # the classical model is untouched by it

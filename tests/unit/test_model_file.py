@@ -60,7 +60,6 @@ BAD = [
     (("name: pair", "name: 3pair"), "name", "letters"),
     (("  - {name: x, unit: m, stiffness: k_x}", "  - {name: x, unit: m, stiffness: k_z}"),
      "dofs[0].stiffness", "no parameter 'k_z'"),
-    (("stiffness: k_y,", "stiffness: k_x,"), "dofs[1].stiffness", "already the stiffness"),
     (("  - {name: g, value: 0.3, unit: N/m}", "  - {name: X, value: 0.3, unit: N/m}"),
      "parameters[4].name", "declared twice"),
     (("  - {name: g, value: 0.3, unit: N/m}", "  - {name: g, value: 0.3, unit: N/m}\n"
@@ -102,8 +101,21 @@ BAD = [
     (("  x: -c*dx + g*y", "  x: -c*dx + g*y > 0"), "forces.x", "comparison"),
     (("  x: -c*dx + g*y", "  x: \"-c*dx + (g*y\""), "forces.x", "cannot read"),
     (("description: two coupled oscillators", "colour: blue"), "colour", "unknown key"),
-    (("description: two coupled oscillators", "states: [{name: lam}]"), "states",
-     "not supported yet"),
+    (("description: two coupled oscillators", "states: [{name: lam}]"), "rates",
+     "no rate for state lam"),
+    (("description: two coupled oscillators", "states: [{name: lam}]\nrates: {lam: -lam/tau}"),
+     "rates.lam", "unknown name 'tau'"),
+    (("description: two coupled oscillators", "rates: {mu: -x}"), "rates.mu",
+     "no first-order state 'mu'"),
+    (("description: two coupled oscillators", "states: [{name: lam_inflow_1}]\n"
+      "rates: {lam_inflow_1: -lam_inflow_1}"), "states[0].name", "too long for AUTO"),
+    (("description: two coupled oscillators", "states: [{name: dx}]\nrates: {dx: 0}"),
+     "states[0].name", "declared twice"),
+    (("description: two coupled oscillators", "states: [{name: s}]\nrates: {s: 1/(s - s)}"),
+     "rates.s", "cannot be computed"),
+    (("mass: [[m, 0.1*m], [0.1*m, m]]", "mass: [[m, 0.1*s], [0.1*s, m]]\nstates: [{name: s}]"
+      "\nrates: {s: -s}"), "mass[0][1]", "may not depend on the states"),
+    (("mass: [[m, 0.1*m], [0.1*m, m]]", ""), "mass", "missing"),
     (("description: two coupled oscillators", "hub: {y: y*x, z: x}"), "hub.y", "linear"),
     (("description: two coupled oscillators", "hub: {y: m*x, z: x}"), "hub.y", "not a state"),
     (("description: two coupled oscillators",
@@ -244,3 +256,92 @@ def test_an_empty_or_missing_model_file(tmp_path):
     assert problems("") == ["model.yaml: the model file is empty"]
     with pytest.raises(StudyError, match=r"nowhere\.yaml: cannot read the model file"):
         load_model_file(tmp_path / "nowhere.yaml", "nowhere.yaml")
+
+
+# ------------------------------------------------------------------------------ first order
+def test_lorenz_numeric_equations_match_the_written_ones():
+    """A model of first-order states only: the generated right-hand side, Jacobian and second
+    derivatives against the Lorenz equations written out here."""
+    model = get_model(load_model_file(DATA / "lorenz.model.yaml", "lorenz"), ())
+    assert model.state_names == ("x", "y", "z") and model.n_dof == 0
+    rho, sigma, beta = 28.0, 10.0, 8.0 / 3.0
+    params = model.parameter_vector({"rho": rho})
+    rng = np.random.default_rng(3)
+    for x, y, z in rng.normal(size=(5, 3)) * 10:
+        state = np.array([x, y, z])
+        np.testing.assert_allclose(model.rhs_numpy(state, params),
+                                   [sigma * (y - x), rho * x - y - x * z, x * y - beta * z],
+                                   rtol=1e-14, atol=1e-12)
+        np.testing.assert_allclose(model.jacobian_numpy(state, params),
+                                   [[-sigma, sigma, 0], [rho - z, -1, -x], [y, x, -beta]],
+                                   rtol=1e-14, atol=1e-12)
+    second, third = model.derivative_tensors(np.zeros(3), params)
+    expected = np.zeros((3, 3, 3))
+    expected[1, 0, 2] = expected[1, 2, 0] = -1.0
+    expected[2, 0, 1] = expected[2, 1, 0] = 1.0
+    np.testing.assert_array_equal(second, expected)
+    assert not third.any()
+    assert not model.family.symmetric and not model.family.linear
+
+
+def test_mixed_model_numeric_equations_match_the_written_ones():
+    """A dof and a first-order state that loads it: state order q, dq, lam; the batched
+    right-hand side (points on a trailing axis) as the single one."""
+    model = get_model(load_model_file(DATA / "lagged_spring.model.yaml", "lagged"),
+                      ("polynomial",))
+    assert model.state_names == ("q", "dq", "lam") and model.positions == (0, 2)
+    k, c, m, tau, mu = 2.0, 0.4, 1.0, 0.5, -2.0
+    params = model.parameter_vector({})
+    states = np.random.default_rng(5).normal(size=(3, 4))
+    q, dq, lam = states
+    expected = np.array([dq, (-c * dq - k * q + lam) / m, (mu + lam - lam**3 / 3) / tau])
+    np.testing.assert_allclose(model.rhs_numpy(states, np.repeat(params[:, None], 4, axis=1)),
+                               expected, rtol=1e-14)
+    jacobian = model.jacobian_numpy(states[:, 0], params)
+    np.testing.assert_allclose(jacobian, [[0, 1, 0], [-k / m, -c / m, 1 / m],
+                                          [0, 0, (1 - lam[0] ** 2) / tau]], rtol=1e-14)
+
+
+def test_a_study_of_a_first_order_model_takes_no_law(tmp_path):
+    (tmp_path / "lorenz.model.yaml").write_text((DATA / "lorenz.model.yaml").read_text())
+    study = tmp_path / "s.yaml"
+    study.write_text("name: s\nmodel: ./lorenz.model.yaml\nnonlinearity: {type: polynomial}\n")
+    with pytest.raises(StudyError, match=r"s\.yaml:3: nonlinearity: model lorenz has no dofs"):
+        load_study(study)
+    study.write_text("name: s\nmodel: ./lorenz.model.yaml\ncontinuations:\n  - {name: r, type: "
+                     "one-parameter, parameter: rho, range: [0.5, 2], start_state: {w: 1}}\n")
+    with pytest.raises(StudyError, match=r"start_state\.w: expected one of x, y, z"):
+        load_study(study)
+    study.write_text("name: s\nmodel: ./lorenz.model.yaml\n")
+    assert load_study(study).variant().laws == ()
+
+
+def test_a_model_needs_a_dof_or_a_state():
+    text = "name: empty\nparameters: [{name: a, value: 1}]\n"
+    (line,) = problems(text)
+    assert "dofs: a model needs at least one dof" in line
+
+
+# ------------------------------------------------------------------------------ built-ins
+@pytest.mark.parametrize("name", ["classical", "gimballed", "oscillators"])
+def test_built_in_models_are_model_files(name):
+    """Each built-in is a file under models/builtin: read at start-up without line tracking,
+    it declares exactly what the checked reading of a user's file gives."""
+    from whirl_cli.models import BUILTIN, FAMILIES
+    from whirl_cli.models.file import model_from_text
+
+    path = BUILTIN / f"{name}.model.yaml"
+    checked = model_from_text(path.read_text(), path.name, builtin=True)
+    assert FAMILIES[name] == checked and FAMILIES[name].key == checked.key
+    assert FAMILIES[name].name == name
+
+
+def test_a_user_file_may_not_take_a_built_in_name():
+    (line,) = problems(GOOD.replace("name: pair", "name: gimballed"))
+    assert "name: 'gimballed' is the name of a built-in model" in line
+
+
+def test_dofs_may_share_a_stiffness():
+    """An isotropic spring (the gimballed model's K_beta on both gimbal dofs)."""
+    family = model_from_text(GOOD.replace("stiffness: k_y,", "stiffness: k_x,"), "m.yaml")
+    assert [d.stiffness for d in family.dofs] == ["k_x", "k_x"]

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
+from tests.strip_theory import coefficients
 from whirl_cli.models import all_variants, get_model
-from whirl_cli.models.classical import aerodynamic_coefficients
 
 
 @pytest.fixture(scope="module")
@@ -19,7 +19,7 @@ def test_aerodynamic_coefficients_at_datum(model):
     """models.md 2.3: k_d = 0.04657, k_c = 0.05179 N m/rad, c_a = 0.000883 N m s/rad."""
     symbols = {p.name: sp.Symbol(p.name, real=True) for p in model.parameters}
     values = {symbols[k]: v for k, v in model.defaults().items()}
-    k_d, k_c, c_a = (float(e.subs(values)) for e in aerodynamic_coefficients(symbols))
+    k_d, k_c, c_a = (float(e.subs(values)) for e in coefficients(symbols))
     assert k_d == pytest.approx(0.046567, abs=2e-6)
     assert k_c == pytest.approx(0.051795, abs=2e-6)
     assert c_a == pytest.approx(0.0008826, abs=2e-7)

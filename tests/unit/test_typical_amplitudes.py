@@ -12,7 +12,7 @@ from whirl_cli.analysis.global_bifurcations import equilibria_at
 from whirl_cli.continuation.branches import _same_point, typical_amplitudes
 from whirl_cli.continuation.engine import Numerics
 from whirl_cli.continuation.equilibria import equilibrium_constants
-from whirl_cli.models import Model, classical, oscillators
+from whirl_cli.models import FAMILIES, Model
 from whirl_cli.results import Branch, BranchKind, PointType, SpecialPoint
 
 
@@ -26,8 +26,8 @@ def test_branches_stop_at_max_amplitude_typical_amplitudes():
     """AUTO's PVLS maxima are in typical amplitudes; so is the stop (was the dof's unit: a
     model in micrometres would only stop 1.5 m out)."""
     numerics = Numerics(max_amplitude=0.7)
-    for model in (Model(classical.FAMILY, ("polynomial",) * 2),
-                  scaled(oscillators.FAMILY, 1e-6, "tiny")):
+    for model in (Model(FAMILIES["classical"], ("polynomial",) * 2),
+                  scaled(FAMILIES["oscillators"], 1e-6, "tiny")):
         stops = equilibrium_constants(model, numerics, model.parameters[0].name, (0.0, 1.0),
                                       -1)["UZSTOP"]
         for dof in model.dofs:
@@ -35,9 +35,9 @@ def test_branches_stop_at_max_amplitude_typical_amplitudes():
 
 
 def test_typical_amplitudes_per_state():
-    np.testing.assert_array_equal(typical_amplitudes(Model(classical.FAMILY, ("polynomial",) * 2)),
-                                  np.ones(4))
-    tiny = scaled(oscillators.FAMILY, 1e-6, "tiny")
+    classical = Model(FAMILIES["classical"], ("polynomial",) * 2)
+    np.testing.assert_array_equal(typical_amplitudes(classical), np.ones(4))
+    tiny = scaled(FAMILIES["oscillators"], 1e-6, "tiny")
     np.testing.assert_array_equal(typical_amplitudes(tiny), np.full(6, 1e-6))
 
 
@@ -49,7 +49,7 @@ def point(state) -> SpecialPoint:
 def test_special_points_told_apart_in_typical_amplitudes():
     """Two branch points 5 typical amplitudes apart are two points in a model in micrometres
     (absolute 1e-5 called them one); 1e-6 apart in a model of amplitude 1 they are one."""
-    tiny = typical_amplitudes(scaled(oscillators.FAMILY, 1e-6, "tiny"))
+    tiny = typical_amplitudes(scaled(FAMILIES["oscillators"], 1e-6, "tiny"))
     a, b = point([5e-6, 0, 0, 0, 0, 0]), point([0, 0, 0, 0, 0, 0])
     assert not _same_point(a, b, 1.0, tiny)
     assert _same_point(point([1e-6, 0, 0, 0, 0, 0]), b, 1.0, np.ones(6))

@@ -268,7 +268,7 @@ def boundary(name: str, model: Model, overrides: dict[str, float], pair: tuple[s
     first, second = pair
     minimum = 1e-3 * (bounds[first][1] - bounds[first][0])  # narrower pieces are round-off
     if method == "loci":
-        curves_by_name = loci_curves(curves, np.tile([d.amplitude for d in model.dofs], 2))
+        curves_by_name = loci_curves(curves, np.array(model.typical_amplitudes))
         rows = sorted(set(np.linspace(*bounds[second], resolution).tolist()) | set(slices))
         candidates = [loci_candidates(curves_by_name, value) for value in rows]
     else:

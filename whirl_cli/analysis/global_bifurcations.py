@@ -260,7 +260,7 @@ def analyse(family: Branch, model: Model, parameters: dict[str, float],
     value = float(family.parameters[last, 0])
     params = model.parameter_vector({**parameters, name: value})
     orbit = max(family.orbits, key=lambda o: o.period)
-    amplitudes = np.tile([dof.amplitude for dof in model.dofs], 2)
+    amplitudes = np.array(model.typical_amplitudes)
     near = lingering(model, orbit.states, equilibria_at(value, equilibria, amplitudes))
     saddles = [(s, unstable_rate(model, params, s)) for s in near]
     saddles = [(s, rate) for s, rate in saddles if rate > 0]

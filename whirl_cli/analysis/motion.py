@@ -429,9 +429,9 @@ def classify_model(model, overrides: dict[str, float] | None = None, y0=None, *,
     params = model.parameter_vector(overrides or {})
     field, jacobian = model.field_at(params)
     scale = np.asarray(model.state_scale, dtype=float)
-    dofs = len(model.dofs)
     if y0 is None:
-        y0 = np.r_[1e-2 * scale[:dofs], np.zeros(model.n_states - dofs)]
+        y0 = np.zeros(model.n_states)
+        y0[list(model.positions)] = 1e-2 * scale[list(model.positions)]
     y0 = np.asarray(y0, dtype=float)
     origin = np.zeros(model.n_states)
     at = origin if np.allclose(field(origin), 0.0, atol=1e-12) else y0

@@ -62,23 +62,24 @@ def reference_period(model: Model, params: np.ndarray) -> float:
 def settle(model: Model, params: np.ndarray, seed: np.ndarray, max_periods: int = 600,
            tolerance: float = 1e-4, limit: float = 10.0) -> Settled:
     """Simulate ``seed`` until it settles (see the module doc); ``limit``: divergence bound
-    in typical amplitudes of each dof."""
+    in typical amplitudes of each dof (and first-order state)."""
     seed = np.asarray(seed, dtype=float)
     period = reference_period(model, params)
-    amplitudes = np.array([dof.amplitude for dof in model.dofs], dtype=float)
-    dofs = len(amplitudes)
+    k = model.n_dof
+    dofs = list(range(k)) + list(range(2 * k, model.n_states))  # and first-order states
+    amplitudes = np.array(model.typical_amplitudes, dtype=float)[dofs]
     state, elapsed = seed.copy(), 0.0
     while elapsed < max_periods * period:
         t, y = integrate(model, params, state, CHUNK_PERIODS * period,
                          samples=CHUNK_PERIODS * SAMPLES_PER_PERIOD + 1)
         elapsed += t[-1]
-        if not np.isfinite(y).all() or (np.abs(y[:, :dofs]) > limit * amplitudes).any():
+        if not np.isfinite(y).all() or (np.abs(y[:, dofs]) > limit * amplitudes).any():
             return Settled("diverged", seed, y[-1], None,
                            f"a dof beyond {limit:g} typical amplitudes after {elapsed:.3g} s")
         state = y[-1]
         recent = y[-10 * SAMPLES_PER_PERIOD:]
-        size = np.ptp(recent[:, :dofs], axis=0) / amplitudes
-        if size.max() < tolerance * max(np.abs(seed[:dofs] / amplitudes).max(), 1e-12):
+        size = np.ptp(recent[:, dofs], axis=0) / amplitudes
+        if size.max() < tolerance * max(np.abs(seed[dofs] / amplitudes).max(), 1e-12):
             return Settled("equilibrium", seed, state, None,
                            f"at rest after {elapsed:.3g} s")
         orbit, message = _repeating_orbit(t, y, tolerance)

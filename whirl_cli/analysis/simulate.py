@@ -192,10 +192,11 @@ def simulation(model: Model, params: np.ndarray, initial: np.ndarray, duration: 
     elif law == "smoothed":
         field, jacobian = model.field_at(params)
         scale = np.asarray(model.state_scale, dtype=float)
-        amplitudes = scale[: len(model.dofs)]
+        watched = list(model.positions)
+        amplitudes = scale[watched]
 
         def diverged(_t, y):
-            return float(np.max(np.abs(y[: len(amplitudes)]) / amplitudes)) - limit
+            return float(np.max(np.abs(y[watched]) / amplitudes)) - limit
 
         diverged.terminal = True
         diverged.direction = 1.0
@@ -224,7 +225,8 @@ def simulation(model: Model, params: np.ndarray, initial: np.ndarray, duration: 
         initial=y0, time=np.asarray(time, dtype=float),
         states=np.asarray(states, dtype=float).reshape(-1, model.n_states),
         hub=np.asarray(states, dtype=float).reshape(-1, model.n_states) @ matrix.T,
-        hub_unit=used.pop() if len(used) == 1 else "1", status=status, message=message)
+        hub_unit=used.pop() if len(used) == 1 else "1", status=status, message=message,
+        first_order=tuple(x.name for x in model.family.first_order))
 
 
 def _crossing(dof: int, value: float, direction: float):
@@ -249,9 +251,9 @@ def check_orbit(model: Model, overrides: dict[str, float], branch: Branch, orbit
     (relative to its typical amplitude) over the last two periods must match AUTO's within
     ``tolerance`` (relative to its half peak-to-peak amplitude). With a piecewise law
     (freeplay) the exact law's simulation must too; its max is stored as ``exact``."""
-    dofs = len(model.dofs)
-    spans = np.ptp(orbit.states[:, :dofs], axis=0) / np.asarray(model.state_scale[:dofs])
-    dof = int(np.argmax(spans))
+    watched = list(model.positions)
+    spans = np.ptp(orbit.states[:, watched], axis=0) / np.asarray(model.state_scale)[watched]
+    dof = watched[int(np.argmax(spans))]
     params = _parameters(model, overrides, branch.parameter_names, orbit.parameters)
     time, states = integrate(model, params, orbit.states[0], periods * orbit.period,
                              samples=periods * 400)
@@ -294,7 +296,7 @@ def check_equilibrium(model: Model, overrides: dict[str, float], branch: Branch,
     slowest = float(-eigenvalues.real.max())
     # the dofs, in units of their typical amplitudes (rad for the classical model)
     typical = np.asarray(model.state_scale, dtype=float)
-    angles = np.arange(model.n_states) < len(model.dofs)
+    angles = np.isin(np.arange(model.n_states), model.positions)
     deflection = np.abs(state / typical)[angles].max()
     if deflection > 0:  # stay within the basin (tiny next to a pitchfork) of the equilibrium
         perturbation = min(perturbation, 1e-3 * deflection)

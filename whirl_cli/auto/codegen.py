@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 from ..errors import CodegenError
 from ..models import Model
 from ..models.numeric import variant_key
-from .constants import AMPLITUDE, PERIOD_INDEX, par_layout
+from .constants import AMPLITUDE, PERIOD_INDEX, START_FILE, par_layout
 
 if TYPE_CHECKING:
     import sympy as sp
@@ -112,6 +112,43 @@ def model_hash(model: Model) -> str:
     return variant_key(model)
 
 
+def _first_order_lines(symbolic, model: Model, layout, scale: list[float]
+                       ) -> tuple[list[str], dict[str, list[str]], dict[str, list[str]]]:
+    """For the first-order states x' = F(y, p) (rows 2 n_dof + 1.. of F): the temporaries,
+    the lines assigning F, DFDU (by AUTO's U: times each state's scale) and DFDP in physical
+    units, and the lines scaling those rows to AUTO's (by 1 / (scale time_scale))."""
+    import sympy as sp
+
+    first = 2 * len(symbolic.q)
+    rows = range(len(symbolic.x))
+    if not symbolic.x:
+        return [], {"F": [], "DFDU": [], "DFDP": []}, {"F": [], "DFDU": [], "DFDP": []}
+    factor = [fortran_number(1.0 / (scale[first + i] * model.time_scale)) for i in rows]
+    n = len(symbolic.states)
+    slopes = symbolic.rates_jacobian
+    by_state = [(i, j) for i in rows for j in range(n) if slopes[i, j] != 0]
+    by_parameter = [(i, c) for c, _ in enumerate(symbolic.parameters) for i in rows
+                    if symbolic.rates_parameter_jacobian[i, c] != 0]
+    columns = [layout.parameters[model.parameters[c].name] for _, c in by_parameter]
+    temps, lines = [], {}
+    for key, targets, expressions, prefix in (
+            ("F", [f"F({first + i + 1})" for i in rows], list(symbolic.rates), "w_x"),
+            ("DFDU", [f"DFDU({first + i + 1},{j + 1})" for i, j in by_state],
+             [slopes[i, j] * sp.Rational(repr(scale[j])) for i, j in by_state], "w_y"),
+            ("DFDP", [f"DFDP({first + i + 1},{col})" for (i, _), col in
+                      zip(by_parameter, columns, strict=True)],
+             [symbolic.rates_parameter_jacobian[i, c] for i, c in by_parameter], "w_z")):
+        names, lines[key] = _assignments(targets, expressions, prefix)
+        temps += names
+    last = max(layout.parameters.values())
+    scaling = {"F": [f"  F({first + i + 1}) = F({first + i + 1}) * {factor[i]}" for i in rows],
+               "DFDU": [f"  DFDU({first + i + 1},1:{n}) = DFDU({first + i + 1},1:{n}) * "
+                        f"{factor[i]}" for i in rows],
+               "DFDP": [f"  DFDP({first + i + 1},1:{last}) = DFDP({first + i + 1},1:{last}) * "
+                        f"{factor[i]}" for i in rows]}
+    return temps, lines, scaling
+
+
 def fortran_source(model: Model) -> str:
     """The complete AUTO-07p equations file for ``model`` (free-form Fortran 90).
 
@@ -160,6 +197,7 @@ def fortran_source(model: Model) -> str:
                                       "w_p")
     jp_lines = [re.sub(r"\bWA_(\d+)\b", r"WA(\1,1)", line) for line in jp_lines]
     n_p = max(len(used), 1)
+    x_temps, x_lines, x_scaling = _first_order_lines(symbolic, model, layout, scale)
 
     header = [
         "!" + "-" * 78,
@@ -184,6 +222,8 @@ def fortran_source(model: Model) -> str:
                   "of a state (PVLS)")
     header.append(f"! M dv/dt = R(y, p): the accelerations M^-1 R are solved numerically "
                   f"({'M diagonal' if diagonal else 'M full'}).")
+    if symbolic.x:
+        header.append(f"! dx/dt = F(y, p) for the first-order states U({2 * k + 1}..{n}).")
     header.append("!" + "-" * 78)
     broken = [line for line in header if "\n" in line or "\r" in line]
     if broken:  # a line break would end the comment and start a Fortran statement
@@ -209,7 +249,7 @@ def fortran_source(model: Model) -> str:
         f"  DOUBLE PRECISION :: WM({k},{k}), WA({k},1), WJ({k},{n}), WP({k},{n_p})",
         "  INTEGER :: I",
         *_declare([s.name for s in model.states] + [p.name for p in model.parameters]),
-        *_declare(m_temps + f_temps + ju_temps + jp_temps),
+        *_declare(m_temps + f_temps + ju_temps + jp_temps + x_temps),
         "",
         *unpack,
         "",
@@ -219,6 +259,8 @@ def fortran_source(model: Model) -> str:
         *_solve_lines(k, diagonal, "WA", "1"),
         *[f"  F({i + 1}) = U({k + i + 1})" for i in range(k)],
         *[f"  F({k + i + 1}) = WA({i + 1},1) * {rate[i]}" for i in range(k)],
+        *indented(x_lines["F"]),
+        *x_scaling["F"],
         "  IF (IJAC == 0) RETURN",
         "",
         "  DFDU(1:NDIM,1:NDIM) = 0d0",
@@ -227,6 +269,8 @@ def fortran_source(model: Model) -> str:
         *indented(ju_lines),
         *_solve_lines(k, diagonal, "WJ", str(n)),
         *[f"  DFDU({k + i + 1},1:{n}) = WJ({i + 1},1:{n}) * {rate[i]}" for i in range(k)],
+        *indented(x_lines["DFDU"]),
+        *x_scaling["DFDU"],
         "  IF (IJAC == 1) RETURN",
         "",
         f"  DFDP(1:NDIM,1:{max_param_index}) = 0d0",
@@ -235,18 +279,29 @@ def fortran_source(model: Model) -> str:
         *(_solve_lines(k, diagonal, "WP", str(len(used))) if used else []),
         *[f"  DFDP({k + i + 1},{layout.parameters[model.parameters[c].name]}) = "
           f"WP({i + 1},{position[c]}) * {rate[i]}" for c in used for i in range(k)],
+        *indented(x_lines["DFDP"]),
+        *x_scaling["DFDP"],
         "END SUBROUTINE FUNC",
         "",
         "SUBROUTINE STPNT(NDIM,U,PAR,T)",
-        "  ! Datum parameters; the start point is the trivial equilibrium U = 0.",
+        "  ! Datum parameters; the start point is the trivial equilibrium U = 0, or the state",
+        f"  ! in {START_FILE} where whirl wrote one (an equilibrium found by Newton's method).",
         "  IMPLICIT NONE",
         "  INTEGER, INTENT(IN) :: NDIM",
         "  DOUBLE PRECISION, INTENT(INOUT) :: U(NDIM), PAR(*)",
         "  DOUBLE PRECISION, INTENT(IN) :: T",
+        "  LOGICAL :: GIVEN",
+        "  INTEGER :: UNITNO",
         "",
         *[f"  PAR({layout.parameters[p.name]}) = {fortran_number(p.default)}  ! {p.name}"
           for p in model.parameters],
         "  U(1:NDIM) = 0d0",
+        f"  INQUIRE(FILE='{START_FILE}', EXIST=GIVEN)",
+        "  IF (GIVEN) THEN",
+        f"    OPEN(NEWUNIT=UNITNO, FILE='{START_FILE}', STATUS='OLD', ACTION='READ')",
+        "    READ(UNITNO, *) U(1:NDIM)",
+        "    CLOSE(UNITNO)",
+        "  END IF",
         "END SUBROUTINE STPNT",
         "",
         "SUBROUTINE PVLS(NDIM,U,PAR)",

@@ -25,6 +25,9 @@ TORUS_ANGLE_INDEX = 12
 #: PVLS output: the largest half peak-to-peak value of any (AUTO, non-dimensional) state over
 #: the solution; 0 on equilibria. Used to stop periodic families that shrink back onto a Hopf.
 AMPLITUDE = "amplitude"
+#: A file in an AUTO run's directory whose one line holds the starting state U (AUTO's
+#: units) that the generated STPNT reads where the zero state is not an equilibrium.
+START_FILE = "whirl_start.txt"
 
 
 @dataclass(frozen=True)

@@ -35,7 +35,7 @@ from pathlib import Path
 
 from ..errors import WhirlError
 from ..interrupts import Interrupted, catching
-from .constants import constants_text
+from .constants import START_FILE, constants_text
 
 #: stdout texts meaning AUTO did not do what was asked, although it exits 0 -> message shown.
 FATAL_PATTERNS = (
@@ -189,15 +189,17 @@ def _describe_signal(returncode: int) -> str:
 
 def run(executable: Path, constants: dict, workdir: Path, name: str,
         restart: Path | None = None, timeout: float = 120.0,
-        data: str | None = None, on_slow: Callable[[str, float], None] | None = None
-        ) -> RunOutcome:
+        data: str | None = None, on_slow: Callable[[str, float], None] | None = None,
+        start_state: str | None = None) -> RunOutcome:
     """Run AUTO once in the fresh directory ``workdir``.
 
     ``constants`` are complete (whirl never relies on AUTO defaults it did not choose); ``sv`` is
     set to ``name`` here. ``restart`` is the ``s.`` file to restart from; it is copied into
     ``workdir`` and named through the ``s`` constant. ``data``: the text of an AUTO data file
     to start from instead (rows ``t u1 .. uNDIM``, used with IRS=0), written into ``workdir``
-    and named through the ``dat`` constant. ``on_slow(name, seconds)`` is called when the run
+    and named through the ``dat`` constant. ``start_state``: a line of the starting state U
+    (AUTO's units) that the equations' STPNT reads (:data:`~.constants.START_FILE`) instead of
+    U = 0. ``on_slow(name, seconds)`` is called when the run
     is still running after each of :func:`slow_notices` (a run stuck until its timeout is
     not silent meanwhile).
     """
@@ -210,6 +212,8 @@ def run(executable: Path, constants: dict, workdir: Path, name: str,
     if data is not None:
         (workdir / "start.dat").write_text(data)
         constants["dat"] = "start"
+    if start_state is not None:
+        (workdir / START_FILE).write_text(start_state)
     text = constants_text(constants)
     (workdir / f"c.{name}").write_text(text)
     (workdir / "fort.2").write_text(text)

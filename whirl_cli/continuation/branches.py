@@ -106,11 +106,9 @@ def _torus(branch: Branch, index: int) -> dict:
 
 
 def typical_amplitudes(model: Model) -> np.ndarray:
-    """(n,) the typical amplitude of each state's dof (a rate shares its dof's, per second):
-    SI states divided by it are in units of typical amplitudes, for tolerances that hold for
-    any unit (rad for the classical model, where it is 1)."""
-    amplitudes = np.array([dof.amplitude for dof in model.dofs], dtype=float)
-    return np.concatenate([amplitudes, amplitudes])
+    """(n,) :attr:`~whirl_cli.models.Model.typical_amplitudes` (rad for the classical
+    model, where it is 1)."""
+    return np.array(model.typical_amplitudes, dtype=float)
 
 
 def _same_point(a: SpecialPoint, b: SpecialPoint, width: float,

@@ -31,7 +31,8 @@ class RunSpec:
 
     ``restart``: (AUTO name of an earlier run, i.e. its name with "/" -> ".", label to restart
     from). ``data``: instead, the text of an AUTO data file to start from (IRS=0; see
-    :func:`whirl_cli.auto.runner.run`).
+    :func:`whirl_cli.auto.runner.run`). ``start_state``: the starting state of an equilibrium
+    run that does not start at U = 0 (a line of AUTO's U).
     """
 
     name: str
@@ -41,6 +42,7 @@ class RunSpec:
     parameter_names: tuple[str, ...]
     restart: tuple[str, int] | None = None
     data: str | None = None
+    start_state: str | None = None
 
 
 class _Slots:
@@ -108,7 +110,8 @@ class Engine:
         with self._slots.held(background):
             outcome = runner.run(self.executable.path, constants, self.workroot / spec.name,
                                  spec.name.replace("/", "."), restart=restart_file,
-                                 timeout=self.timeout, data=spec.data, on_slow=self.on_slow)
+                                 timeout=self.timeout, data=spec.data, on_slow=self.on_slow,
+                                 start_state=spec.start_state)
         self.outcomes[outcome.name] = outcome
         self.specs[outcome.name] = spec
         if self.on_run is not None:
@@ -188,8 +191,8 @@ def run_end(branch: Branch, constants: dict, model: Model) -> str:
         return "no convergence (MX)"
     if branch.status != "ok":
         return f"{branch.status}: {branch.message}"
-    dofs = {dof.name: k for k, dof in enumerate(model.dofs)}
-    amplitudes = [dof.amplitude for dof in model.dofs]
+    dofs = {model.state_names[k]: k for k in model.positions}
+    amplitudes = model.typical_amplitudes
     stops = constants.get("UZSTOP", {}) if branch.point_type[-1] == PointType.UZ else {}
     for name, limit in stops.items():
         limits = limit if isinstance(limit, list | tuple) else [limit]

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..auto.constants import base_constants, par_layout
+from ..errors import WhirlError
 from ..models import Model
 from ..results import Branch, BranchKind, PointType, SpecialPoint
 from .branches import _same_point, typical_amplitudes
@@ -21,12 +22,13 @@ MAX_SWITCH_DEPTH = 3
 
 
 def _stops(model: Model, parameter: str, bounds: tuple[float, float], amplitude: float) -> dict:
-    """UZSTOP: the range ends, and every dof at +/- ``amplitude`` in units of its typical
-    amplitude (AUTO's PVLS values are in those units: for the classical model rad)."""
+    """UZSTOP: the range ends, and every dof (and first-order state) at +/- ``amplitude`` in
+    units of its typical amplitude (AUTO's PVLS values are in those units: for the classical
+    model rad)."""
     stops: dict = {parameter: [float(bounds[0]), float(bounds[1])]}
-    for dof in model.dofs:
-        stops[f"max_{dof.name}"] = float(amplitude)
-        stops[f"min_{dof.name}"] = -float(amplitude)
+    for k in model.positions:
+        stops[f"max_{model.state_names[k]}"] = float(amplitude)
+        stops[f"min_{model.state_names[k]}"] = -float(amplitude)
     return stops
 
 
@@ -52,20 +54,28 @@ def equilibrium_constants(model: Model, numerics: Numerics, parameter: str,
 
 def equilibria(engine: Engine, name: str, parameter: str, start: float,
                bounds: tuple[float, float], parameters: dict[str, float], numerics: Numerics,
-               branch_points: bool = True) -> tuple[list[Branch], list[SpecialPoint]]:
-    """Equilibrium branches (main, then secondary from every BP) and their special points."""
+               branch_points: bool = True, guess: np.ndarray | None = None
+               ) -> tuple[list[Branch], list[SpecialPoint]]:
+    """Equilibrium branches (main, then secondary from every BP) and their special points;
+    the main branch starts at the equilibrium :func:`starting_equilibrium` finds from
+    ``guess``."""
     model = engine.model
     lower, upper = bounds
     width = upper - lower
     amplitudes = typical_amplitudes(model)
     start_parameters = {**parameters, parameter: float(start)}
+    state = starting_equilibrium(model, start_parameters, guess, f"{name}: {parameter} = "
+                                 f"{start:g}")
+    start_state = None if not state.any() else \
+        " ".join(f"{x:.17g}" for x in state / model.state_scale) + "\n"
     specs = []
     for direction, label in ((-1, "down"), (1, "up")):
         if (direction < 0 and start > lower) or (direction > 0 and start < upper):
             constants = equilibrium_constants(model, numerics, parameter, bounds, direction)
             constants["PAR"] = start_parameters
             specs.append(RunSpec(f"{name}/main_{label}", constants, BranchKind.EQUILIBRIUM,
-                                 f"start at {parameter} = {start:g}", (parameter,)))
+                                 f"start at {parameter} = {start:g}", (parameter,),
+                                 start_state=start_state))
     branches: list[Branch] = []
     points: list[SpecialPoint] = []
     frontier = _run_branches(engine, specs, branches, points, skip_first=False)
@@ -103,6 +113,43 @@ def equilibria(engine: Engine, name: str, parameter: str, start: float,
                    for q in unique):
             unique.append(point)
     return branches, unique
+
+
+def starting_equilibrium(model: Model, parameters: dict[str, float],
+                         guess: np.ndarray | None, where: str) -> np.ndarray:
+    """The equilibrium (SI) a continuation starts from: the zero state where it is one (every
+    symmetric model), else the root Newton's method finds from ``guess`` (default: zero; see
+    :func:`newton`). WhirlError naming ``where`` when it finds none."""
+    values = model.parameter_vector(parameters)
+    field, jacobian = model.field_at(values)
+    start = np.zeros(model.n_states) if guess is None else np.asarray(guess, dtype=float)
+    if guess is None and np.allclose(field(start), 0.0, rtol=0.0, atol=1e-14):
+        return start
+    state, reason = newton(field, jacobian, start, np.asarray(model.state_scale, dtype=float))
+    if state is None:
+        origin = "the zero state" if guess is None else "start_state"
+        raise WhirlError(f"{where}: no equilibrium found by Newton's method from {origin} "
+                         f"({reason}); give the continuation a `start_state` near one")
+    return state
+
+
+def newton(field, jacobian, start: np.ndarray, scale: np.ndarray, iterations: int = 100,
+           max_step: float = 10.0) -> tuple[np.ndarray | None, str]:
+    """A root of ``field`` (SI) by Newton's method from ``start``: full steps (a least-squares
+    step where the Jacobian is singular), each at most ``max_step`` typical sizes ``scale``,
+    until the step is below 1e-12 of them. (root, "") or (None, why not)."""
+    state = np.array(start, dtype=float)
+    for _ in range(iterations):
+        step = np.linalg.lstsq(jacobian(state), -field(state), rcond=None)[0]
+        size = float(np.abs(step / scale).max())
+        if not np.isfinite(size):
+            return None, "the iteration diverged"
+        state = state + step * min(1.0, max_step / size) if size else state
+        if size < 1e-12:
+            residual = float(np.abs(field(state)).max())
+            return (state, "") if residual <= 1e-9 * max(1.0, float(np.abs(
+                state / scale).max())) else (None, f"stalled at a residual of {residual:.3g}")
+    return None, f"no convergence in {iterations} steps"
 
 
 def is_linear(model: Model, parameters: dict[str, float]) -> bool:

@@ -470,9 +470,10 @@ def _periodic_end(family: Branch, model: Model, hopfs: list[SpecialPoint],
         return "period cap", None
     if min(abs(value - bounds[0]), abs(value - bounds[1])) < 1e-6 * width:
         return "range", None
-    dofs = len(model.dofs)  # in units of their typical amplitudes, as the UZSTOP bound
-    reach = (np.abs(np.concatenate([family.state_max[-1, :dofs], family.state_min[-1, :dofs]]))
-             / np.tile(scale[:dofs], 2)).max()
+    watched = list(model.positions)  # in typical amplitudes, as the UZSTOP bound
+    reach = (np.abs(np.concatenate([family.state_max[-1, watched],
+                                    family.state_min[-1, watched]]))
+             / np.tile(np.asarray(scale)[watched], 2)).max()
     if reach >= 0.999 * numerics.max_amplitude:
         return "amplitude bound", None
     if len(state.pieces) >= MAX_SEGMENTS:

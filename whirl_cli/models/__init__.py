@@ -5,8 +5,9 @@ Modules, lowest first:
 * :mod:`~whirl_cli.models.declaration` -- what a model family declares: degrees of freedom,
   parameters with bounds, its equations (M q'' = G - S); no sympy;
 * :mod:`~whirl_cli.models.laws` -- structural stiffness laws on a dof (polynomial);
-* :mod:`~whirl_cli.models.classical`, :mod:`~whirl_cli.models.gimballed` (provisional),
-  :mod:`~whirl_cli.models.oscillators` -- the families;
+* :mod:`~whirl_cli.models.expressions`, :mod:`~whirl_cli.models.file` -- model files: a
+  family as YAML data, its expressions read through a whitelist; the built-in families
+  (classical, gimballed (provisional), oscillators) are such files, ``builtin/*.model.yaml``;
 * :mod:`~whirl_cli.models.variant` -- a family with a law on each dof, as whirl runs it
   (names, scales, numeric functions);
 * :mod:`~whirl_cli.models.symbolic` -- a variant's sympy equations (code generation only);
@@ -18,21 +19,51 @@ shipped studies use, whose AUTO files are committed under ``auto_equations/``.
 
 from __future__ import annotations
 
+from collections.abc import Iterator, Mapping
 from functools import cache
 from pathlib import Path
 
-from . import classical, gimballed, oscillators
 from .declaration import Bounds, Constraint, Dof, Family, ModeGroup, Parameter, State
 from .laws import LAWS
 from .variant import Model
 
 __all__ = ["Bounds", "Constraint", "Dof", "Family", "ModeGroup", "Model", "Parameter", "State",
-           "FAMILIES", "LAWS", "SHIPPED", "get_model", "all_variants", "family_of",
-           "is_model_file", "load_model_file", "register_model_text"]
+           "BUILTIN", "FAMILIES", "LAWS", "MODEL_SUFFIX", "SHIPPED", "get_model", "all_variants",
+           "family_of", "file_key", "is_model_file", "load_model_file", "register_model_text"]
+
+#: The folder of the built-in model files, ``<name>.model.yaml``.
+BUILTIN = Path(__file__).resolve().parent / "builtin"
+MODEL_SUFFIX = ".model.yaml"
+
+
+class _BuiltIns(Mapping):
+    """The built-in families by name: known from the file names, each file read and checked
+    when first asked for (a command that needs no model reads none)."""
+
+    def __init__(self, folder: Path) -> None:
+        self._paths = {p.name[:-len(MODEL_SUFFIX)]: p
+                       for p in sorted(folder.glob(f"*{MODEL_SUFFIX}"))}
+        self._read: dict[str, Family] = {}
+
+    def __getitem__(self, name: str) -> Family:
+        if name not in self._read:
+            from .file import read_builtin
+
+            self._read[name] = read_builtin(self._paths[name])
+        return self._read[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._paths)
+
+    def __len__(self) -> int:
+        return len(self._paths)
+
+    def __contains__(self, name: object) -> bool:
+        return isinstance(name, str) and name in self._paths
+
 
 #: Model families by the name a study gives as ``model``.
-FAMILIES: dict[str, Family] = {f.name: f for f in (classical.FAMILY, gimballed.FAMILY,
-                                                    oscillators.FAMILY)}
+FAMILIES: Mapping[str, Family] = _BuiltIns(BUILTIN)
 
 #: The variants the shipped studies use: (family, law per dof).
 SHIPPED: tuple[tuple[str, tuple[str, ...]], ...] = (
@@ -61,6 +92,12 @@ def family_of(reference: str) -> Family:
             and Path(reference).is_file():  # e.g. in a worker process of another machine
         load_model_file(Path(reference))
     return _FILES[reference]
+
+
+def file_key(reference: str) -> str:
+    """The content key of the model file a study's ``model`` names; "" for a built-in (a
+    built-in is named, and its equations are whirl's version's)."""
+    return family_of(reference).key if is_model_file(reference) else ""
 
 
 def is_known(reference: object) -> bool:

@@ -3,9 +3,11 @@
 A :class:`Family` is a model as its author writes it down: its degrees of freedom (with a
 typical amplitude that scales every amplitude threshold whirl uses), its parameters (datum,
 unit, description, physical bounds), the structural stiffness term of each degree of freedom
-that a stiffness law may replace, and its equations of motion in second-order form
+that a stiffness law may replace, its first-order states x if any (an aerodynamic lag, an
+actuator, or every state of a plain first-order system), and its equations of motion
 
-    M(p) q'' = G(q, q', p) - S(q, p),     S_i = K_i q_i   (or a law's restoring force),
+    M(p) q'' = G(q, q', x, p) - S(q, p),     S_i = K_i q_i   (or a law's restoring force),
+    x' = F(q, q', x, p),
 
 with M the (possibly full) mass matrix, G every other generalised force (aerodynamic,
 gyroscopic, damping) and S the structural stiffness. Building the first-order system, its
@@ -122,6 +124,17 @@ class Dof:
         return f"{self.unit}/s"
 
 
+@dataclass(frozen=True)
+class FirstOrderState:
+    """A first-order state x_j (its own rate x_j' = F_j is declared, no stiffness law attaches
+    to it). ``amplitude``: its typical size in ``unit``, the scale of AUTO's state."""
+
+    name: str
+    unit: str
+    description: str
+    amplitude: float = 1.0
+
+
 #: A combination of first-order states giving one component of a path: ((state index,
 #: factor), ...).
 Combination = tuple[tuple[int, float], ...]
@@ -152,10 +165,11 @@ class Constraint:
     reason: str = ""
 
 
-#: The equations of a family: given a symbol for every dof (``q[name]``), rate (``v[name]``)
-#: and parameter (``p[name]``), return (M, G): the mass matrix (n x n, parameters only) and
-#: the generalised forces other than the structural stiffness (n x 1), as sympy matrices in
-#: dof order.
+#: The equations of a family: given a symbol for every dof (``q[name]``), rate (``v[name]``),
+#: parameter (``p[name]``) and first-order state (``x[name]``), return (M, G, F): the mass
+#: matrix (n x n, parameters only), the generalised forces other than the structural
+#: stiffness (n x 1) in dof order, and the rates of the first-order states (m x 1, in their
+#: order; 0 x 1 without any), as sympy matrices.
 Equations = Callable[[dict, dict, dict], tuple]
 
 
@@ -173,7 +187,8 @@ class Family:
     secondary branches come in +/- pairs). ``linear``: apart from the stiffness laws, the
     equations are linear in the states (so a study without nonlinear law coefficients is a
     linear system). ``provisional``: whirl's own derivation, not yet checked against the
-    published model. ``key``: for a model file, the sha256 of what it declares (its
+    published model. ``first_order``: the first-order states, after the dofs and rates in the
+    state vector. ``key``: for a model file, the sha256 of what it declares (its
     generated code is keyed on it); ``source``: the file's text (stored with results).
     """
 
@@ -190,12 +205,13 @@ class Family:
     linear: bool = True
     provisional: bool = False
     notes: str = ""
+    first_order: tuple[FirstOrderState, ...] = ()
     key: str = ""
     source: str = field(default="", repr=False, compare=False)
 
     def __post_init__(self) -> None:
         names = [d.name for d in self.dofs] + [d.rate for d in self.dofs]
-        names += [p.name for p in self.parameters]
+        names += [x.name for x in self.first_order] + [p.name for p in self.parameters]
         aliases = [a for p in self.parameters for a in p.aliases]
         lowered = [n.lower() for n in names + aliases]
         if len(set(lowered)) != len(lowered):
@@ -210,6 +226,13 @@ class Family:
                 raise ValueError(f"model {self.name}: dof {d.name}: no parameter {d.stiffness}")
             if not (math.isfinite(d.amplitude) and d.amplitude > 0):
                 raise ValueError(f"model {self.name}: dof {d.name}: amplitude must be > 0")
+        if not self.dofs and not self.first_order:
+            raise ValueError(f"model {self.name}: no dofs and no first-order states")
+        for x in self.first_order:
+            if len(f"max_{x.name}") > AUTO_NAME_LENGTH:
+                raise ValueError(f"model {self.name}: state name {x.name!r} too long for AUTO")
+            if not (math.isfinite(x.amplitude) and x.amplitude > 0):
+                raise ValueError(f"model {self.name}: state {x.name}: amplitude must be > 0")
         for p in self.parameters:
             if len(p.name) > AUTO_NAME_LENGTH:
                 raise ValueError(f"model {self.name}: parameter name {p.name!r} too long")
@@ -230,6 +253,12 @@ class Family:
     @property
     def dof_names(self) -> tuple[str, ...]:
         return tuple(d.name for d in self.dofs)
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        """Every state in state order: the dofs, their rates, the first-order states."""
+        return (self.dof_names + tuple(d.rate for d in self.dofs)
+                + tuple(x.name for x in self.first_order))
 
     def dof(self, name: str) -> Dof:
         return next(d for d in self.dofs if d.name == name)

@@ -2,10 +2,12 @@
 
 A model file gives what a built-in family declares in Python (see ``docs`` and README "Your
 own model"): its dofs (in state order, each with the parameter of its linear structural
-stiffness), parameters (datum value, unit, bounds, aliases), optional named ``definitions``,
-the mass matrix and the generalised forces G per dof, all in the form
+stiffness), first-order ``states`` if any, parameters (datum value, unit, bounds, aliases),
+optional named ``definitions``, the mass matrix, the generalised forces G per dof and the
+``rates`` F per first-order state, all in the form
 
-    M(p) q'' = G(q, q', p) - S(q, p),     S_i = K_i q_i   (or a stiffness law),
+    M(p) q'' = G(q, q', x, p) - S(q, p),     S_i = K_i q_i   (or a stiffness law),
+    x' = F(q, q', x, p),
 
 with expressions written as text and read by :mod:`~.expressions` (a whitelist, never
 ``eval``). Every problem of a file is reported at once as ``file:line: key: reason``
@@ -42,6 +44,7 @@ from .declaration import (
     Constraint,
     Dof,
     Family,
+    FirstOrderState,
     ModeGroup,
     Parameter,
 )
@@ -59,7 +62,7 @@ from .laws import LAWS
 
 #: Names a study reserves for the single law's coefficients (``K1`` = the dof's stiffness).
 THESIS_NAMES = frozenset({"K1", "K2", "K3"})
-#: Largest number of dofs a model file may declare.
+#: Largest number of dofs, and of first-order states, a model file may declare.
 MAX_DOFS = 32
 #: Probe states (multiples of each dof's amplitude) for the derived ``symmetric``/``linear``.
 PROBES = (0.37, -0.61)
@@ -107,11 +110,6 @@ def _as_bounds(value: Any) -> Bounds | None:
           "got {value}")
 
 
-def _not_yet(value: Any) -> None:
-    if value is not None:
-        _fail("first-order states are not supported yet: declare second-order dofs")
-
-
 def _as_model_name(value: Any) -> str:
     if not isinstance(value, str) or not NAME_RE.fullmatch(value) or len(value) > 40:
         _fail("expected a name of letters, digits and '_' starting with a letter, at most 40 "
@@ -134,6 +132,16 @@ class DofEntry(_Strict):
     amplitude: Positive = Field(1.0, description="Typical amplitude in its unit: scales "
                                 "AUTO's state and every amplitude threshold.")
     rate: Symbol | None = Field(None, description="Name of its rate (default d<name>).")
+
+
+class StateEntry(_Strict):
+    """A first-order state x_j: its rate x_j' is given under ``rates``."""
+
+    name: Symbol = Field(description="Name (state order = list order, after the dofs' rates).")
+    unit: Text = Field("1", description="Unit of the state.")
+    description: Text = Field("", description="What it is.")
+    amplitude: Positive = Field(1.0, description="Typical size in its unit: scales AUTO's "
+                                "state.")
 
 
 class ParameterEntry(_Strict):
@@ -176,11 +184,13 @@ class ModelFile(_Strict):
 
     name: Annotated[str, BeforeValidator(_as_model_name)]
     description: Text = ""
-    dofs: tuple[DofEntry, ...] = Field(min_length=1, max_length=MAX_DOFS)
+    dofs: tuple[DofEntry, ...] = Field((), max_length=MAX_DOFS)
+    states: tuple[StateEntry, ...] = Field((), max_length=MAX_DOFS)
     parameters: tuple[ParameterEntry, ...] = Field(min_length=1)
     definitions: dict[str, Expr] = Field(default_factory=dict)
-    mass: tuple[tuple[Expr, ...], ...] | tuple[Expr, ...]
-    forces: dict[str, Expr]
+    mass: tuple[tuple[Expr, ...], ...] | tuple[Expr, ...] | None = None
+    forces: dict[str, Expr] = Field(default_factory=dict)
+    rates: dict[str, Expr] = Field(default_factory=dict)
     time_scale: Positive | None = None
     hub: PathEntry | None = None
     mode_groups: tuple[ModeGroupEntry, ...] = ()
@@ -189,32 +199,32 @@ class ModelFile(_Strict):
     linear: Boolean | None = None
     provisional: Boolean = False
     notes: Text = ""
-    states: Annotated[None, BeforeValidator(_not_yet)] = Field(
-        None, description="First-order states: not supported yet.")
-    rates: Annotated[None, BeforeValidator(_not_yet)] = None
 
 
 @dataclass(frozen=True)
 class FileEquations:
-    """The (M, G) of a model file as sympy, from its checked expressions (see
+    """The (M, G, F) of a model file as sympy, from its checked expressions (see
     :data:`~.declaration.Equations`)."""
 
     definitions: tuple[tuple[str, Expression], ...]
     mass: tuple[tuple[Expression, ...], ...]
     forces: tuple[Expression, ...]
-    rates: tuple[tuple[str, str], ...]  # (dof, rate name)
+    rate_names: tuple[tuple[str, str], ...]  # (dof, the name of its rate)
+    rates: tuple[Expression, ...] = ()  # of the first-order states, in their order
 
-    def __call__(self, q: dict, v: dict, p: dict):
+    def __call__(self, q: dict, v: dict, p: dict, x: dict):
         import sympy as sp
 
         from .expressions import to_sympy
 
-        symbols = {**p, **q, **{rate: v[dof] for dof, rate in self.rates}}
+        symbols = {**p, **q, **{rate: v[dof] for dof, rate in self.rate_names}, **x}
         for name, expression in self.definitions:
             symbols[name] = to_sympy(expression, symbols)
-        mass = sp.Matrix([[to_sympy(e, symbols) for e in row] for row in self.mass])
-        forces = sp.Matrix([to_sympy(e, symbols) for e in self.forces])
-        return mass, forces
+        n = len(self.forces)
+        mass = sp.Matrix(n, n, [to_sympy(e, symbols) for row in self.mass for e in row])
+        forces = sp.Matrix(n, 1, [to_sympy(e, symbols) for e in self.forces])
+        rates = sp.Matrix(len(self.rates), 1, [to_sympy(e, symbols) for e in self.rates])
+        return mass, forces, rates
 
 
 def read_model_file(path: Path, label: str | None = None) -> Family:
@@ -223,7 +233,21 @@ def read_model_file(path: Path, label: str | None = None) -> Family:
     return model_from_text(_read_text(path, label, "model").replace("\r\n", "\n"), label)
 
 
-def model_from_text(text: str, label: str) -> Family:
+def read_builtin(path: Path) -> Family:
+    """The family of one of whirl's own model files (``models/builtin``): read with libyaml
+    and without the line tracking that only messages about a user's file need (a run reads
+    one at start-up); the same checks, any problem a bug of whirl's."""
+    import yaml
+
+    text = path.read_text(encoding="utf-8")
+    declared = ModelFile.model_validate(yaml.load(text, Loader=yaml.CSafeLoader))
+    problems = _Checker(declared, builtin=True).problems()
+    if problems:
+        raise ValueError(f"{path}: {problems}")
+    return _family(declared, text)
+
+
+def model_from_text(text: str, label: str, builtin: bool = False) -> Family:
     """The family the model file ``text`` declares (messages name it ``label``)."""
     tree = _Tree(_compose(text, label, "model"))
     try:
@@ -231,7 +255,7 @@ def model_from_text(text: str, label: str) -> Family:
     except ValidationError as error:
         problems = [_translate(e, tree, ModelFile) for e in error.errors(include_url=False)]
         raise StudyError(_report(tree.problems + problems, tree, label)) from None
-    problems = tree.problems + _Checker(declared).problems()
+    problems = tree.problems + _Checker(declared, builtin).problems()
     if problems:
         raise StudyError(_report(problems, tree, label))
     return _family(declared, text)
@@ -241,8 +265,9 @@ def model_from_text(text: str, label: str) -> Family:
 class _Checker:
     """The checks that span keys: names, references, shapes and the datum."""
 
-    def __init__(self, model: ModelFile) -> None:
+    def __init__(self, model: ModelFile, builtin: bool = False) -> None:
         self.model = model
+        self.builtin = builtin
         self.found: list[tuple[tuple, str]] = []
 
     def problems(self) -> list[tuple[tuple, str]]:
@@ -263,6 +288,7 @@ class _Checker:
         for i, d in enumerate(model.dofs):
             names.append((("dofs", i, "name"), d.name))
             names.append((("dofs", i, "rate" if d.rate else "name"), _rate(d)))
+        names += [(("states", i, "name"), x.name) for i, x in enumerate(model.states)]
         for i, p in enumerate(model.parameters):
             names.append((("parameters", i, "name"), p.name))
             names += [(("parameters", i, "aliases", k), a) for k, a in enumerate(p.aliases)]
@@ -271,6 +297,9 @@ class _Checker:
 
     def _names(self) -> None:
         model = self.model
+        if not model.dofs and not model.states:
+            self._add(("dofs",), "a model needs at least one dof (or a first-order state under "
+                                 "`states`)")
         seen: dict[str, str] = {}
         for loc, name in self._declared():
             if name.lower() in seen:
@@ -287,6 +316,10 @@ class _Checker:
             if len(f"max_{_rate(d)}") > AUTO_NAME_LENGTH:
                 self._add(("dofs", i, "name"), f"the rate name {_rate(d)!r} is too long for "
                           f"AUTO (at most {AUTO_NAME_LENGTH - 4} characters)")
+        for i, x in enumerate(model.states):
+            if len(f"max_{x.name}") > AUTO_NAME_LENGTH:
+                self._add(("states", i, "name"), f"{x.name!r} is too long for AUTO (a state "
+                          f"name has at most {AUTO_NAME_LENGTH - 4} characters)")
         reserved = _law_names(model)
         for i, p in enumerate(model.parameters):
             for k, name in enumerate((p.name, *p.aliases)):
@@ -297,24 +330,19 @@ class _Checker:
                     self._add(loc, f"{name!r} is the name of a stiffness law's coefficient "
                                    f"({reserved[name]})")
         parameters = {p.name for p in model.parameters}
-        stiffnesses: dict[str, str] = {}
-        for i, d in enumerate(model.dofs):
+        for i, d in enumerate(model.dofs):  # dofs may share one (an isotropic spring)
             if d.stiffness not in parameters:
                 self._add(("dofs", i, "stiffness"), f"no parameter {d.stiffness!r} is declared")
-            elif d.stiffness in stiffnesses:
-                self._add(("dofs", i, "stiffness"), f"{d.stiffness!r} is already the "
-                          f"stiffness of dof {stiffnesses[d.stiffness]!r}")
-            stiffnesses.setdefault(d.stiffness, d.name)
         from . import FAMILIES
 
-        if model.name in FAMILIES:
+        if model.name in FAMILIES and not self.builtin:
             self._add(("name",), f"{model.name!r} is the name of a built-in model")
 
     # -------------------------------------------------------------- references
     def _references(self) -> None:
         model = self.model
         parameters = {p.name for p in model.parameters}
-        states = {d.name for d in model.dofs} | {_rate(d) for d in model.dofs}
+        states = set(_state_names(model))
         known = parameters | states
         state_free = set(parameters)
         for name, expression in model.definitions.items():
@@ -342,6 +370,17 @@ class _Checker:
         missing = [d for d in dofs if d not in model.forces]
         if missing:
             self._add(("forces",), f"no force for dof {', '.join(missing)} (write 0 if none)")
+        first_order = [x.name for x in model.states]
+        for name, expression in model.rates.items():
+            if name not in first_order:
+                self._add(("rates", name), f"no first-order state {name!r} (states: "
+                          f"{', '.join(first_order) or 'none'})")
+            unknown = sorted(expression.names - known)
+            if unknown:
+                self._add(("rates", name), _unknown(unknown))
+        missing = [x for x in first_order if x not in model.rates]
+        if missing:
+            self._add(("rates",), f"no rate for state {', '.join(missing)} (write 0 if none)")
         if model.hub is not None:
             self._path(("hub",), model.hub, states)
         for i, group in enumerate(model.mode_groups):
@@ -360,6 +399,12 @@ class _Checker:
 
     def _mass(self, known: set[str], state_free: set[str]) -> None:
         n = len(self.model.dofs)
+        if self.model.mass is None or not n:
+            if n:
+                self._add(("mass",), f"missing: the {n} x {n} mass matrix of the dofs")
+            elif self.model.mass:
+                self._add(("mass",), "a model without dofs has no mass matrix")
+            return
         rows = _mass_rows(self.model)
         if rows is None:
             count = len(self.model.mass)
@@ -397,14 +442,13 @@ class _Checker:
                 self._add(("parameters", i, "value"), f"{p.value:g} is outside its bounds "
                                                       f"{bounds.text(p.unit)}")
             values[p.name] = p.value
-        zero = {name: 0.0 for d in model.dofs for name in (d.name, _rate(d))}
+        zero = dict.fromkeys(_state_names(model), 0.0)
         try:
             point = _definitions_at(model, {**values, **zero})
         except _AtDatum as error:
             self._add(error.loc, error.reason)
             return
         rows = _mass_rows(model)
-        assert rows is not None
         mass = []
         for i, row in enumerate(rows):
             mass.append([])
@@ -421,18 +465,19 @@ class _Checker:
                     self._add(("mass", i, j), f"the mass matrix must be symmetric: entry "
                               f"({i}, {j}) is {mass[i][j]:g} at the datum, ({j}, {i}) "
                               f"{mass[j][i]:g}")
-        if not self.found and not _positive_definite(mass):
+        if not self.found and mass and not _positive_definite(mass):
             self._add(("mass",), "the mass matrix is singular or not positive definite at "
                                  "the datum")
-        for name, expression in model.forces.items():
-            try:
-                force = evaluate(expression, point)
-            except ArithmeticError as error:
-                self._add(("forces", name), f"cannot be computed at the datum with every "
-                                            f"state 0 ({error})")
-                continue
-            if not math.isfinite(force):
-                self._add(("forces", name), "is not finite at the datum with every state 0")
+        for key, expressions in (("forces", model.forces), ("rates", model.rates)):
+            for name, expression in expressions.items():
+                try:
+                    value = evaluate(expression, point)
+                except ArithmeticError as error:
+                    self._add((key, name), f"cannot be computed at the datum with every "
+                                           f"state 0 ({error})")
+                    continue
+                if not math.isfinite(value):
+                    self._add((key, name), "is not finite at the datum with every state 0")
         for i, constraint in enumerate(model.constraints):
             if not constraint.expression.holds(values):
                 self._add(("constraints", i, "expression"), "does not hold at the datum")
@@ -466,6 +511,18 @@ def _rate(dof: DofEntry) -> str:
     return dof.rate or f"d{dof.name}"
 
 
+def _state_names(model: ModelFile) -> list[str]:
+    """Every state in state order: the dofs, their rates, the first-order states."""
+    return ([d.name for d in model.dofs] + [_rate(d) for d in model.dofs]
+            + [x.name for x in model.states])
+
+
+def _state_scales(model: ModelFile) -> list[float]:
+    """A typical size of each state (in state order): a rate's is its dof's amplitude."""
+    dofs = [d.amplitude for d in model.dofs]
+    return dofs + dofs + [x.amplitude for x in model.states]
+
+
 def _law_names(model: ModelFile) -> dict[str, str]:
     """Parameter names the stiffness laws give their coefficients on this model's dofs."""
     names = {}
@@ -482,10 +539,12 @@ def _law_names(model: ModelFile) -> dict[str, str]:
 
 
 def _mass_rows(model: ModelFile) -> list[list[Expression]] | None:
-    """The mass matrix as rows (a diagonal given as a list filled with zeros); None if its
-    shape is wrong."""
+    """The mass matrix as rows (a diagonal given as a list filled with zeros; none without
+    dofs); None if its shape is wrong."""
     n = len(model.dofs)
-    if len(model.mass) != n:
+    if not n:
+        return []
+    if model.mass is None or len(model.mass) != n:
         return None
     if all(isinstance(row, tuple) for row in model.mass):
         return [list(row) for row in model.mass] if all(len(r) == n for r in model.mass) \
@@ -548,8 +607,9 @@ def _family(model: ModelFile, text: str) -> Family:
     assert rows is not None
     equations = FileEquations(tuple(model.definitions.items()), tuple(map(tuple, rows)),
                               tuple(model.forces[d.name] for d in model.dofs),
-                              tuple((d.name, _rate(d)) for d in model.dofs))
-    states = [d.name for d in model.dofs] + [_rate(d) for d in model.dofs]
+                              tuple((d.name, _rate(d)) for d in model.dofs),
+                              tuple(model.rates[x.name] for x in model.states))
+    states = _state_names(model)
     constraints = tuple(Constraint(tuple(sorted(c.expression.names)), c.expression.holds,
                                    c.reason or f"{c.expression.text} must hold")
                         for c in model.constraints)
@@ -570,6 +630,8 @@ def _family(model: ModelFile, text: str) -> Family:
         linear=model.linear if model.linear is not None else probes[1],
         provisional=model.provisional,
         notes=model.notes,
+        first_order=tuple(FirstOrderState(x.name, x.unit, x.description, x.amplitude)
+                          for x in model.states),
         key=content_key(model),
         source=text,
     )
@@ -614,15 +676,16 @@ def _combination_pair(path: PathEntry | None, states: list[str]):
 
 
 def _forces_at(model: ModelFile, datum: dict, state: dict[str, float]) -> list[float]:
+    """The forces G per dof, then the rates F per first-order state, at ``state``."""
     point = _definitions_at(model, {**datum, **state})
-    return [evaluate(model.forces[d.name], point) for d in model.dofs]
+    return ([evaluate(model.forces[d.name], point) for d in model.dofs]
+            + [evaluate(model.rates[x.name], point) for x in model.states])
 
 
 def _probes(model: ModelFile, datum: dict) -> tuple[bool, bool]:
-    """(odd, linear): whether the forces are odd in the states and linear in them, probed at
-    the datum at two states of a few typical amplitudes."""
-    names = [n for d in model.dofs for n in (d.name, _rate(d))]
-    scale = [d.amplitude for d in model.dofs for _ in range(2)]
+    """(odd, linear): whether the forces and rates are odd in the states and linear in them,
+    probed at the datum at two states of a few typical sizes."""
+    names, scale = _state_names(model), _state_scales(model)
 
     def state(factor: float, shift: int) -> dict[str, float]:
         return {n: factor * s * (1 + 0.13 * ((k + shift) % 5)) for k, (n, s) in
@@ -649,29 +712,32 @@ def _probes(model: ModelFile, datum: dict) -> tuple[bool, bool]:
 
 def _time_scale(model: ModelFile, datum: dict) -> float:
     """A reference frequency [rad/s]: the geometric mean of the moduli of the linear model's
-    eigenvalues at the datum (finite differences of the forces), to two significant
-    figures; 1 where none is non-zero."""
+    eigenvalues at the datum with every state 0 (finite differences of the forces and
+    rates), to two significant figures; 1 where none is non-zero."""
     import numpy as np
 
-    names = [d.name for d in model.dofs] + [_rate(d) for d in model.dofs]
-    n = len(model.dofs)
+    names, scale = _state_names(model), _state_scales(model)
+    n, size = len(model.dofs), len(names)
     zero = dict.fromkeys(names, 0.0)
     try:
         point = _definitions_at(model, {**datum, **zero})
         rows = _mass_rows(model)
         assert rows is not None
-        mass = np.array([[evaluate(e, point) for e in row] for row in rows])
-        jacobian = np.zeros((n, 2 * n))
+        mass = np.array([[evaluate(e, point) for e in row] for row in rows]).reshape(n, n)
+        slopes = np.zeros((size - n, size))
         for k, name in enumerate(names):
-            step = 1e-6 * model.dofs[k % n].amplitude
+            step = 1e-6 * scale[k]
             up = _forces_at(model, datum, {**zero, name: step})
             down = _forces_at(model, datum, {**zero, name: -step})
-            jacobian[:, k] = (np.array(up) - np.array(down)) / (2 * step)
+            slopes[:, k] = (np.array(up) - np.array(down)) / (2 * step)
     except (ArithmeticError, _AtDatum):
         return 1.0
-    stiffness = np.diag([datum[d.stiffness] for d in model.dofs])
-    jacobian[:, :n] -= stiffness
-    system = np.block([[np.zeros((n, n)), np.eye(n)], [np.linalg.solve(mass, jacobian)]])
+    slopes[:n, :n] -= np.diag([datum[d.stiffness] for d in model.dofs])
+    system = np.zeros((size, size))
+    system[:n, n:2 * n] = np.eye(n)
+    if n:
+        system[n:2 * n] = np.linalg.solve(mass, slopes[:n])
+    system[2 * n:] = slopes[n:]
     moduli = np.abs(np.linalg.eigvals(system))
     moduli = moduli[np.isfinite(moduli) & (moduli > 1e-9)]
     if moduli.size == 0:

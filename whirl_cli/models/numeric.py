@@ -8,8 +8,9 @@ M(p) v' = R):
 
 * ``prepare(p)``: the parameter values and every subexpression that depends on parameters
   only (aerodynamic coefficients, ...), computed once per parameter set;
-* ``residual(y, c)``, ``residual_jacobian(y, c)``: R and dR/dy from the state and
-  ``c = prepare(p)``; ``residual_tensors(y, p)``: the non-zero second and third derivatives;
+* ``residual(y, c)``, ``residual_jacobian(y, c)``: [R; F] and its derivative by y from the
+  state and ``c = prepare(p)`` (F the rates of the first-order states, if any);
+  ``residual_tensors(y, p)``: the non-zero second and third derivatives;
 * ``mass(p)``: the entries of M, and ``DIAGONAL_MASS``.
 
 :class:`Numeric` adds the generic part: q' = v, and the solve with M (a division where M is
@@ -36,9 +37,10 @@ READERS = frozenset({"__init__.py", "file.py"})
 
 @cache
 def code_key() -> str:
-    """sha256 over the source of the models package that generated code depends on
-    (declarations, laws, the built-in families, the generators, the expression reader): a
-    change to any of it regenerates every variant's code."""
+    """sha256 over the generator: the source of the models package that generated code
+    depends on (declarations, laws, the expression reader, the symbolic and numeric
+    generators). A change to it regenerates every variant's code; the models themselves are
+    files, whose content is in each family's key (:func:`variant_key`)."""
     digest = hashlib.sha256()
     for path in sorted(PACKAGE.rglob("*.py")):
         if path.relative_to(PACKAGE).as_posix() in READERS:
@@ -49,8 +51,9 @@ def code_key() -> str:
 
 
 def variant_key(model) -> str:
-    """Identifies everything generated for ``model`` without generating it."""
-    declared = f"{model.family.key}:" if model.family.key else ""  # a model file's content
+    """Identifies everything generated for ``model`` without generating it: the generator,
+    what its model file declares (a comment in one file changes no other's key) and laws."""
+    declared = f"{model.family.key}:" if model.family.key else ""
     return hashlib.sha256(f"{code_key()}:{declared}{model.name}:{model.laws}".encode()
                           ).hexdigest()
 
@@ -70,9 +73,11 @@ def numeric_source(model, exact: bool = False) -> str:
     states = [str(s) for s in symbolic.states]
     params = [str(s) for s in symbolic.parameters]
     n_dof, n = len(symbolic.q), len(symbolic.states)
+    n_rows = n_dof + len(symbolic.x)
 
-    residual = [_by_state(e, symbolic.states) for e in symbolic.residual]
-    jacobian = [_by_state(e, symbolic.states) for e in symbolic.residual_jacobian]
+    residual = [_by_state(e, symbolic.states) for e in symbolic.rows]
+    jacobian = [_by_state(e, symbolic.states)
+                for e in symbolic.residual_jacobian.col_join(symbolic.rates_jacobian)]
     temporaries, reduced = sp.cse(residual + jacobian, symbols=sp.numbered_symbols("w_"),
                                   order="canonical")
     parameter_only: list[tuple[sp.Symbol, sp.Expr]] = []
@@ -85,7 +90,7 @@ def numeric_source(model, exact: bool = False) -> str:
         else:
             state_dependent.append((symbol, expression))
     prepared = params + [str(s) for s, _ in parameter_only]
-    forces, slopes = reduced[:n_dof], reduced[n_dof:]
+    forces, slopes = reduced[:n_rows], reduced[n_rows:]
 
     # M^-1 as prepared numbers (field_at: fixed parameters): 1/M_ii, or a numeric inverse
     inverse = [[sp.Symbol(f"m_{i}_{j}") for j in range(n_dof)] for i in range(n_dof)]
@@ -105,9 +110,9 @@ def numeric_source(model, exact: bool = False) -> str:
     force_symbols = [sp.Symbol(f"r_{j}") for j in range(n_dof)]
     slope_symbols = [sp.S.Zero if slopes[j * n + k] == 0 else sp.Symbol(f"s_{j}_{k}")
                      for j in range(n_dof) for k in range(n)]
-    force_lines = list(zip(force_symbols, forces, strict=True))
-    slope_lines = [(symbol, slope) for symbol, slope in zip(slope_symbols, slopes, strict=True)
-                   if symbol != 0]
+    force_lines = list(zip(force_symbols, forces[:n_dof], strict=True))
+    slope_lines = [(symbol, slope) for symbol, slope in zip(slope_symbols, slopes[:n_dof * n],
+                                                             strict=True) if symbol != 0]
     accelerations = [sp.Add(*[inverse[i][j] * force_symbols[j] for j in range(n_dof)
                               if structure[i][j]]) for i in range(n_dof)]
     lower = [sp.Add(*[inverse[i][j] * slope_symbols[j * n + k] for j in range(n_dof)
@@ -143,6 +148,7 @@ def numeric_source(model, exact: bool = False) -> str:
         "",
         f"N_DOF = {n_dof}",
         f"N_STATES = {n}",
+        *([f"N_FIRST_ORDER = {n_rows - n_dof}"] if n_rows > n_dof else []),
         f"DIAGONAL_MASS = {symbolic.diagonal_mass}",
         f"TENSOR_INDEX = {list(nonzero)}",
         "",
@@ -174,12 +180,12 @@ def numeric_source(model, exact: bool = False) -> str:
         "",
         "",
         "def field(y, f):",
-        *body(used(forces) + force_lines, list(symbolic.v) + accelerations,
+        *body(used(forces) + force_lines, list(symbolic.v) + accelerations + forces[n_dof:],
               [unpack(states, "y"), unpack(field_constants, "f")]),
         "",
         "",
         "def field_jacobian(y, f):",
-        *body(used(slopes) + slope_lines, upper + lower,
+        *body(used(slopes) + slope_lines, upper + lower + slopes[n_dof * n:],
               [unpack(states, "y"), unpack(field_constants, "f")]),
         "",
     ]
@@ -225,7 +231,7 @@ def load(model, exact: bool = False) -> Numeric:
         write_atomically(path, text)
     namespace: dict = {}
     exec(compile(text, str(path), "exec"), namespace)  # noqa: S102 - whirl's own generated code
-    return Numeric(model.n_states, namespace)
+    return Numeric(namespace)
 
 
 def _stack(values, axis: int) -> np.ndarray:
@@ -233,11 +239,12 @@ def _stack(values, axis: int) -> np.ndarray:
 
 
 class Numeric:
-    """dy/dt = [v, M^-1 R], its Jacobian and derivative tensors from a generated module."""
+    """dy/dt = [v, M^-1 R, F], its Jacobian and derivative tensors from a generated module."""
 
-    def __init__(self, n_states: int, module: dict) -> None:
-        self.n = n_states
-        self.n_dof = n_states // 2
+    def __init__(self, module: dict) -> None:
+        self.n = int(module["N_STATES"])
+        self.n_dof = int(module["N_DOF"])
+        self.n_rows = self.n - self.n_dof  # rows of [R; F]
         self.prepare = module["prepare"]
         self.residual = module["residual"]
         self.residual_jacobian = module["residual_jacobian"]
@@ -254,7 +261,11 @@ class Numeric:
 
     def _mass(self, params) -> np.ndarray:
         """M with the points first: (..., n_dof, n_dof)."""
-        entries = _stack(self.mass(tuple(params)), axis=-1)
+        entries = self.mass(tuple(params))
+        if not entries:  # no dofs
+            points = np.shape(params)[1:]
+            return np.zeros(points + (0, 0))
+        entries = _stack(entries, axis=-1)
         return entries.reshape(entries.shape[:-1] + (self.n_dof, self.n_dof))
 
     def _solved(self, mass: np.ndarray, right: np.ndarray) -> np.ndarray:
@@ -268,34 +279,42 @@ class Numeric:
     def rhs(self, y, params) -> np.ndarray:
         """dy/dt: (n,) or (n, M), like ``y``/``params`` (P,) or (P, M)."""
         y = tuple(y)
-        forces = _stack(self.residual(y, self.prepare(tuple(params))), axis=-1)
-        mass = self._mass(params)
-        acceleration = self._solved(mass, forces[..., None])[..., 0]  # (..., n_dof)
-        values = list(y[self.n_dof:]) + [acceleration[..., i] for i in range(self.n_dof)]
+        rows = _stack(self.residual(y, self.prepare(tuple(params))), axis=-1)
+        k = self.n_dof
+        acceleration = self._solved(self._mass(params), rows[..., :k, None])[..., 0] if k \
+            else rows[..., :0]
+        values = list(y[k:2 * k]) + [acceleration[..., i] for i in range(k)] \
+            + [rows[..., i] for i in range(k, self.n_rows)]
         return _stack(values, axis=0)
 
     def jacobian(self, y, params) -> np.ndarray:
         """df/dy: (n, n), or (M, n, n) with M points."""
         y = tuple(y)
         entries = _stack(self.residual_jacobian(y, self.prepare(tuple(params))), axis=-1)
-        lower = entries.reshape(entries.shape[:-1] + (self.n_dof, self.n))
-        lower = self._solved(self._mass(params), lower)
-        upper = np.zeros(lower.shape[:-2] + (self.n_dof, self.n))
-        upper[..., np.arange(self.n_dof), self.n_dof + np.arange(self.n_dof)] = 1.0
-        return np.concatenate([upper, lower], axis=-2)
+        rows = entries.reshape(entries.shape[:-1] + (self.n_rows, self.n))
+        k = self.n_dof
+        lower = self._solved(self._mass(params), rows[..., :k, :]) if k else rows[..., :0, :]
+        upper = np.zeros(rows.shape[:-2] + (k, self.n))
+        upper[..., np.arange(k), k + np.arange(k)] = 1.0
+        return np.concatenate([upper, lower, rows[..., k:, :]], axis=-2)
 
     def tensors(self, y, params) -> tuple[np.ndarray, np.ndarray]:
         """(d2f/dy2 (n, n, n), d3f/dy3 (n, n, n, n)) at one point."""
-        n, k = self.n, self.n_dof
-        flat = np.zeros(k * n**2 + k * n**3)
+        n, k, r = self.n, self.n_dof, self.n_rows
+        flat = np.zeros(r * n**2 + r * n**3)
         if len(self.tensor_index):
             flat[self.tensor_index] = np.array(
                 self.residual_tensors(tuple(y), tuple(params)), dtype=float)
-        inverse = np.linalg.inv(self._mass(params))
+        second_rows = flat[:r * n**2].reshape(r, n, n)
+        third_rows = flat[r * n**2:].reshape(r, n, n, n)
         second = np.zeros((n, n, n))
         third = np.zeros((n, n, n, n))
-        second[k:] = np.einsum("ij,j...->i...", inverse, flat[:k * n**2].reshape(k, n, n))
-        third[k:] = np.einsum("ij,j...->i...", inverse, flat[k * n**2:].reshape(k, n, n, n))
+        if k:
+            inverse = np.linalg.inv(self._mass(params))
+            second[k:2 * k] = np.einsum("ij,j...->i...", inverse, second_rows[:k])
+            third[k:2 * k] = np.einsum("ij,j...->i...", inverse, third_rows[:k])
+        second[2 * k:] = second_rows[k:]
+        third[2 * k:] = third_rows[k:]
         return second, third
 
     def field_at(self, params):

@@ -7,14 +7,15 @@ that running a study never imports sympy.
 
 Conventions
 -----------
-* The state is y = [q, v]: the dofs in declaration order, then their rates, in SI units; the
-  physical system is dy/dt = f(y, p) with time in seconds.
+* The state is y = [q, v, x]: the dofs in declaration order, then their rates, then the
+  first-order states (if any), in SI units; the physical system is dy/dt = f(y, p) with time
+  in seconds.
 * AUTO integrates a non-dimensional version: tau = ``time_scale`` * t and y* = y /
   ``state_scale``, with each dof scaled by its typical amplitude and each rate by that times
-  ``time_scale``. Hence dy*/dtau = f(S y*, p) / (S * time_scale). Periods from AUTO divide by
-  ``time_scale`` to give seconds; eigenvalues multiply by it to give 1/s; Floquet multipliers
-  are unchanged. Amplitude thresholds are set in these units, so they scale with each dof's
-  typical amplitude.
+  ``time_scale``, each first-order state by its typical amplitude. Hence dy*/dtau =
+  f(S y*, p) / (S * time_scale). Periods from AUTO divide by ``time_scale`` to give seconds;
+  eigenvalues multiply by it to give 1/s; Floquet multipliers are unchanged. Amplitude
+  thresholds are set in these units, so they scale with each dof's typical amplitude.
 * Parameters: the family's, then each law's coefficients named by dof (``K2_theta``), in dof
   order; all of them travel to AUTO through PAR.
 """
@@ -62,7 +63,7 @@ class Model:
     def description(self) -> str:
         laws = ", ".join(f"{law} on {dof}" for law, dof in zip(self.laws, self.family.dof_names,
                                                                strict=True))
-        return f"{self.family.description}; {laws}"
+        return f"{self.family.description}; {laws}" if laws else self.family.description
 
     @property
     def notes(self) -> str:
@@ -88,13 +89,15 @@ class Model:
     def states(self) -> tuple[State, ...]:
         dofs = self.family.dofs
         return (tuple(State(d.name, d.unit, d.description) for d in dofs)
-                + tuple(State(d.rate, d.rate_unit, f"rate of {d.name}") for d in dofs))
+                + tuple(State(d.rate, d.rate_unit, f"rate of {d.name}") for d in dofs)
+                + tuple(State(x.name, x.unit, x.description) for x in self.family.first_order))
 
     @cached_property
     def state_scale(self) -> tuple[float, ...]:
         """Physical state = state_scale * AUTO state (see the module doc)."""
         amplitudes = tuple(float(d.amplitude) for d in self.family.dofs)
-        return amplitudes + tuple(a * self.time_scale for a in amplitudes)
+        return (amplitudes + tuple(a * self.time_scale for a in amplitudes)
+                + tuple(float(x.amplitude) for x in self.family.first_order))
 
     @cached_property
     def parameters(self) -> tuple[Parameter, ...]:
@@ -102,6 +105,22 @@ class Model:
         coefficients = tuple(p for dof, law in zip(self.family.dofs, self.law_objects, strict=True)
                              for p in law.parameters(dof, declared[dof.stiffness]))
         return self.family.parameters + coefficients
+
+    @cached_property
+    def typical_amplitudes(self) -> tuple[float, ...]:
+        """Each state's typical size, in state order: a dof's amplitude for the dof and for its
+        rate (per second), a first-order state's own: states divided by it are in typical
+        amplitudes, for tolerances that hold in any unit."""
+        amplitudes = tuple(float(d.amplitude) for d in self.family.dofs)
+        return amplitudes + amplitudes + tuple(float(x.amplitude)
+                                               for x in self.family.first_order)
+
+    @cached_property
+    def positions(self) -> tuple[int, ...]:
+        """Indices of the states that are not a dof's rate: the dofs, then the first-order
+        states (what amplitude bounds, divergence tests and plots of a motion watch)."""
+        k = self.n_dof
+        return tuple(range(k)) + tuple(range(2 * k, self.n_states))
 
     @cached_property
     def hub_matrix(self) -> np.ndarray:
@@ -134,7 +153,12 @@ class Model:
     # ------------------------------------------------------------------ names and lookup
     @property
     def n_states(self) -> int:
-        return 2 * len(self.family.dofs)
+        return 2 * len(self.family.dofs) + len(self.family.first_order)
+
+    @property
+    def n_dof(self) -> int:
+        """The number of dofs: the first n_dof states are the dofs, the next n_dof their rates."""
+        return len(self.family.dofs)
 
     @property
     def state_names(self) -> tuple[str, ...]:
@@ -287,9 +311,13 @@ class Model:
         lines = [f"{self.name}: {self.description}"
                  + (" [provisional: whirl's own derivation]" if self.family.provisional else "")]
         lines.append(f"  time scale: tau = {self.time_scale:g} rad/s * t")
-        lines.append("  degrees of freedom: " + ", ".join(
+        lines.append("  degrees of freedom: " + (", ".join(
             f"{d.name} [{d.unit}] (typical amplitude {d.amplitude:g} {d.unit}, stiffness "
-            f"{d.stiffness})" for d in self.family.dofs))
+            f"{d.stiffness})" for d in self.family.dofs) or "none"))
+        if self.family.first_order:
+            lines.append("  first-order states: " + ", ".join(
+                f"{x.name} [{x.unit}] (typical amplitude {x.amplitude:g})"
+                for x in self.family.first_order))
         lines.append("  states: " + ", ".join(f"{s.name} [{s.unit}]" for s in self.states))
         lines.append("  parameters:")
         for p in self.parameters:

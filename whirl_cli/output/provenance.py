@@ -14,6 +14,7 @@ from functools import cache
 from pathlib import Path
 
 from .. import __version__
+from ..models import file_key
 
 PACKAGE = Path(__file__).resolve().parent.parent
 
@@ -43,11 +44,13 @@ def provenance(study) -> dict[str, str]:
         "created": datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
     }
     family = study.variant().family
-    if family.key:  # a model file: the equations that made the result, and their hash
+    if file_key(study.model):  # a model file: the equations that made the result, their hash
         attributes["model_file"] = study.model
         attributes["model_file_yaml"] = family.source
         attributes["model_file_sha256"] = hashlib.sha256(family.source.encode()).hexdigest()
         attributes["model_key"] = family.key
+    if family.first_order:  # which states are not a dof or its rate
+        attributes["first_order_states"] = ",".join(x.name for x in family.first_order)
     try:
         described = subprocess.run(["git", "describe", "--always", "--dirty"], cwd=PACKAGE,
                                    capture_output=True, text=True, timeout=5, check=False)

@@ -3,7 +3,10 @@
 Layout (units in a ``units`` attribute on every physical dataset)::
 
     /                               attrs: whirl_schema, whirl_version, auto_version, study_name,
-                                           study_yaml, study_sha256, model, created, git_describe
+                                           study_yaml, study_sha256, model, created, git_describe;
+                                           a model file's model_file, model_file_yaml,
+                                           model_file_sha256, model_key, first_order_states
+                                           (comma-separated; only if it has any)
     /continuations/<name>/          attrs: kind (one-parameter | two-parameter)
         branches/<branch>/          attrs: kind, origin, status, message, run
             parameters   (N, P)     attrs: names, units
@@ -107,6 +110,7 @@ from ..results import (
     SpecialPoint,
     StudyResult,
     UnsafeInterval,
+    first_order_states,
 )
 from .atomic import publish
 from .guard import RESULT, check
@@ -622,7 +626,8 @@ def read(path: Path) -> StudyResult:
                       for k, v in handle.attrs.items() if k not in skip}
         parameters = read_table(member(handle, "parameters"), ParameterValue, PARAMETER) \
             if schema >= 2 else ()
-        simulations = tuple(Simulation(name=name, **read_record(group, SIMULATION))
+        simulations = tuple(Simulation(name=name, **read_record(group, SIMULATION),
+                                       first_order=first_order_states(attributes))
                             for name, group in handle.get("simulations", {}).items())
         return StudyResult(text(attribute(handle, "study_name")),
                            text(attribute(handle, "model")),

@@ -25,7 +25,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..results import Branch, ContinuationResult, PointType, SpecialPoint, StudyResult
+from ..results import (
+    Branch,
+    ContinuationResult,
+    PointType,
+    SpecialPoint,
+    StudyResult,
+    positions,
+)
 from ..units import axis_label, display_unit
 from ..verdict import truncation
 
@@ -77,18 +84,19 @@ def summary_rows(result: StudyResult, dofs: Sequence[str] | None = None) -> list
     """One row per special point of every continuation of ``result``, in stored order.
 
     Plain points (regular, labelled, user, end and no-convergence points) are left out.
-    ``dofs``: the states whose amplitude is shown (the model's dofs); None: the first half of
-    each branch's states.
+    ``dofs``: the states whose amplitude is shown; None: every state but the dofs' rates.
     """
     return [row for continuation in result.continuations
-            for row in continuation_rows(continuation, dofs)]
+            for row in continuation_rows(continuation, dofs, result.first_order)]
 
 
-def continuation_rows(continuation: ContinuationResult, dofs: Sequence[str] | None = None
-                      ) -> list[SummaryRow]:
-    """The rows of :func:`summary_rows` of one continuation."""
+def continuation_rows(continuation: ContinuationResult, dofs: Sequence[str] | None = None,
+                      first_order: tuple[str, ...] = ()) -> list[SummaryRow]:
+    """The rows of :func:`summary_rows` of one continuation (``first_order``: the model's
+    first-order states)."""
     by_name = {b.name: b for b in continuation.branches}
-    return [_row(continuation, point, by_name.get(point.branch), continuation.branches, dofs)
+    return [_row(continuation, point, by_name.get(point.branch), continuation.branches,
+                 dofs, first_order)
             for point in continuation.special_points if _listed(point.point_type)]
 
 
@@ -109,14 +117,15 @@ def type_name(code: int) -> str:
 
 
 def _row(continuation: ContinuationResult, point: SpecialPoint, branch: Branch | None,
-         branches: Sequence[Branch], dofs: Sequence[str] | None) -> SummaryRow:
+         branches: Sequence[Branch], dofs: Sequence[str] | None,
+         first_order: tuple[str, ...]) -> SummaryRow:
     reference = branch if branch is not None else (branches[0] if branches else None)
     parameters = tuple(Quantity(name, _parameter_unit(name, branch, branches), float(value))
                        for name, value in zip(point.parameter_names,
                                               np.asarray(point.parameters, dtype=float),
                                               strict=False))
     return SummaryRow(continuation.name, point.branch, type_name(point.point_type), parameters,
-                      _amplitudes(point, reference, dofs), float(point.period),
+                      _amplitudes(point, reference, dofs, first_order), float(point.period),
                       _stability(point, branch), point.criticality,
                       point.status + (" (smoothing artefact)" if point.artefact else ""))
 
@@ -129,13 +138,14 @@ def _parameter_unit(name: str, branch: Branch | None, branches: Sequence[Branch]
     return ""
 
 
-def _amplitudes(point: SpecialPoint, branch: Branch | None, dofs: Sequence[str] | None
-                ) -> tuple[Quantity, ...]:
-    """The point's state for each dof, in the dof's unit (rad shown in deg)."""
+def _amplitudes(point: SpecialPoint, branch: Branch | None, dofs: Sequence[str] | None,
+                first_order: tuple[str, ...]) -> tuple[Quantity, ...]:
+    """The point's state for each of ``dofs`` (None: every state but the dofs' rates), in
+    its unit (rad shown in deg)."""
     if branch is None:
         return ()
     names = branch.state_names
-    shown = [name for name in (names[:len(names) // 2] if dofs is None else dofs)
+    shown = [name for name in (positions(names, first_order) if dofs is None else dofs)
              if name in names]
     state = np.asarray(point.state, dtype=float)
     amplitudes = []
@@ -309,7 +319,7 @@ def tables(result: StudyResult, dofs: Sequence[str] | None = None) -> list[Table
     a continuation without any gets a table whose body is "none")."""
     drawn = []
     for continuation in result.continuations:
-        rows = continuation_rows(continuation, dofs)
+        rows = continuation_rows(continuation, dofs, result.first_order)
         names = tuple(columns(rows)[1:])  # the continuation is the title
         cells = []
         for record in compact(records(rows)):

@@ -149,8 +149,7 @@ def _simulation_problems(items: Any, names: Names, family: str,
     """Each simulation: a unique name (given, or ``sim_<k>``), its overrides (as the study's,
     and the constraints with them on top of the study's values), initial-state keys states
     of the model, and ``law: exact`` only with a piecewise law (freeplay)."""
-    dofs = family_of(family).dofs
-    states = [d.name for d in dofs] + [d.rate for d in dofs]
+    states = family_of(family).state_names
     problems: list[Problem] = []
     taken: set[str] = set()
     for i, item in _dict_items(items):
@@ -189,6 +188,11 @@ def _law_problems(data: dict, family: str) -> list[Problem]:
     seen: dict[str, tuple] = {}
     for loc, block in law_blocks(data):
         if not isinstance(block, dict):
+            continue
+        if not dofs:
+            problems.append((loc or ("nonlinearity",), f"model {family_of(family).name} has no "
+                             "dofs (only first-order states): a stiffness law has nothing to "
+                             "act on"))
             continue
         dof = block_dof(block, family, single)
         if dof is None:
@@ -239,8 +243,7 @@ def _law_range_problems(loc: Loc, canonical: str, bounds: Any, names: Names,
 
 def _plot_state_problems(state: Any, family: str) -> list[Problem]:
     """``plot_state`` a state of the model: a dof or a rate."""
-    dofs = family_of(family).dofs
-    states = [d.name for d in dofs] + [d.rate for d in dofs]
+    states = family_of(family).state_names
     if not isinstance(state, str) or state in states:
         return []
     return [(("plot_state",), _choice_reason(states, repr(state)))]
@@ -426,8 +429,8 @@ def _continuation_problems(
             found += _orbits_problems(loc, item)
             found += _orbits_problems(loc, item, "explore")
             found += _seed_problems(loc, item.get("seeds"), family)
-            found += _initial_problems(loc + ("explore_initial",),
-                                       item.get("explore_initial"), family)
+            for key in ("explore_initial", "start_state"):
+                found += _initial_problems(loc + (key,), item.get(key), family)
             section = item.get("explore_section")
             if isinstance(section, str):
                 found += _state_problems(loc + ("explore_section",), section, family)
@@ -437,8 +440,7 @@ def _continuation_problems(
 
 def _seed_problems(loc: Loc, seeds: Any, family: str) -> list[Problem]:
     """Seeds naming states the model lacks."""
-    dofs = family_of(family).dofs
-    states = [d.name for d in dofs] + [d.rate for d in dofs]
+    states = family_of(family).state_names
     if not isinstance(seeds, list):
         return []
     return [(loc + ("seeds", k, name), _choice_reason(states, repr(name)))
@@ -448,8 +450,7 @@ def _seed_problems(loc: Loc, seeds: Any, family: str) -> list[Problem]:
 
 def _initial_problems(loc: Loc, initial: Any, family: str) -> list[Problem]:
     """An initial state (``explore_initial``) naming states the model lacks."""
-    dofs = family_of(family).dofs
-    states = [d.name for d in dofs] + [d.rate for d in dofs]
+    states = family_of(family).state_names
     if not isinstance(initial, dict):
         return []
     return [(loc + (name,), _choice_reason(states, repr(name)))
@@ -458,8 +459,7 @@ def _initial_problems(loc: Loc, initial: Any, family: str) -> list[Problem]:
 
 def _state_problems(loc: Loc, name: str, family: str) -> list[Problem]:
     """A state name (``explore_section``) the model lacks."""
-    dofs = family_of(family).dofs
-    states = [d.name for d in dofs] + [d.rate for d in dofs]
+    states = family_of(family).state_names
     return [] if name in states else [(loc, _choice_reason(states, repr(name)))]
 
 

@@ -63,7 +63,8 @@ def block_dof(block: Any, family: str, single: bool) -> Any:
     """The dof a law block names; a law given as a single mapping without one acts on the
     family's first dof (in a list every law names its dof)."""
     dof = _get(block, "dof")
-    return family_of(family).dofs[0].name if dof is None and single else dof
+    dofs = family_of(family).dof_names
+    return dofs[0] if dof is None and single and dofs else dof
 
 
 @dataclass(frozen=True)
@@ -127,7 +128,8 @@ def _names_of_data(data: dict) -> Names | None:
     laws = []
     for _, block in blocks:
         if block is None:
-            laws.append((family_of(family).dofs[0].name, {"type": "linear"}))
+            if family_of(family).dofs:  # none: a first-order model has no stiffness law
+                laws.append((family_of(family).dofs[0].name, {"type": "linear"}))
             continue
         if not isinstance(block, dict | BaseModel):
             return None
@@ -186,11 +188,13 @@ def _resolved(data: dict) -> dict:
     elif laws is not None:
         data["nonlinearity"] = _with_derived_defaults(laws)
     block = data.get("nonlinearity", {"type": "linear"})
-    first = names.model.family.dofs[0].name
-    if isinstance(block, dict) and block.get("dof") is None:
-        data["nonlinearity"] = {**block, "dof": first}
-    elif isinstance(block, BaseModel) and getattr(block, "dof", None) is None:
-        data["nonlinearity"] = block.model_copy(update={"dof": first})
+    dofs = names.model.family.dof_names
+    if not dofs and "nonlinearity" not in data:
+        data["nonlinearity"] = []  # a first-order model: no stiffness law
+    if dofs and isinstance(block, dict) and block.get("dof") is None:
+        data["nonlinearity"] = {**block, "dof": dofs[0]}
+    elif dofs and isinstance(block, BaseModel) and getattr(block, "dof", None) is None:
+        data["nonlinearity"] = block.model_copy(update={"dof": dofs[0]})
     values = _study_values(data, names)
     items = data.get("continuations")
     if isinstance(items, list | tuple):

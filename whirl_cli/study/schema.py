@@ -290,6 +290,12 @@ class OneParameterContinuation(_Strict):
     branch_points: Boolean = Field(
         True, description="Switch at branch points (pitchforks) to follow secondary equilibria."
     )
+    start_state: Annotated[dict[str, float] | None, BeforeValidator(_as_state)] = Field(
+        None,
+        description="Where Newton's method seeks the starting equilibrium at `start` when the "
+        "zero state is not one: state name -> value (angles in deg, rates in deg/s, other "
+        "states in their unit; unnamed states 0). Unset: from the zero state.",
+    )
     orbits_at: Annotated[tuple[Number, ...], AfterValidator(_at_most_orbits)] = Field(
         (),
         description="Parameter values (in its unit) at which every branch stores a labelled "

@@ -21,6 +21,7 @@ import h5py
 from .. import __version__
 from ..auto.toolchain import auto_version
 from ..errors import StudyError, WhirlError
+from ..models import MODEL_SUFFIX, file_key
 from ..output.provenance import code_sha256
 from ..output.store import check_contents
 from ..output.study_files import missing_plots
@@ -50,10 +51,6 @@ class SweepItem:
     @property
     def name(self) -> str:
         return self.study.name if self.study is not None else self.source.name
-
-
-#: How a model file beside studies is named, so that a directory sweep does not take it for one.
-MODEL_SUFFIX = ".model.yaml"
 
 
 def find_studies(paths: Iterable[str | os.PathLike[str]], what: str = "study files"
@@ -132,7 +129,7 @@ def _decide(study: Study, output: Path, force: bool) -> tuple[str, str, tuple[st
         return RUN, f"unreadable output ({type(error).__name__})", ()
     if stored.study_sha256 != study.sha256:
         return RUN, "study changed", ()
-    if stored.model_key != study.variant().family.key:
+    if stored.model_key != file_key(study.model):
         return RUN, "model file changed", ()
     if stored.whirl_version != __version__:
         return RUN, f"whirl {stored.whirl_version} -> {__version__}", ()
