@@ -12,6 +12,11 @@ onto a matplotlib Axes::
     table = api.special_points(api.read("linear-case2.h5"))
     api.draw(result, "bifurcation", ax)
 
+A model, built-in or a model file, as numbers (its right-hand side, Jacobian, eigenvalues)::
+
+    model = api.load_model("studies/nacelle_on_wing/nacelle_on_wing.model.yaml")
+    model.jacobian_numpy(np.zeros(model.n_states), model.parameter_vector({"V": 7.0}))
+
 Nothing here prints; progress of the AUTO runs goes to ``on_run`` (and ``on_slow``) if given.
 """
 
@@ -34,14 +39,34 @@ from .study import Study, load_study
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
+    from .models import Model
+
     from .output.study_files import Published
 
-__all__ = ["draw", "export", "load", "read", "run", "run_and_save", "save", "special_points"]
+__all__ = ["draw", "export", "load", "load_model", "read", "run", "run_and_save", "save",
+           "special_points"]
 
 
 def load(path: str | os.PathLike[str]) -> Study:
     """The validated study at ``path`` (a StudyError lists every problem)."""
     return load_study(path)
+
+
+def load_model(model: str | os.PathLike[str], laws: Sequence[str] | None = None) -> Model:
+    """A model: a built-in by name (``"classical"``) or a model file by path (checked; a
+    StudyError lists every problem), with the stiffness law ``laws[i]`` on its i-th dof
+    (default: the polynomial law on every dof, linear at its datum). What a study's
+    ``model:`` names, as :class:`~whirl_cli.models.Model`: names, units, datum values and
+    the generated numeric functions (``rhs_numpy``, ``jacobian_numpy``, ...)."""
+    from .models import FAMILIES, get_model, is_model_file, load_model_file
+
+    reference = os.fspath(model)
+    if reference not in FAMILIES and is_model_file(reference):
+        reference = load_model_file(Path(reference))
+    elif reference not in FAMILIES:
+        raise WhirlError(f"unknown model {reference!r} (built-in: {', '.join(FAMILIES)}; or "
+                         "a model file path ending in .yaml)")
+    return get_model(reference, tuple(laws) if laws else None)
 
 
 def run(study: Study | str | os.PathLike[str], jobs: int | None = None,
