@@ -40,7 +40,6 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
     from .models import Model
-
     from .output.study_files import Published
 
 __all__ = ["draw", "export", "load", "load_model", "read", "run", "run_and_save", "save",
