@@ -89,3 +89,25 @@ def test_sweep_sees_a_changed_model_file(tmp_path, edit):
     (tmp_path / MODEL.name).write_text(changed)
     assert _decide(load_study(study), tmp_path / "s.h5", False)[0] == (SKIP if edit == "comment"
                                                                else RUN)
+
+
+def test_a_model_file_is_generated_once_then_run_without_sympy(tmp_path):
+    """A model file's code goes into the user's cache (WHIRL_CACHE_DIR): the first run
+    generates it (sympy imported), a second run in a fresh process only reads it (no sympy),
+    and nothing is written into the package."""
+    import os
+    import subprocess
+    import sys
+
+    study = ROOT / "tests" / "data" / "lagged_spring_mu.yaml"
+    code = ("import sys; from whirl_cli import api; api.run(api.load(sys.argv[1]), jobs=1); "
+            "print('sympy' in sys.modules)")
+    env = {**os.environ, "WHIRL_CACHE_DIR": str(tmp_path / "cache")}
+    before = sorted(p.name for p in (ROOT / "whirl_cli" / "models").iterdir())
+    runs = [subprocess.run([sys.executable, "-c", code, str(study)], env=env, text=True,
+                           capture_output=True, timeout=300) for _ in range(2)]
+    assert [r.returncode for r in runs] == [0, 0], runs[0].stderr + runs[1].stderr
+    assert [r.stdout.split()[-1] for r in runs] == ["True", "False"]
+    generated = list((tmp_path / "cache").rglob("lagged_spring*"))
+    assert any(p.suffix == ".py" for p in generated), generated
+    assert sorted(p.name for p in (ROOT / "whirl_cli" / "models").iterdir()) == before
