@@ -23,10 +23,10 @@ import yaml
 from click.testing import CliRunner
 
 from whirl_cli.auto import codegen
-from whirl_cli.auto.constants import constants_text
+from whirl_cli.auto.constants import START_FILE, constants_text
 from whirl_cli.cli import cli
 from whirl_cli.errors import CodegenError
-from whirl_cli.models import all_variants
+from whirl_cli.models import all_variants, get_model, load_model_file
 from whirl_cli.output import store
 
 from .helpers import ROOT, STUDIES
@@ -114,6 +114,9 @@ FORTRAN_WORDS = {
     # statements and attributes the generator writes
     "subroutine", "end", "implicit", "none", "integer", "intent", "in", "out", "inout",
     "double", "precision", "external", "if", "return", "do",
+    # STPNT's reading of a starting state (whirl_start.txt): numbers into U only
+    "logical", "inquire", "file", "exist", "then", "open", "newunit", "status", "action",
+    "read", "close",
     # intrinsics sympy's fcode may emit for these models
     "sqrt", "asinh", "max", "min", "abs", "exp", "log", "sin", "cos", "tan", "sinh", "cosh",
     "tanh", "atan", "atan2", "asin", "acos", "sign",
@@ -148,24 +151,34 @@ def undeclared(source: str, model) -> set[str]:
     """Identifiers in the code of ``source`` that are not Fortran words, AUTO's routine and
     argument names, or names declared in it (the model's states and parameters, temporaries)."""
     code, strings = code_and_strings(source)
-    assert set(strings) <= {"'MAX'", "'MIN'"}, strings
+    # GETP's, and STPNT's start file (READ of numbers only, into U)
+    assert set(strings) <= {"'MAX'", "'MIN'", f"'{START_FILE}'", "'OLD'", "'READ'"}, strings
     declared = set()
     for line in code:
-        if line.strip().upper().startswith(("DOUBLE PRECISION ::", "INTEGER ::")):
+        if line.strip().upper().startswith(("DOUBLE PRECISION ::", "INTEGER ::",
+                                            "LOGICAL ::")):
             listed = re.sub(r"\([^)]*\)", "", line.split("::", 1)[1])  # drop array shapes
             declared |= {n.strip().lower() for n in listed.split(",")}
     names = {n.lower() for n in model.state_names + model.parameter_names}
     assert names <= declared
     temporaries = declared - names
-    work = {"wm", "wa", "wj", "wp", "i"}  # mass matrix, right-hand sides, loop index
-    assert all(re.fullmatch(r"w_[fupm]\d+", n) or n in work | SOLVER_NAMES
+    # mass matrix, right-hand sides, loop index; STPNT's start file: whether given, its unit
+    work = {"wm", "wa", "wj", "wp", "i", "given", "unitno"}
+    assert all(re.fullmatch(r"w_[fupmxyz]\d+", n) or n in work | SOLVER_NAMES
                for n in temporaries), temporaries
     code = [_SOLVER_CALL.sub("(", line) for line in code]
     return {word for line in code for word in _IDENTIFIER.findall(_NUMBER.sub(" ", line))
             if word.lower() not in FORTRAN_WORDS | AUTO_NAMES | declared | SOLVER_NAMES}
 
 
-@pytest.mark.parametrize("model", all_variants(), ids=lambda m: m.name)
+def first_order_models():
+    """Model files with first-order states (tests/data): the mixed and the pure case."""
+    data = Path(__file__).resolve().parents[1] / "data"
+    return [get_model(load_model_file(data / name)) for name in
+            ("lagged_spring.model.yaml", "lorenz.model.yaml")]
+
+
+@pytest.mark.parametrize("model", all_variants() + first_order_models(), ids=lambda m: m.name)
 def test_generated_fortran_holds_only_numbers_and_declared_names(model):
     source = codegen.fortran_source(model)
     assert undeclared(source, model) == set()
@@ -174,7 +187,8 @@ def test_generated_fortran_holds_only_numbers_and_declared_names(model):
                               "  CALL EXECUTE_COMMAND_LINE('x') ! x\n  IF (IJAC == 0) RETURN")
     with pytest.raises(AssertionError):
         undeclared(injected, model)
-    assert undeclared(source.replace("IF (IJAC == 0) RETURN", "K_theta = 0; CALL EXIT"),
+    name = model.parameter_names[0]  # declared: only the call is new
+    assert undeclared(source.replace("IF (IJAC == 0) RETURN", f"{name} = 0; CALL EXIT"),
                       model) == {"CALL", "EXIT"}
 
 

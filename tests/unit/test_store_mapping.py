@@ -25,7 +25,7 @@ STRUCTURAL = {
     results.RunRecord: {"name"},
     results.FreeplayAmplitudes: {"branch"},
     results.SeedOutcome: set(),
-    results.Simulation: {"name"},
+    results.Simulation: {"name", "first_order"},  # first_order: the file's root attribute
 }
 DECLARATIONS = {
     results.Branch: store.BRANCH, results.Orbit: store.ORBIT,
