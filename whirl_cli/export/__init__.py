@@ -19,7 +19,7 @@ from functools import partial
 from pathlib import Path
 
 from ..errors import OutputError
-from ..output.guard import Own, check
+from ..output.guard import Own, check, whirl_marked
 from ..results import StudyResult
 from . import csvfiles, matlab, netcdf
 
@@ -48,16 +48,10 @@ def _starting(*signatures: bytes) -> Callable[[int], str]:
 def _netcdf(fd: int) -> str:
     """"" for a NetCDF-4 file that is not a whirl result file (HDF5 without whirl's
     ``whirl_schema`` attribute)."""
-    if os.pread(fd, 8, 0) != b"\x89HDF\r\n\x1a\n":
-        return "a file that is not NetCDF-4"
-    import h5py
-
-    try:
-        with os.fdopen(os.dup(fd), "rb") as stream, h5py.File(stream, "r") as handle:
-            result = "whirl_schema" in handle.attrs
-    except (OSError, ValueError):
-        return "a damaged HDF5 file"
-    return "a whirl result file" if result else ""
+    marked = whirl_marked(fd)
+    if marked is None:
+        return "a file that is not NetCDF-4 (or a damaged one)"
+    return "a whirl result file" if marked else ""
 
 
 FORMATS: dict[str, Format] = {f.suffix: f for f in (

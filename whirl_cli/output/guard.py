@@ -45,17 +45,25 @@ class Own:
     recognise: Callable[[int], str]
 
 
-def _result(fd: int) -> str:
-    """"" for a whirl result file (HDF5 with the root attribute ``whirl_schema``)."""
+def whirl_marked(fd: int) -> bool | None:
+    """Whether the open HDF5 file ``fd`` has whirl's root attribute ``whirl_schema`` (a whirl
+    result file); None if it is not an HDF5 file or cannot be read as one."""
     if os.pread(fd, 8, 0) != b"\x89HDF\r\n\x1a\n":
-        return "a file that is not HDF5"
+        return None
     import h5py
 
     try:
         with os.fdopen(os.dup(fd), "rb") as stream, h5py.File(stream, "r") as handle:
-            marked = "whirl_schema" in handle.attrs
+            return "whirl_schema" in handle.attrs
     except (OSError, ValueError):
-        return "a damaged HDF5 file"
+        return None
+
+
+def _result(fd: int) -> str:
+    """"" for a whirl result file (HDF5 with the root attribute ``whirl_schema``)."""
+    marked = whirl_marked(fd)
+    if marked is None:
+        return "a file that is not HDF5 (or a damaged one)"
     return "" if marked else "an HDF5 file without whirl's whirl_schema attribute"
 
 
