@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 
 from whirl_cli.analysis.global_bifurcations import analyse
-from whirl_cli.models import Model, classical
+from whirl_cli.models import FAMILIES, Model
 from whirl_cli.results import Branch, BranchKind, Orbit, PointType
 
-MODEL = Model(classical.FAMILY, ("polynomial",) * 2)
+MODEL = Model(FAMILIES["classical"], ("polynomial",) * 2)
 PARAMETERS = {"K_psi": 0.3}
 ROWS = 12
 

@@ -8,10 +8,10 @@ from types import SimpleNamespace
 import numpy as np
 
 from whirl_cli.continuation.mirror import mirror_sources, mirrored_branch, mirrored_point
-from whirl_cli.models import Model, classical
+from whirl_cli.models import FAMILIES, Model
 from whirl_cli.results import Branch, BranchKind, Orbit, PointType, SpecialPoint
 
-MODEL = Model(classical.FAMILY, ("polynomial",) * 2)
+MODEL = Model(FAMILIES["classical"], ("polynomial",) * 2)
 PARAMETERS = {"K_psi": 0.3, "K2_theta": 10.0}
 STATE = np.array([0.1, 0.03, 0.0, 0.0])
 
