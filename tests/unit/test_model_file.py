@@ -218,6 +218,12 @@ def test_the_key_follows_what_is_declared_not_how_it_is_written():
     key = model_from_text(GOOD, "m.yaml").key
     assert model_from_text("# a comment\n" + GOOD.replace("2*c", "2 * c"), "m.yaml").key == key
     assert model_from_text(GOOD.replace("2*c", "3*c"), "m.yaml").key != key
+    # a default written out, or an optional key the format gained since, changes nothing
+    defaults = GOOD.replace("stiffness: k_x}", "stiffness: k_x, amplitude: 1.0}") + \
+        "states: []\nrates: {}\nprovisional: false\n"
+    assert model_from_text(defaults, "m.yaml").key == key
+    assert model_from_text(GOOD.replace("stiffness: k_x}", "stiffness: k_x, amplitude: 2.0}"),
+                           "m.yaml").key != key
 
 
 # ------------------------------------------------------------------------------ classical

@@ -638,8 +638,9 @@ def _family(model: ModelFile, text: str) -> Family:
 
 
 def content_key(model: ModelFile) -> str:
-    """sha256 of what the file declares, not how it is written: comments, spacing and key
-    order do not change it."""
+    """sha256 of what the file declares, not how it is written: comments, spacing, key order
+    and keys at their default (written out or left out) do not change it, nor does a key
+    the format gains later."""
     def plain(value: Any) -> Any:
         if isinstance(value, Expression):
             return value.canonical
@@ -653,7 +654,9 @@ def content_key(model: ModelFile) -> str:
         if isinstance(value, list | tuple):
             return [plain(v) for v in value]
         if isinstance(value, BaseModel):
-            return {k: plain(getattr(value, k)) for k in type(value).model_fields}
+            return {k: plain(getattr(value, k)) for k, field in type(value).model_fields.items()
+                    if field.is_required()
+                    or getattr(value, k) != field.get_default(call_default_factory=True)}
         return value
 
     text = json.dumps(plain(model), sort_keys=True, separators=(",", ":"))
