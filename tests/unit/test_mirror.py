@@ -32,6 +32,7 @@ def test_the_hopf_point_of_a_mirror_branch_maps_onto_the_earlier_one():
 def test_no_mirror_where_the_right_hand_side_is_not_odd():
     """A model declared symmetric whose right-hand side has an even term maps nothing."""
     even = SimpleNamespace(symmetric=True, n_states=4, dofs=MODEL.dofs,
+                           typical_amplitudes=MODEL.typical_amplitudes,
                            parameter_vector=MODEL.parameter_vector,
                            rhs_numpy=lambda y, p: MODEL.rhs_numpy(y, p) + y[0] ** 2)
     points = [hopf("secondary_1a", STATE), hopf("secondary_1b", -STATE)]
