@@ -16,6 +16,7 @@ from whirl_cli.output.compare import (
     compare_curves,
     compare_files,
     compare_results,
+    different_models,
     monotone_stretches,
 )
 from whirl_cli.results import (
@@ -355,7 +356,7 @@ def test_cli_prints_at_most_the_limit(tmp_path):
     base = make_result()
     sweep = base.linear_sweeps[0]
     other = replace(base, attributes={**base.attributes, "study_sha256": "zzz",
-                                      "study_yaml": "other"}, study_name="y", model="m",
+                                      "study_yaml": "other"}, study_name="y",
                     linear_sweeps=(replace(sweep, values=sweep.values + 1,
                                            eigenvalues=sweep.eigenvalues + 1,
                                            damping_ratio=sweep.damping_ratio + 1,
@@ -363,4 +364,21 @@ def test_cli_prints_at_most_the_limit(tmp_path):
     a, b = store.write(base, tmp_path / "a.h5"), store.write(other, tmp_path / "b.h5")
     result = CliRunner().invoke(cli, ["compare", str(a), str(b), "--limit", "3", "--strict"])
     assert result.exit_code == 1
-    assert "... and 5 more" in result.output
+    assert "... and 4 more" in result.output
+
+
+@pytest.mark.parametrize("changes", [{"model": "gimballed_poly"},
+                                     {"attributes": {"model_key": "another"}}])
+def test_results_of_different_models_are_not_compared(tmp_path, changes):
+    """Another model variant, or a model file declaring other equations or values (its
+    stored model_key): one line saying so, exit 1, no list of differences."""
+    base = make_result()
+    other = replace(base, **{k: ({**base.attributes, **v} if k == "attributes" else v)
+                             for k, v in changes.items()})
+    a, b = store.write(base, tmp_path / "a.h5"), store.write(other, tmp_path / "b.h5")
+    result = CliRunner().invoke(cli, ["compare", str(a), str(b)])
+    assert result.exit_code == 1
+    assert result.output.strip().splitlines() == [
+        f"{a} and {b} are results of different models "
+        f"({different_models(base, other)}): not compared"]
+    assert different_models(base, base) == ""

@@ -42,6 +42,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from ..errors import OutputError
 from ..results import (
     Branch,
     ContinuationResult,
@@ -126,12 +127,28 @@ class Comparison:
 def compare(a: Path, b: Path, tolerances: Tolerances | None = None, strict: bool = False
             ) -> Comparison:
     """Drift and provenance notes between the result files ``a`` and ``b``; with ``strict``
-    a difference of study text or hash is drift too."""
+    a difference of study text or hash is drift too. OutputError for results of different
+    models (other equations: nothing to compare)."""
     tolerances = tolerances or Tolerances()
     result_a, result_b = store.read(a), store.read(b)
+    different = different_models(result_a, result_b)
+    if different:
+        raise OutputError(f"{a} and {b} are results of different models ({different}): not "
+                          "compared")
     differences = compare_results(result_a, result_b, tolerances, strict)
     differences += compare_boundaries(a, b, tolerances)
     return Comparison(differences, [] if strict else provenance_notes(result_a, result_b))
+
+
+def different_models(a: StudyResult, b: StudyResult) -> str:
+    """Why ``a`` and ``b`` come from different equations: another model variant, or a model
+    file of other content (its ``model_key``); "" if from the same."""
+    if a.model != b.model:
+        return f"{a.model} vs {b.model}"
+    keys = [r.attributes.get("model_key", "") for r in (a, b)]
+    if keys[0] != keys[1]:
+        return f"{a.model} from model files that declare different equations or values"
+    return ""
 
 
 def compare_files(a: Path, b: Path, tolerances: Tolerances | None = None, strict: bool = False
