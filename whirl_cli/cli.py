@@ -485,8 +485,9 @@ def doctor() -> None:
     except WhirlError as error:
         problems.append(error.message)
     try:
-        click.echo(f"AUTO engine: {toolchain.engine_name()} ({toolchain.ENGINE_VARIABLE}, one "
-                   f"of {', '.join(toolchain.ENGINES)}; default {toolchain.DEFAULT_ENGINE})")
+        name, why = toolchain.engine_choice()
+        click.echo(f"AUTO engine: {name} ({why}; {toolchain.ENGINE_VARIABLE} chooses one of "
+                   f"{', '.join(toolchain.ENGINES)})")
         chosen = toolchain.engine()
         click.echo(f"AUTO-07p: {chosen.version}: {chosen.location} "
                    f"({', '.join(o.name for o in chosen.objects)})"

@@ -5,6 +5,8 @@ and the PyPI package bifpy), and a missing one fails here with its install hint.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from click.testing import CliRunner
@@ -87,3 +89,37 @@ def test_engines_agree_on_combined_case2(tmp_path, monkeypatch):
     scale = max(float(np.abs(v).max()) for _, v in reference)
     for (key, a), (_, b) in zip(reference, other, strict=True):
         assert a == pytest.approx(b, abs=1e-6 * scale), key
+
+
+def test_without_debians_auto_whirl_runs_on_bifpy(tmp_path):
+    """Debian's AUTO hidden (WHIRL_AUTO_DIR at an empty folder) and no WHIRL_AUTO_ENGINE: the
+    console script runs linear case 2 on bifpy's AUTO-07p, stores that engine, and finds the
+    Hopf points of the Debian engine's run (to 1e-9 of K_theta); `whirl doctor` says why."""
+    import os
+    import subprocess
+    import sys
+
+    import h5py
+
+    from whirl_cli.output import store
+
+    env = {k: v for k, v in os.environ.items() if k != toolchain.ENGINE_VARIABLE}
+    env["WHIRL_AUTO_DIR"] = str(tmp_path / "no-auto")
+    (tmp_path / "no-auto").mkdir()
+    whirl = [str(Path(sys.executable).parent / "whirl")]
+    study = STUDIES / "linear_case2.yaml"
+    hidden = subprocess.run([*whirl, "run", str(study), "-o", str(tmp_path / "b.h5"),
+                             "--no-plots"], env=env, capture_output=True, text=True, timeout=600)
+    assert hidden.returncode == 0, hidden.stderr
+    with h5py.File(tmp_path / "b.h5") as handle:
+        assert handle.attrs["auto_version"].startswith("bifpy ")
+    debian = run_study(load_study(study), tmp_path / "work", jobs=2)
+    assert debian.attributes["auto_version"] == toolchain.auto_version("debian")
+    on_bifpy = store.read(tmp_path / "b.h5")
+    assert _points(on_bifpy, PointType.HB) == pytest.approx(_points(debian, PointType.HB),
+                                                            abs=1e-9)
+    doctor = subprocess.run([*whirl, "doctor"], env=env, capture_output=True, text=True,
+                            timeout=300)
+    assert doctor.returncode == 0, doctor.stdout + doctor.stderr
+    assert (f"AUTO engine: bifpy (Debian's auto-07p not found in {tmp_path / 'no-auto'}; "
+            "bifpy's AUTO-07p is installed") in doctor.stdout

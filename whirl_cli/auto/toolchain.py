@@ -3,11 +3,15 @@
 Equation files are compiled and linked against the runtime of one **AUTO engine**, chosen by
 the environment variable ``WHIRL_AUTO_ENGINE``:
 
-* ``debian`` (the default): Debian's package ``auto-07p`` (0.9.2), its runtime objects
+* ``debian``: Debian's package ``auto-07p`` (0.9.2), its runtime objects
   ``/usr/lib/auto-07p/lib/*.o`` (``WHIRL_AUTO_DIR`` moves the directory);
 * ``bifpy``: the PyPI package ``bifpy``, which builds a current upstream AUTO-07p with gfortran
   when it is installed and ships it as ``bifpy/auto/_lib/main.o`` and ``libbifpy.a``
   (``pip install -e '.[bifpy]'``, also in ``.[dev]``).
+
+Unset, it is ``debian`` where Debian's runtime is installed, else ``bifpy`` where that is (a
+machine without Debian's package: another Linux, a container, macOS with gfortran), else
+``debian`` (whose error says how to install either); :func:`engine_choice` says why.
 
 Executables are cached under ``$WHIRL_CACHE_DIR`` (default ``~/.cache/whirl``) keyed by a hash
 of the source, the engine, the compiler, the flags and the runtime files. The cache entry
@@ -38,11 +42,13 @@ AUTO_DIR = Path(os.environ.get("WHIRL_AUTO_DIR", "/usr/lib/auto-07p"))
 FFLAGS = ("-g", "-O2", "-fstack-protector-strong", "-fPIC", "-std=legacy", "-fopenmp")
 #: bifpy's runtime is built without OpenMP; the equations are compiled as for Debian otherwise.
 BIFPY_FFLAGS = ("-g", "-O2", "-fstack-protector-strong", "-fPIC", "-std=legacy")
-INSTALL_HINT = "install them with: sudo apt-get install auto-07p gfortran   (or: make setup)"
+INSTALL_HINT = ("install them with: sudo apt-get install auto-07p gfortran   (or: make setup); "
+                "or, without Debian's package, AUTO-07p from PyPI: pip install 'bifpy>=0.3,<0.4'")
 BIFPY_HINT = ("install it with: .venv/bin/pip install 'bifpy>=0.3,<0.4' (it compiles AUTO-07p "
               "with gfortran, about 20 s), or: pip install -e '.[bifpy]', or: make setup")
 
-#: The environment variable that picks the engine, its values, and the default.
+#: The environment variable that picks the engine, its values, and the default where neither
+#: engine is installed (:func:`engine_choice`).
 ENGINE_VARIABLE = "WHIRL_AUTO_ENGINE"
 ENGINES = ("debian", "bifpy")
 DEFAULT_ENGINE = "debian"
@@ -67,12 +73,26 @@ class Engine:
 
 
 def engine_name() -> str:
-    """The engine ``WHIRL_AUTO_ENGINE`` asks for (default ``debian``)."""
-    name = os.environ.get(ENGINE_VARIABLE, "").strip().lower() or DEFAULT_ENGINE
-    if name not in ENGINES:
-        raise ToolchainError(f"{ENGINE_VARIABLE}={os.environ[ENGINE_VARIABLE]!r} is not an AUTO "
-                             f"engine; choose one of: {', '.join(ENGINES)}")
-    return name
+    """The engine whirl runs (:func:`engine_choice`)."""
+    return engine_choice()[0]
+
+
+def engine_choice() -> tuple[str, str]:
+    """(engine, why): the one ``WHIRL_AUTO_ENGINE`` asks for; unset, Debian's where it is
+    installed, else bifpy's where that is, else Debian's (the module doc)."""
+    given = os.environ.get(ENGINE_VARIABLE, "").strip().lower()
+    if given:
+        if given not in ENGINES:
+            raise ToolchainError(f"{ENGINE_VARIABLE}={os.environ[ENGINE_VARIABLE]!r} is not an "
+                                 f"AUTO engine; choose one of: {', '.join(ENGINES)}")
+        return given, f"{ENGINE_VARIABLE}={given}"
+    if any((AUTO_DIR / "lib").glob("*.o")):
+        return "debian", f"Debian's auto-07p found in {AUTO_DIR}"
+    try:
+        bifpy_library()
+    except ToolchainError:
+        return DEFAULT_ENGINE, f"neither Debian's auto-07p (in {AUTO_DIR}) nor bifpy is installed"
+    return "bifpy", f"Debian's auto-07p not found in {AUTO_DIR}; bifpy's AUTO-07p is installed"
 
 
 def engine(name: str | None = None) -> Engine:
