@@ -459,15 +459,19 @@ def _own(suffix: str):
 
 def rendered_formats(figure: Figure, formats: tuple[str, ...], dpi: int,
                      key: str | None = None) -> dict[str, bytes]:
-    """``figure`` in each of ``formats`` (:data:`FORMATS`), the figure cleared afterwards.
-    The vector files are drawn from the same figure (after the PNG, so with the same layout)
-    with :data:`VECTOR_RC`, without dates, the same bytes run to run; ``key`` (if given) is
-    stored in each: PNG text chunk, PDF and SVG keywords (:func:`stored_key_in`)."""
+    """``figure`` in each of ``formats`` (:data:`FORMATS`, in that order), the figure
+    cleared afterwards. A file drawn after another keeps the layout of the first draw (not
+    laid out again: the vector files of a sheet cost a draw each, not a layout too). Vector
+    files are drawn with :data:`VECTOR_RC`, without dates: the same bytes run to run.
+    ``key`` (if given) is stored in each: PNG text chunk, PDF and SVG keywords
+    (:func:`stored_key_in`)."""
     from matplotlib import rc_context
 
     out: dict[str, bytes] = {}
     try:
         for suffix in formats:
+            if out:
+                figure.set_layout_engine("none")
             if suffix == "png":
                 out[suffix] = _png(figure, dpi, {_KEY: key} if key else None, clear=False)
                 continue
@@ -475,13 +479,28 @@ def rendered_formats(figure: Figure, formats: tuple[str, ...], dpi: int,
             keywords = f"{_KEY}:{key}" if key else None
             metadata = ({"CreationDate": None, "Keywords": keywords} if suffix == "pdf"
                         else {"Date": None, "Keywords": keywords})
-            with rc_context(VECTOR_RC):
-                figure.savefig(buffer, format=suffix, dpi=dpi, metadata=metadata)
+            with rc_context(VECTOR_RC):  # the backend's canvas itself: savefig would draw
+                _VECTOR_CANVAS[suffix](figure, buffer, metadata)  # twice, once to lay out
             out[suffix] = buffer.getvalue()
     finally:
         figure.clear()
     return out
 
+
+def _pdf(figure: Figure, buffer: io.BytesIO, metadata: dict) -> None:
+    from matplotlib.backends.backend_pdf import FigureCanvasPdf
+
+    FigureCanvasPdf(figure).print_pdf(buffer, metadata=metadata)
+
+
+def _svg(figure: Figure, buffer: io.BytesIO, metadata: dict) -> None:
+    from matplotlib.backends.backend_svg import FigureCanvasSVG
+
+    FigureCanvasSVG(figure).print_svg(buffer, metadata=metadata)
+
+
+_VECTOR_CANVAS = {"pdf": _pdf, "svg": _svg}
+"""Vector format -> a function drawing a figure into a buffer with that backend."""
 
 _KEY = "whirl-figure-key"
 _KEY_RE = re.compile(rb"whirl-figure-key:([0-9a-f]{64})")
