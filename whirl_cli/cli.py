@@ -396,6 +396,18 @@ def _limits(ctx: click.Context, param: click.Parameter, value):
     return float(low), float(high)
 
 
+def _formats(ctx: click.Context, param: click.Parameter, value: str) -> tuple[str, ...]:
+    """``--format``: comma-separated file formats of :data:`whirl_cli.plots.files.FORMATS`,
+    the PNG first (always written)."""
+    from .plots.files import FORMATS
+
+    named = [part.strip().lower() for part in value.split(",") if part.strip()]
+    unknown = [f for f in named if f not in FORMATS]
+    if unknown or not named:
+        raise click.BadParameter(f"expected formats among {', '.join(FORMATS)}, got {value!r}")
+    return tuple(dict.fromkeys(["png", *named]))
+
+
 @cli.command()
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--kind", "kinds", multiple=True,
@@ -417,8 +429,13 @@ def _limits(ctx: click.Context, param: click.Parameter, value):
 @click.option("--hz", is_flag=True, help="Frequencies in Hz instead of rad/s (linear sweeps).")
 @click.option("--artefacts", is_flag=True,
               help="Also draw special points flagged as smoothing artefacts (freeplay).")
+@click.option("--format", "formats", default="png", show_default=True, callback=_formats,
+              metavar="png[,pdf][,svg]",
+              help="File formats, comma-separated: the PNG always, and vector PDF (fonts "
+                   "embedded) or SVG beside it.")
 def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None,
-         state: str | None, xlim, ylim, hz: bool, artefacts: bool) -> None:
+         state: str | None, xlim, ylim, hz: bool, artefacts: bool,
+         formats: tuple[str, ...]) -> None:
     """Draw the plots of a whirl result file."""
     from . import api
     from .plots.files import View, available_kinds, missing_data, save_study_plots
@@ -446,7 +463,7 @@ def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None,
                           f"({error.strerror or error})") from None
     view = View(xlim=xlim, ylim=ylim, hz=hz, artefacts=artefacts)
     for path in save_study_plots(result, kinds, output_dir, result_file.stem, state,
-                                 view=view, result_file=result_file):
+                                 view=view, result_file=result_file, formats=formats):
         click.echo(f"wrote {path}")
 
 
@@ -567,8 +584,12 @@ def sweep(paths: tuple[Path, ...], out_dir: Path, jobs: int, dask_address: str |
 @click.option("-j", "--jobs", type=click.IntRange(1, 256), default=os.cpu_count() or 1,
               show_default=True, help="Studies run in parallel (local worker processes).")
 @click.option("--force", is_flag=True, help="Rerun studies whose output is up to date.")
+@click.option("--format", "formats", default="png,pdf", show_default=True, callback=_formats,
+              metavar="png[,pdf][,svg]",
+              help="File formats of each figure, comma-separated: the PNG always (the index "
+                   "shows it), and vector PDF (fonts embedded) or SVG beside it.")
 def figures(paths: tuple[Path, ...], out_dir: Path, results_dir: Path, jobs: int,
-            force: bool) -> None:
+            force: bool, formats: tuple[str, ...]) -> None:
     """Draw the figures of the sheets in PATHS (files, or directories searched for *.yaml):
     run the studies they name (as `whirl sweep`, reusing up-to-date results), write one PNG per
     sheet and an index.html. Exit 1 if any figure could not be drawn."""
@@ -576,7 +597,7 @@ def figures(paths: tuple[Path, ...], out_dir: Path, results_dir: Path, jobs: int
 
     try:
         outcomes = make_figures(paths, out_dir, results_dir, jobs=jobs, force=force,
-                                console=_console())
+                                console=_console(), formats=formats)
     except KeyboardInterrupt as error:
         click.echo("interrupted", err=True)
         raise SystemExit(128 + getattr(error, "signum", 2)) from None

@@ -42,7 +42,7 @@ def test_one_bad_sheet_does_not_stop_the_others(tmp_path, monkeypatch):
                                       str(tmp_path / "results"), "-j", "1"])
     assert result.exit_code == 1, result.output
     assert "internal error" not in result.output and "Traceback" not in result.output
-    assert sorted(p.name for p in out.iterdir()) == ["fig9_1.png", "index.html"]
+    assert sorted(p.name for p in out.iterdir()) == ["fig9_1.pdf", "fig9_1.png", "index.html"]
     lines = result.output.splitlines()
     for expected in (
             f"figure 9.2: not drawn: {folder / 'pixels.yaml'}:3: size[0]: expected inches, 1 "

@@ -59,7 +59,7 @@ def test_sheet_reads_and_resolves_study_paths(tmp_path):
     ("panels:\n  - {kind: bifurcation}\n",
      "f.yaml:4: panels[0]: give exactly one of `study` and `overlay`"),
     ("panels:\n  - {kind: period, overlay: [{study: a.yaml}]}\n",
-     "f.yaml:4: panels[0]: only bifurcation and damping_multiples panels can be overlaid"),
+     "f.yaml:4: panels[0]: only bifurcation, damping_multiples and law panels can be overlaid"),
     ("panels:\n  - {kind: contour, study: a.yaml}\n",
      "f.yaml:4: panels[0].kind: expected one of bifurcation"),
     ("layout: [1, 1]\npanels:\n  - {kind: bifurcation, study: a.yaml}\n"

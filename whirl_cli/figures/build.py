@@ -34,6 +34,9 @@ from .sheet import Sheet, find_sheets, load_sheet
 KEY = "whirl-figure-key"
 """PNG text chunk holding a figure's :func:`figure_key`."""
 
+DEFAULT_FORMATS = ("png", "pdf")
+"""Formats of the figures unless told otherwise: the PNG and a PDF for print."""
+
 
 @dataclass(frozen=True)
 class Refused:
@@ -97,9 +100,11 @@ def _figure_and_caption(path: Path) -> tuple[str, str]:
 
 
 def make_figures(paths: Sequence[str | os.PathLike[str]], out_dir: Path, results_dir: Path,
-                 jobs: int = 1, force: bool = False, console=None, dpi: int = 150
-                 ) -> list[FigureOutcome]:
+                 jobs: int = 1, force: bool = False, console=None, dpi: int = 150,
+                 formats: Sequence[str] = DEFAULT_FORMATS) -> list[FigureOutcome]:
     """Run, draw and index (module docstring); the outcome of every sheet, in figure order.
+    Each figure is written in every format of ``formats`` (:data:`whirl_cli.plots.files.
+    FORMATS`; the PNG always, the index shows it).
 
     While a worker is idle (no study left waiting for one), each study stored lets one sheet
     whose studies are all stored be drawn, so sheets of the short studies are drawn while the
@@ -112,7 +117,7 @@ def make_figures(paths: Sequence[str | os.PathLike[str]], out_dir: Path, results
     sheets, refused = load_sheets(paths)
     sheets.sort(key=lambda s: figure_order(s.figure))
     studies = list(dict.fromkeys(p for s in sheets for p in s.studies()))
-    artist = _Artist(out_dir, force, dpi)
+    artist = _Artist(out_dir, force, dpi, ("png", *(f for f in formats if f != "png")))
 
     def stored(outcome, pending: int) -> None:
         artist.record(outcome)
@@ -149,8 +154,9 @@ class _Artist:
     :meth:`draw_ready` sheets that are :meth:`ready` (their studies all stored),
     :meth:`outcome` of every sheet at the end (why a sheet was not drawn)."""
 
-    def __init__(self, out_dir: Path, force: bool, dpi: int) -> None:
-        self.out_dir, self.force, self.dpi = out_dir, force, dpi
+    def __init__(self, out_dir: Path, force: bool, dpi: int, formats: tuple[str, ...]
+                 ) -> None:
+        self.out_dir, self.force, self.dpi, self.formats = out_dir, force, dpi, formats
         self.outputs: dict[Path, Path] = {}
         self.failed: dict[Path, str] = {}
         self.read: dict[Path, StudyResult] = {}
@@ -198,44 +204,47 @@ class _Artist:
         return sheet.path not in self.done and all(p in self.outputs for p in sheet.studies())
 
     def _reused(self, sheet: Sheet) -> tuple[str, FigureOutcome | None]:
-        """The sheet's :func:`figure_key`, and its outcome if its PNG has that key."""
+        """The sheet's :func:`figure_key`, and its outcome if its file of every format has
+        that key."""
         target = self.out_dir / f"{sheet.stem}.png"
         key = figure_key(sheet, [self.outputs[p] for p in sheet.studies()], self.dpi)
-        if not self.force and stored_key(target) == key:
+        if not self.force and all(stored_key(self.out_dir / f"{sheet.stem}.{suffix}") == key
+                                  for suffix in self.formats):
             return key, FigureOutcome(sheet, target, reused=True)
         return key, None
 
-    def _image(self, sheet: Sheet, key: str) -> tuple[bytes | None, str]:
-        """The sheet's PNG (carrying ``key``), or None and why it cannot be drawn."""
+    def _image(self, sheet: Sheet, key: str) -> tuple[dict[str, bytes] | None, str]:
+        """The sheet's file of each format (carrying ``key``), or None and why it cannot be
+        drawn."""
         from ..output import store
+        from ..plots.files import rendered_formats
         from .draw import draw_sheet
 
         try:
             for path in sheet.studies():
                 if path not in self.read:
                     self.read[path] = store.read(self.outputs[path])
-            return _render(draw_sheet(sheet, self.read), self.dpi, {KEY: key}), ""
+            return rendered_formats(draw_sheet(sheet, self.read), self.formats, self.dpi,
+                                    key), ""
         except WhirlError as error:
             return None, str(error)
         except Exception as error:  # noqa: BLE001 - a bug in drawing: this sheet only
             return None, f"{sheet.path}: {type(error).__name__}: {error}"
 
-    def _published(self, sheet: Sheet, image: bytes | None, problem: str) -> FigureOutcome:
+    def _published(self, sheet: Sheet, files: dict[str, bytes] | None, problem: str
+                   ) -> FigureOutcome:
+        """Publish the sheet's files, the vector ones first, the PNG (whose key says the
+        figure is up to date) last."""
         from ..output.atomic import publish
-        from ..output.guard import IMAGE
+        from ..plots.files import _own
 
-        if image is None:
+        if files is None:
             return FigureOutcome(sheet, None, problem)
         _make_folder(self.out_dir)
-        target = self.out_dir / f"{sheet.stem}.png"
-        return FigureOutcome(sheet, publish(image, target, overwrite=True, what="the figure",
-                                            own=IMAGE))
-
-
-def _render(figure, dpi: int, metadata: dict[str, str]) -> bytes:
-    from ..plots.files import _png
-
-    return _png(figure, dpi, metadata)
+        for suffix in sorted(files, key=lambda s: s == "png"):
+            publish(files[suffix], self.out_dir / f"{sheet.stem}.{suffix}", overwrite=True,
+                    what="the figure", own=_own(suffix))
+        return FigureOutcome(sheet, self.out_dir / f"{sheet.stem}.png")
 
 
 def figure_key(sheet: Sheet, outputs: Sequence[Path], dpi: int) -> str:
@@ -260,14 +269,18 @@ def figure_key(sheet: Sheet, outputs: Sequence[Path], dpi: int) -> str:
 
 
 def stored_key(path: Path) -> str | None:
-    """The :data:`KEY` text chunk of the PNG at ``path`` (None: no regular file, not a PNG,
-    no key)."""
+    """The :data:`KEY` text chunk of the PNG at ``path``, or the key a PDF or SVG file
+    there carries (None: no regular file, no key)."""
     if not os.path.isfile(path):  # a FIFO would block the read
         return None
     try:
         data = path.read_bytes()
     except OSError:
         return None
+    if path.suffix != ".png":
+        from ..plots.files import stored_key_in
+
+        return stored_key_in(data)
     if data[:8] != b"\x89PNG\r\n\x1a\n":
         return None
     at = 8

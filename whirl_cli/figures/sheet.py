@@ -95,8 +95,8 @@ class PanelSpec(_Strict):
     kind: PanelKind = Field(description="Plot kind drawn in the panel.")
     study: Text | None = Field(None, description="Study file, relative to the sheet's folder.")
     overlay: tuple[Member, ...] = Field(
-        (), description="Several studies on one axes (instead of `study`; kinds bifurcation "
-        "and damping_multiples).")
+        (), description="Several studies on one axes (instead of `study`; kinds bifurcation, "
+        "damping_multiples and law).")
     continuation: Text | None = Field(
         None, description="Continuation (or boundary) drawn; unset: the first that fits.")
     branch: Text | None = Field(None, description="Periodic branch of a `phase` panel.")
@@ -117,7 +117,8 @@ class PanelSpec(_Strict):
         if (self.study is None) == (not self.overlay):
             _fail("give exactly one of `study` and `overlay`")
         if self.overlay and self.kind not in OVERLAY_KINDS:
-            _fail(f"only {' and '.join(OVERLAY_KINDS)} panels can be overlaid")
+            kinds = ", ".join(OVERLAY_KINDS[:-1]) + f" and {OVERLAY_KINDS[-1]}"
+            _fail(f"only {kinds} panels can be overlaid")
         return self
 
 

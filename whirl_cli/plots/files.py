@@ -107,8 +107,10 @@ def available_kinds(result: StudyResult) -> tuple[str, ...]:
 
 def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path, stem: str,
                      state: str | None = None, dpi: int = 150, view: View = View(),
-                     result_file: Path | None = None) -> list[Path]:
-    """Write a study's figures as PNG files into ``out_dir``; return the paths, sorted.
+                     result_file: Path | None = None, formats: tuple[str, ...] = ("png",)
+                     ) -> list[Path]:
+    """Write a study's figures as PNG files into ``out_dir`` (and each also in the other
+    ``formats`` of :data:`FORMATS`, beside it: ``<name>.pdf``); return the paths, sorted.
 
     ``kinds`` (any of :data:`PLOT_KINDS`):
 
@@ -164,19 +166,22 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
     study's plots together with its HDF5 file instead (:mod:`whirl_cli.output.study_files`).
     """
     out_dir = Path(out_dir)
-    rendered = render_study_plots(result, kinds, stem, state, dpi, view)
+    rendered = render_study_plots(result, kinds, stem, state, dpi, view, formats=formats)
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"cannot create plot directory {out_dir}: {exc}") from exc
     from ..output.atomic import publish
-    from ..output.guard import IMAGE
+    from ..output.guard import check
     from ..output.study_files import check_plot
 
     for name, _ in rendered:  # a PNG is replaced, never a link, directory, device, FIFO
-        check_plot(out_dir / name, result_file or out_dir / f"{stem}.h5", overwrite=True)
-    return sorted(publish(data, out_dir / name, overwrite=True, what="the plot", own=IMAGE)
-                  for name, data in rendered)
+        if name.endswith(".png"):
+            check_plot(out_dir / name, result_file or out_dir / f"{stem}.h5", overwrite=True)
+        else:
+            check(out_dir / name, _own(Path(name).suffix[1:]), overwrite=True)
+    return sorted(publish(data, out_dir / name, overwrite=True, what="the plot",
+                          own=_own(Path(name).suffix[1:])) for name, data in rendered)
 
 
 def plot_names(result: StudyResult, kinds: tuple[str, ...], stem: str,
@@ -188,14 +193,23 @@ def plot_names(result: StudyResult, kinds: tuple[str, ...], stem: str,
 
 def render_study_plots(result: StudyResult, kinds: tuple[str, ...], stem: str,
                        state: str | None = None, dpi: int = 150, view: View = View(),
-                       jobs: int = 1) -> list[tuple[str, bytes]]:
-    """(file name, PNG bytes) of every figure of :func:`save_study_plots`, rendered in
-    memory, in ``jobs`` forked processes (:func:`whirl_cli.interrupts.forked_map`; the same
-    bytes in the same order for any ``jobs``); nothing is written."""
+                       jobs: int = 1, formats: tuple[str, ...] = ("png",)
+                       ) -> list[tuple[str, bytes]]:
+    """(file name, bytes) of every figure of :func:`save_study_plots` in each of ``formats``
+    (the PNG always, first), rendered in memory, in ``jobs`` forked processes
+    (:func:`whirl_cli.interrupts.forked_map`; the same bytes in the same order for any
+    ``jobs``); nothing is written."""
     from ..interrupts import forked_map
 
-    tasks = render_tasks(result, kinds, stem, state, dpi, view)
-    return forked_map(lambda k: tasks[k](), len(tasks), jobs)
+    if tuple(formats) == ("png",):
+        tasks = render_tasks(result, kinds, stem, state, dpi, view)
+        return forked_map(lambda k: tasks[k](), len(tasks), jobs)
+    formats = ("png", *(f for f in formats if f != "png"))
+    jobs_ = _named_jobs(result, kinds, stem, state, view)
+    drawn = forked_map(lambda k: rendered_formats(_viewed(jobs_[k][1](), view), formats, dpi),
+                       len(jobs_), jobs)
+    return [(str(Path(name).with_suffix(f".{suffix}")), files[suffix])
+            for (name, _), files in zip(jobs_, drawn, strict=True) for suffix in formats]
 
 
 def render_tasks(result: StudyResult, kinds: tuple[str, ...], stem: str,
@@ -424,13 +438,88 @@ def _unique(path: Path, taken: list[Path]) -> Path:
     return candidate
 
 
-def _png(figure: Figure, dpi: int, metadata: dict[str, str] | None = None) -> bytes:
+FORMATS = ("png", "pdf", "svg")
+"""File formats a figure is written in: PNG (raster, at the given dpi), and the vector
+formats PDF (fonts embedded as TrueType) and SVG (text as paths)."""
+
+VECTOR_RC = {"pdf.fonttype": 42, "svg.fonttype": "path", "svg.hashsalt": "whirl"}
+"""matplotlib settings of the vector files: fonts embedded whole (type 42, not type 3
+bitmaps), SVG text drawn as paths (no font needed to view it), SVG ids the same each run."""
+
+
+def _own(suffix: str):
+    """The kind of file (:class:`whirl_cli.output.guard.Own`) a figure of ``suffix`` may
+    replace: a PNG, PDF or SVG file."""
+    from ..output.guard import IMAGE, Own, _starting
+
+    return {"png": IMAGE,
+            "pdf": Own("a PDF document", _starting(b"%PDF-", "a file that is not PDF")),
+            "svg": Own("an SVG image", _starting(b"<?xml", "a file that is not SVG"))}[suffix]
+
+
+def rendered_formats(figure: Figure, formats: tuple[str, ...], dpi: int,
+                     key: str | None = None) -> dict[str, bytes]:
+    """``figure`` in each of ``formats`` (:data:`FORMATS`, in that order), the figure
+    cleared afterwards. A file drawn after another keeps the layout of the first draw (not
+    laid out again: the vector files of a sheet cost a draw each, not a layout too). Vector
+    files are drawn with :data:`VECTOR_RC`, without dates: the same bytes run to run.
+    ``key`` (if given) is stored in each: PNG text chunk, PDF and SVG keywords
+    (:func:`stored_key_in`)."""
+    from matplotlib import rc_context
+
+    out: dict[str, bytes] = {}
+    try:
+        for suffix in formats:
+            if out:
+                figure.set_layout_engine("none")
+            if suffix == "png":
+                out[suffix] = _png(figure, dpi, {_KEY: key} if key else None, clear=False)
+                continue
+            buffer = io.BytesIO()
+            keywords = f"{_KEY}:{key}" if key else None
+            metadata = ({"CreationDate": None, "Keywords": keywords} if suffix == "pdf"
+                        else {"Date": None, "Keywords": keywords})
+            with rc_context(VECTOR_RC):  # the backend's canvas itself: savefig would draw
+                _VECTOR_CANVAS[suffix](figure, buffer, metadata)  # twice, once to lay out
+            out[suffix] = buffer.getvalue()
+    finally:
+        figure.clear()
+    return out
+
+
+def _pdf(figure: Figure, buffer: io.BytesIO, metadata: dict) -> None:
+    from matplotlib.backends.backend_pdf import FigureCanvasPdf
+
+    FigureCanvasPdf(figure).print_pdf(buffer, metadata=metadata)
+
+
+def _svg(figure: Figure, buffer: io.BytesIO, metadata: dict) -> None:
+    from matplotlib.backends.backend_svg import FigureCanvasSVG
+
+    FigureCanvasSVG(figure).print_svg(buffer, metadata=metadata)
+
+
+_VECTOR_CANVAS = {"pdf": _pdf, "svg": _svg}
+"""Vector format -> a function drawing a figure into a buffer with that backend."""
+
+_KEY = "whirl-figure-key"
+_KEY_RE = re.compile(rb"whirl-figure-key:([0-9a-f]{64})")
+
+
+def stored_key_in(data: bytes) -> str | None:
+    """The key :func:`rendered_formats` stored in a PDF or SVG file's bytes (None: none)."""
+    found = _KEY_RE.search(data)
+    return found.group(1).decode() if found else None
+
+
+def _png(figure: Figure, dpi: int, metadata: dict[str, str] | None = None,
+         clear: bool = True) -> bytes:
     """``figure`` rendered as PNG bytes at ``dpi``, with ``metadata`` as PNG text chunks (the
-    figure is cleared afterwards). Drawn once on its Agg canvas (its layout engine runs in
-    that draw), then its pixels written: what ``savefig`` writes (the same pixels and PNG
-    chunks for the 304 figures of 47 result files and the 25 thesis sheets, measured), without
-    its first pass over the figure, a draw that only lays it out (about a tenth of the
-    drawing time)."""
+    figure is cleared afterwards if ``clear``). Drawn once on its Agg canvas (its layout
+    engine runs in that draw), then its pixels written: what ``savefig`` writes (the same
+    pixels and PNG chunks for the 304 figures of 47 result files and the 25 thesis sheets,
+    measured), without its first pass over the figure, a draw that only lays it out (about a
+    tenth of the drawing time)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.image import imsave
 
@@ -444,6 +533,7 @@ def _png(figure: Figure, dpi: int, metadata: dict[str, str] | None = None) -> by
         imsave(buffer, canvas.buffer_rgba(), format="png", origin="upper", dpi=dpi,
                metadata=metadata)
     finally:
-        figure.clear()
+        if clear:
+            figure.clear()
     return buffer.getvalue()
 

@@ -88,3 +88,49 @@ def nonlinear_laws(result: StudyResult) -> list[tuple[Model, dict[str, float], s
         if not law.is_linear(model.law_values(dof, values)):
             found.append((model, values, dof))
     return found
+
+
+#: Line styles of the laws of :func:`laws_plot`, in turn (with the colour cycle).
+LAW_LINESTYLES = ("-", "--", "-.", (0, (5, 1, 1, 1, 1, 1)))
+
+
+def laws_plot(entries, ax: Axes | None = None, span: float | None = None,
+              title: str | None = None) -> Figure:
+    """Several stiffness laws on one axes: per entry (model, parameter values, dof, label)
+    the restoring force as continued, each in its own colour and line style, beside the
+    linear spring K x of each distinct linear stiffness (grey, dotted). x over +-``span``
+    (None: as :func:`law_plot` does for the first entry), in degrees for angles. Title:
+    ``title`` (None: none)."""
+    from matplotlib import rcParams
+
+    if ax is None:
+        ax = _new_figure().add_subplot()
+    colours = rcParams["axes.prop_cycle"].by_key()["color"]
+    springs: dict[float, str] = {}
+    for k, (model, values, dof, label) in enumerate(entries):
+        law, declared = model.law_on(dof), model.family.dof(dof)
+        coefficients = model.law_values(dof, values)
+        stiffness = {**model.defaults(), **values}[declared.stiffness]
+        if span is None:
+            breakpoints = law.breakpoints(coefficients) if law.breakpoints else ()
+            span = (GAP_SPAN * max(abs(b) for b in breakpoints) if breakpoints
+                    else np.radians(DEFAULT_SPAN) if declared.unit == "rad"
+                    else declared.amplitude)
+        x = np.linspace(-span, span, 2001)
+        factor, unit = display_unit(declared.unit, True)
+        if stiffness not in springs:
+            springs[stiffness] = declared.stiffness
+            ax.plot(factor * x, stiffness * x, **LINEAR_STYLE,
+                    label=f"linear ({declared.stiffness} = {stiffness:g})")
+        ax.plot(factor * x, law.force(x, stiffness, coefficients), color=colours[k % len(colours)],
+                linestyle=LAW_LINESTYLES[k % len(LAW_LINESTYLES)], linewidth=1.5, label=label)
+        stiffness_unit = model.parameter(declared.stiffness).unit
+        moment_unit = stiffness_unit.removesuffix(f"/{declared.unit}") or stiffness_unit
+        ax.set_xlabel(axis_label(dof, unit))
+        ax.set_ylabel(axis_label(f"restoring force on {dof}", moment_unit))
+    ax.axhline(0.0, color="black", linewidth=0.5, zorder=0, label="_zero")
+    ax.axvline(0.0, color="black", linewidth=0.5, zorder=0, label="_zero")
+    ax.legend(fontsize="small")
+    if title is not None:
+        ax.set_title(title)
+    return ax.figure

@@ -27,7 +27,10 @@ def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = 
     One line per column of ``sweep.eigenvalues``, drawn only where Im(lambda) > 0 so each
     conjugate pair appears once (real eigenvalues are not drawn). Lines are labelled with their
     whirl direction ("BW"/"FW", after the mode group for models with several: "nacelle BW";
-    numbered if repeated); the damping panel has a zero line.
+    numbered if repeated); a mode whose damping ratio falls below zero somewhere (flutter) is
+    drawn in :data:`UNSTABLE_COLOURS`, the others in :data:`STABLE_COLOURS`. Each crossing of
+    zero by a damping ratio (:func:`zero_crossings`) is marked on both panels and named with
+    its value in the legend; the damping panel has a zero line.
     Title: ``title`` (None: ``"linear analysis vs <parameter>"``). Draws on ``axes``
     (frequency, damping) if given, else on a new figure; returns the figure.
     """
@@ -35,21 +38,73 @@ def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = 
         axes = _new_figure(figsize=(6.4, 6.4)).subplots(2, 1, sharex=True)
     ax_freq, ax_damp = axes
     figure = ax_freq.figure
-    for (column, label), colour in zip(_mode_labels(sweep), _colours(), strict=False):
+    scale = HZ_PER_RAD_S if hz else 1.0
+    crossings = zero_crossings(sweep)
+    unstable = iter(UNSTABLE_COLOURS * len(sweep.eigenvalues.T))
+    stable = iter(STABLE_COLOURS * len(sweep.eigenvalues.T))
+    for column, label in _mode_labels(sweep):
         upper = sweep.eigenvalues[:, column].imag > 0
-        freq = np.where(upper, sweep.frequency[:, column], np.nan) * (HZ_PER_RAD_S if hz
-                                                                      else 1.0)
+        freq = np.where(upper, sweep.frequency[:, column], np.nan) * scale
         damp = np.where(upper, sweep.damping_ratio[:, column], np.nan)
-        ax_freq.plot(sweep.values, freq, color=colour, label=label)
-        ax_damp.plot(sweep.values, damp, color=colour, label=label)
+        flutters = bool(np.nanmin(damp) < 0.0)
+        colour = next(unstable if flutters else stable)
+        style = {"color": colour, "linewidth": 1.8 if flutters else 1.2}
+        ax_freq.plot(sweep.values, freq, label=label, **style)
+        ax_damp.plot(sweep.values, damp, label=label, **style)
+        for value, frequency in crossings.get(column, ()):
+            ax_freq.plot([value], [frequency * scale], **ONSET_STYLE, label="_onset")
+            ax_damp.plot([value], [0.0], **ONSET_STYLE,
+                         label=f"damping ratio 0 ({_onset_text(sweep, value)})")
+    for ax in (ax_freq, ax_damp):
+        for value in sorted({v for found in crossings.values() for v, _ in found}):
+            ax.axvline(value, color="black", linewidth=0.6, linestyle=":", label="_onset",
+                       zorder=0)
     ax_damp.axhline(0.0, color="black", linewidth=0.8, label="_zero")
     ax_freq.set_ylabel(axis_label("frequency", "Hz" if hz else "rad/s"))
     ax_damp.set_ylabel(axis_label("damping ratio", ""))
     ax_damp.set_xlabel(axis_label(sweep.parameter, sweep.unit))
     if ax_freq.get_lines():
-        ax_freq.legend(fontsize="small")
+        handles, labels = ax_freq.get_legend_handles_labels()
+        more, named = ax_damp.get_legend_handles_labels()
+        extra = [(h, n) for h, n in zip(more, named, strict=True) if n not in labels]
+        ax_freq.legend(handles + [h for h, _ in extra], labels + [n for _, n in extra],
+                       fontsize="small")
     ax_freq.set_title(f"linear analysis vs {sweep.parameter}" if title is None else title)
     return figure
+
+
+#: Colours of the modes that flutter somewhere in a sweep, and of the others (in turn).
+UNSTABLE_COLOURS = ("C3", "C1", "C6")
+STABLE_COLOURS = ("C0", "C2", "C4", "C9", "C5", "C7", "C8")
+#: The marker of a damping ratio crossing zero.
+ONSET_STYLE = {"marker": "o", "markersize": 6, "markerfacecolor": "white",
+               "markeredgecolor": "black", "linestyle": "none", "zorder": 4}
+
+
+def zero_crossings(sweep: LinearSweep) -> dict[int, list[tuple[float, float]]]:
+    """Per column of ``sweep`` (modes with Im(lambda) > 0 at both ends of an interval), the
+    (parameter, frequency [rad/s]) where its damping ratio crosses zero, interpolated
+    linearly between the sweep's points; a point exactly at zero counts once."""
+    values = np.asarray(sweep.values, dtype=float)
+    found: dict[int, list[tuple[float, float]]] = {}
+    for column in range(sweep.eigenvalues.shape[1]):
+        upper = np.asarray(sweep.eigenvalues)[:, column].imag > 0
+        zeta = np.where(upper, np.asarray(sweep.damping_ratio)[:, column], np.nan)
+        freq = np.asarray(sweep.frequency)[:, column]
+        for k in range(len(values) - 1):
+            a, b = zeta[k], zeta[k + 1]
+            if not (np.isfinite(a) and np.isfinite(b)) or a == b or a * b > 0 or b == 0:
+                continue
+            t = a / (a - b)
+            found.setdefault(column, []).append(
+                (float(values[k] + t * (values[k + 1] - values[k])),
+                 float(freq[k] + t * (freq[k + 1] - freq[k]))))
+    return found
+
+
+def _onset_text(sweep: LinearSweep, value: float) -> str:
+    unit = f" {sweep.unit}" if sweep.unit not in ("", "1") else ""
+    return f"{sweep.parameter} = {value:.4g}{unit}"
 
 
 #: Markers of the root locus by whirl direction (real roots: "--").

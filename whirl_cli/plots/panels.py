@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import WhirlError
-from ..results import Branch, ContinuationResult, LinearSweep, StudyResult
+from ..results import Branch, ContinuationResult, LinearSweep, PointType, StudyResult
 from .captions import Fixed, captions
 from .diagrams import (
     _checked_branches,
@@ -36,14 +36,7 @@ from .maps import _oriented_grid, boundary_plot, overhang_diagram
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
-PANEL_KINDS = ("bifurcation", "projections", "period", "phase", "linear", "root_locus",
-               "damping_multiples", "boundary", "overhang", "amplitude", "time_history",
-               "hub_path", "law", "poincare", "spectrum", "orbit_diagram")
-"""Kinds :func:`draw` accepts (``overhang``: one slice of a boundary, its unsafe intervals
-shaded)."""
-
-OVERLAY_KINDS = ("bifurcation", "damping_multiples")
-"""Kinds :func:`draw_overlay` accepts."""
+_GLOBAL_TYPES = (PointType.HOMOCLINIC, PointType.HETEROCLINIC)
 
 
 @dataclass(frozen=True)
@@ -71,65 +64,133 @@ class PanelChoice:
 def draw(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice = PanelChoice()
          ) -> list[Axes]:
     """Draw ``result``'s figure of ``kind`` (:data:`PANEL_KINDS`) onto ``ax``; return the
-    axes drawn on (``linear`` and ``projections`` replace ``ax`` by their own panels in its
-    place). Titles name the study and its fixed parameters unless ``choice.title`` is set.
-    A result without what the kind needs is a :class:`WhirlError` saying what is missing."""
-    if kind not in PANEL_KINDS:
+    axes drawn on (``linear``, ``projections``, ``damping_multiples`` and ``time_history``
+    replace ``ax`` by their own panels in its place). Titles name the study and its fixed
+    parameters unless ``choice.title`` is set. A result without what the kind needs is a
+    :class:`WhirlError` saying what is missing."""
+    panel = _PANELS.get(kind)
+    if panel is None:
         raise WhirlError(f"unknown panel kind {kind!r}; choose from {', '.join(PANEL_KINDS)}")
-    title = choice.title
-    caption = captions(result)
-    if kind in ("poincare", "spectrum", "orbit_diagram"):
-        continuation = pick_continuation(result, choice.continuation, kind)
-        varied = {n for b in continuation.branches for n in b.parameter_names}
-        if continuation.explorations:
-            varied.add(continuation.explorations[0].parameter)
-        _motion_panel(kind, continuation, ax, choice.state,
-                      caption.title(varied) if title is None else title)
-        return [ax]
-    if kind in ("bifurcation", "projections", "period", "amplitude"):
-        continuation = pick_continuation(result, choice.continuation, kind)
-        varied = {n for b in continuation.branches for n in b.parameter_names}
-        title = caption.title(varied) if title is None else title
-        if kind == "bifurcation":
-            bifurcation_diagram(continuation, choice.state, ax=ax, title=title)
-        elif kind == "period":
-            period_plot(continuation, title=title, ax=ax)
-        elif kind == "amplitude":
-            amplitude_diagram(continuation, ax=ax)
-            ax.set_title(title)
-        else:
-            return _replaced(ax, lambda region: projections_figure(
-                continuation, title=title, region=region))
-        return [ax]
-    if kind == "phase":
-        branch = _pick_branch(result, choice)
-        labels = list(choice.orbits) if choice.orbits is not None else None
-        if labels is None:
-            from .files import phase_labels
-
-            labels = phase_labels(branch)
-        phase_plane(branch, labels=labels, y=choice.state, ax=ax,
-                    title=caption.title(branch.parameter_names) if title is None else title)
-        return [ax]
-    if kind in ("time_history", "hub_path"):
-        return _draw_simulation(result, kind, ax, choice, caption)
-    if kind == "law":
-        return _draw_law(result, ax, choice)
-    if kind == "damping_multiples":
-        return _replaced(ax, lambda region: _draw_multiples(result, region, choice, caption))
-    if kind in ("linear", "root_locus"):
-        sweep = _pick_sweep(result, choice.sweep)
-        title = caption.title({sweep.parameter}) if title is None else title
-        if kind == "root_locus":
-            root_locus_plot(sweep, title=title, ax=ax)
-            return [ax]
-        return _replaced(ax, lambda region: linear_sweep_plot(
-            sweep, hz=choice.hz, title=title,
-            axes=tuple(region.subgridspec(2, 1).subplots(sharex=True))))
-    return _draw_map(result, kind, ax, choice, caption)
+    return panel(result, ax, choice, captions(result))
 
 
-def _draw_law(result: StudyResult, ax: Axes, choice: PanelChoice) -> list[Axes]:
+def _continuation_title(continuation: ContinuationResult, choice: PanelChoice, caption
+                        ) -> str:
+    """``choice.title``, else the study's title over what ``continuation`` does not vary."""
+    if choice.title is not None:
+        return choice.title
+    varied = {n for b in continuation.branches for n in b.parameter_names}
+    if continuation.explorations:
+        varied.add(continuation.explorations[0].parameter)
+    return caption.title(varied)
+
+
+def _bifurcation_panel(result, ax, choice, caption) -> list[Axes]:
+    continuation = pick_continuation(result, choice.continuation, "bifurcation")
+    bifurcation_diagram(continuation, choice.state, ax=ax,
+                        title=_continuation_title(continuation, choice, caption))
+    return [ax]
+
+
+def _projections_panel(result, ax, choice, caption) -> list[Axes]:
+    continuation = pick_continuation(result, choice.continuation, "projections")
+    title = _continuation_title(continuation, choice, caption)
+    return _replaced(ax, lambda region: projections_figure(continuation, title=title,
+                                                           region=region))
+
+
+def _period_panel(result, ax, choice, caption) -> list[Axes]:
+    continuation = pick_continuation(result, choice.continuation, "period")
+    period_plot(continuation, title=_continuation_title(continuation, choice, caption), ax=ax)
+    return [ax]
+
+
+def _blowup_panel(result, ax, choice, caption) -> list[Axes]:
+    from .blowup import blowup_plot
+
+    continuation = pick_continuation(result, choice.continuation, "blowup")
+    blowup_plot(continuation, branch=choice.branch, ax=ax,
+                title=_continuation_title(continuation, choice, caption))
+    return [ax]
+
+
+def _amplitude_panel(result, ax, choice, caption) -> list[Axes]:
+    continuation = pick_continuation(result, choice.continuation, "amplitude")
+    amplitude_diagram(continuation, ax=ax)
+    ax.set_title(_continuation_title(continuation, choice, caption))
+    return [ax]
+
+
+def _poincare_panel(result, ax, choice, caption) -> list[Axes]:
+    from .motion import poincare_plot
+
+    continuation = pick_continuation(result, choice.continuation, "poincare")
+    poincare_plot(continuation, ax=ax, title=_continuation_title(continuation, choice, caption))
+    return [ax]
+
+
+def _spectrum_panel(result, ax, choice, caption) -> list[Axes]:
+    from .motion import spectrum_plot
+
+    continuation = pick_continuation(result, choice.continuation, "spectrum")
+    spectrum_plot(continuation, ax=ax, title=_continuation_title(continuation, choice, caption))
+    return [ax]
+
+
+def _orbit_diagram_panel(result, ax, choice, caption) -> list[Axes]:
+    from .motion import orbit_diagram
+
+    continuation = pick_continuation(result, choice.continuation, "orbit_diagram")
+    orbit_diagram(continuation, choice.state, ax=ax,
+                  title=_continuation_title(continuation, choice, caption))
+    return [ax]
+
+
+def _phase_panel(result, ax, choice, caption) -> list[Axes]:
+    branch = _pick_branch(result, choice)
+    labels = list(choice.orbits) if choice.orbits is not None else None
+    if labels is None:
+        from .files import phase_labels
+
+        labels = phase_labels(branch)
+    phase_plane(branch, labels=labels, y=choice.state, ax=ax,
+                title=caption.title(branch.parameter_names) if choice.title is None
+                else choice.title)
+    return [ax]
+
+
+def _linear_panel(result, ax, choice, caption) -> list[Axes]:
+    sweep = _pick_sweep(result, choice.sweep)
+    title = caption.title({sweep.parameter}) if choice.title is None else choice.title
+    return _replaced(ax, lambda region: linear_sweep_plot(
+        sweep, hz=choice.hz, title=title,
+        axes=tuple(region.subgridspec(2, 1).subplots(sharex=True))))
+
+
+def _root_locus_panel(result, ax, choice, caption) -> list[Axes]:
+    sweep = _pick_sweep(result, choice.sweep)
+    root_locus_plot(sweep, title=caption.title({sweep.parameter}) if choice.title is None
+                    else choice.title, ax=ax)
+    return [ax]
+
+
+def _multiples_panel(result, ax, choice, caption) -> list[Axes]:
+    return _replaced(ax, lambda region: _draw_multiples(result, region, choice, caption))
+
+
+def _simulation_panel(kind: str):
+    """The panel of ``time_history`` or ``hub_path``."""
+    return lambda result, ax, choice, caption: _draw_simulation(result, kind, ax, choice,
+                                                                caption)
+
+
+def _map_panel(kind: str):
+    """The panel of ``boundary`` or ``overhang``."""
+    return lambda result, ax, choice, caption: _draw_map(result, kind, ax, choice, caption)
+
+
+def _law_panel(result: StudyResult, ax: Axes, choice: PanelChoice, caption=None
+               ) -> list[Axes]:
     """The ``law`` kind: the nonlinear law on the dof ``choice.state`` (None: the first)."""
     from .laws import law_plot, nonlinear_laws
 
@@ -140,19 +201,6 @@ def _draw_law(result: StudyResult, ax: Axes, choice: PanelChoice) -> list[Axes]:
     model, values, dof = found[0]
     law_plot(model, values, dof, ax=ax, title=choice.title)
     return [ax]
-
-
-def _motion_panel(kind: str, continuation, ax: Axes, state: str | None, title: str) -> None:
-    """The ``poincare``, ``spectrum`` and ``orbit_diagram`` kinds on ``ax`` (``state``: the
-    orbit diagram's)."""
-    from .motion import orbit_diagram, poincare_plot, spectrum_plot
-
-    if kind == "poincare":
-        poincare_plot(continuation, ax=ax, title=title)
-    elif kind == "spectrum":
-        spectrum_plot(continuation, ax=ax, title=title)
-    else:
-        orbit_diagram(continuation, state, ax=ax, title=title)
 
 
 def _draw_simulation(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice, caption
@@ -254,14 +302,16 @@ def pick_continuation(result: StudyResult, name: str | None, kind: str = "bifurc
                              f"(continuations: {', '.join(c.name for c in one) or 'none'})")
         return found[0]
     explored = lambda c: bool(c.explorations)  # noqa: E731
+    blowup = lambda c: any(p.point_type in _GLOBAL_TYPES for p in c.special_points)  # noqa: E731
     fits = {"period": lambda c: any(b.is_periodic for b in c.branches),
             "amplitude": has_amplitudes, "poincare": explored, "spectrum": explored,
-            "orbit_diagram": explored}.get(kind, lambda c: True)
+            "orbit_diagram": explored, "blowup": blowup}.get(kind, lambda c: True)
     found = [c for c in one if fits(c)]
     if not found:
         need = {"period": "periodic branch", "amplitude": "freeplay amplitudes",
                 "poincare": "explored values", "spectrum": "explored values",
-                "orbit_diagram": "explored values"}.get(
+                "orbit_diagram": "explored values",
+                "blowup": "periodic family ending in a global bifurcation"}.get(
             kind, "one-parameter continuation")
         raise WhirlError(f"{result.study_name}: nothing to draw as {kind}: no {need}")
     return found[0]
@@ -312,10 +362,12 @@ def draw_overlay(results: Sequence[StudyResult], kind: str, ax: Axes,
     ``bifurcation`` each result in its own colour, stable branches solid and unstable dotted,
     special points with the markers of :data:`PLOT_KEY`; for ``damping_multiples`` each
     parameter in its own colour, each result in its own line style (the Axes split in
-    damping and frequency). The legend names each result by
+    damping and frequency); for ``law`` each result's stiffness law in its own colour and
+    line style beside the linear spring. The legend names each result by
     ``labels`` (missing or None: :func:`differing_labels`). Title: ``title`` (None: the
     parameters off their datum that every result shares and the diagram does not vary)."""
-    if kind not in OVERLAY_KINDS:
+    overlay = _OVERLAYS.get(kind)
+    if overlay is None:
         raise WhirlError(f"kind {kind!r} cannot be overlaid; choose from "
                          f"{', '.join(OVERLAY_KINDS)}")
     if not results:
@@ -323,9 +375,12 @@ def draw_overlay(results: Sequence[StudyResult], kind: str, ax: Axes,
     auto = differing_labels(results)
     names = [labels[k] if k < len(labels) and labels[k] else auto[k]
              for k in range(len(results))]
-    if kind == "damping_multiples":
-        return _replaced(ax, lambda region: _overlay_multiples(results, names, region, choice,
-                                                               title))
+    return overlay(results, names, ax, choice, title)
+
+
+def _overlay_bifurcations(results: Sequence[StudyResult], names: Sequence[str], ax: Axes,
+                          choice: PanelChoice, title: str | None) -> list[Axes]:
+    """Every result's bifurcation diagram on ``ax``, one colour per result."""
     first: dict[str, object] = {}
     handles = []
     state = choice.state
@@ -348,21 +403,50 @@ def draw_overlay(results: Sequence[StudyResult], kind: str, ax: Axes,
     if title is None:
         varied = {n for r in results for c in r.continuations for b in c.branches
                   for n in b.parameter_names}
-        shared = [p for p in results[0].parameters if p.name not in varied
-                  and p.value != p.datum and all(
-                      any(q.name == p.name and q.value == p.value for q in r.parameters)
-                      for r in results[1:])]
-        kept = [str(Fixed(p.name, p.value, p.unit)) for p in shared]
-        title = ", ".join(kept)
+        title = _shared_title(results, varied)
     ax.set_title(title)
     return [ax]
 
 
-def _overlay_multiples(results: Sequence[StudyResult], names: Sequence[str], region,
-                       choice: PanelChoice, title: str | None) -> None:
-    """Every result's ``damping_multiples`` on one pair of axes: a colour per parameter (in
-    the order of each result's sweeps), a line style per result, its lines labelled
-    ``"<name>: <parameter> (<whirl>)"``."""
+def _shared_title(results: Sequence[StudyResult], varied: set[str]) -> str:
+    """The parameters off their datum that every result shares, but for ``varied``."""
+    shared = [p for p in results[0].parameters if p.name not in varied
+              and p.value != p.datum and all(
+                  any(q.name == p.name and q.value == p.value for q in r.parameters)
+                  for r in results[1:])]
+    return ", ".join(str(Fixed(p.name, p.value, p.unit)) for p in shared)
+
+
+def _overlay_laws(results: Sequence[StudyResult], names: Sequence[str], ax: Axes,
+                  choice: PanelChoice, title: str | None) -> list[Axes]:
+    """Every result's nonlinear law on the dof ``choice.state`` (None: the first) on ``ax``,
+    beside the linear spring (:func:`~whirl_cli.plots.laws.laws_plot`)."""
+    from .laws import laws_plot, nonlinear_laws
+
+    chosen = []
+    for result, name in zip(results, names, strict=True):
+        found = [(m, v, d) for m, v, d in nonlinear_laws(result) if choice.state in (None, d)]
+        if not found:
+            raise WhirlError(f"{result.study_name}: no nonlinear stiffness law"
+                             + (f" on {choice.state!r}" if choice.state else ""))
+        chosen.append((*found[0], name))
+    laws_plot(chosen, ax=ax, title=title)
+    return [ax]
+
+
+def _overlay_multiples(results: Sequence[StudyResult], names: Sequence[str], ax: Axes,
+                       choice: PanelChoice, title: str | None) -> list[Axes]:
+    """``ax`` split in two (damping, frequency) with every result's ``damping_multiples``:
+    a colour per parameter, a line style per result (:func:`_multiples_into`)."""
+    return _replaced(ax, lambda region: _multiples_into(results, names, region, choice,
+                                                        title))
+
+
+def _multiples_into(results: Sequence[StudyResult], names: Sequence[str], region,
+                    choice: PanelChoice, title: str | None) -> None:
+    """Every result's ``damping_multiples`` on one pair of axes in ``region``: a colour per
+    parameter (in the order of each result's sweeps), a line style per result, its lines
+    labelled ``"<name>: <parameter> (<whirl>)"``."""
     axes = tuple(region.subgridspec(2, 1).subplots(sharex=True))
     styles = ("-", "--", "-.", ":")
     for k, (result, name) in enumerate(zip(results, names, strict=True)):
@@ -391,3 +475,28 @@ def _draw_coloured(ax: Axes, branch: Branch, state: str, colour: str):
     if solid is None and len(y):
         (solid,) = ax.plot([], [], color=colour, linestyle="-")
     return solid if np.size(y) else None
+
+
+_PANELS = {
+    "bifurcation": _bifurcation_panel, "projections": _projections_panel,
+    "period": _period_panel, "phase": _phase_panel, "linear": _linear_panel,
+    "root_locus": _root_locus_panel, "damping_multiples": _multiples_panel,
+    "boundary": _map_panel("boundary"), "overhang": _map_panel("overhang"),
+    "amplitude": _amplitude_panel, "time_history": _simulation_panel("time_history"),
+    "hub_path": _simulation_panel("hub_path"), "law": _law_panel,
+    "poincare": _poincare_panel, "spectrum": _spectrum_panel,
+    "orbit_diagram": _orbit_diagram_panel, "blowup": _blowup_panel,
+}
+"""Panel kind -> its drawer (result, axes, choice, captions) -> the axes drawn on."""
+
+PANEL_KINDS = tuple(_PANELS)
+"""Kinds :func:`draw` accepts (``overhang``: one slice of a boundary, its unsafe intervals
+shaded; ``blowup``: the period of a family near its global bifurcation, the fitted
+asymptote)."""
+
+_OVERLAYS = {"bifurcation": _overlay_bifurcations, "damping_multiples": _overlay_multiples,
+             "law": _overlay_laws}
+"""Overlay kind -> its drawer (results, labels, axes, choice, title) -> the axes drawn on."""
+
+OVERLAY_KINDS = tuple(_OVERLAYS)
+"""Kinds :func:`draw_overlay` accepts."""

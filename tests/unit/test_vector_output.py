@@ -1,0 +1,76 @@
+"""Figures as vector files beside the PNG: PDF with its fonts embedded as TrueType, SVG with
+text as paths, both well formed (the PDF's cross-reference table points at its objects, the
+SVG parses as XML), the same bytes run to run, carrying the figure's key; `whirl plot
+--format` writes them."""
+
+from __future__ import annotations
+
+import re
+import xml.etree.ElementTree as ET
+
+import pytest
+from click.testing import CliRunner
+
+from tests.unit.test_plots import continuation  # noqa: F401
+from whirl_cli.cli import cli
+from whirl_cli.output import store
+from whirl_cli.plots.diagrams import bifurcation_diagram
+from whirl_cli.plots.files import rendered_formats, stored_key_in
+from whirl_cli.results import StudyResult
+
+KEY = "0123456789abcdef" * 4
+
+
+def check_pdf(data: bytes) -> None:
+    """A PDF whose trailer's startxref points at its cross-reference table, each of whose
+    in-use entries points at the object it numbers; fonts embedded as TrueType, none type 3."""
+    assert data.startswith(b"%PDF-1.") and data.rstrip().endswith(b"%%EOF")
+    start = int(re.search(rb"startxref\s+(\d+)\s+%%EOF\s*$", data).group(1))
+    assert data[start:start + 4] == b"xref"
+    head = re.match(rb"xref\s+(\d+) (\d+)\s+", data[start:])
+    first, count = int(head.group(1)), int(head.group(2))
+    entries = re.findall(rb"(\d{10}) (\d{5}) ([nf])", data[start + head.end():])[:count]
+    assert len(entries) == count
+    for number, (offset, _, used) in enumerate(entries, start=first):
+        if used == b"n":
+            assert re.match(rb"%d 0 obj" % number, data[int(offset):]), number
+    assert b"/FontFile2" in data and b"/Type3" not in data
+
+
+def check_svg(data: bytes) -> None:
+    """An SVG document that parses as XML, sized in points, with no text element (text is
+    drawn as paths, needing no font)."""
+    root = ET.fromstring(data)
+    assert root.tag == "{http://www.w3.org/2000/svg}svg"
+    assert root.get("width").endswith("pt") and root.get("height").endswith("pt")
+    assert not root.findall(".//{http://www.w3.org/2000/svg}text")
+    assert root.findall(".//{http://www.w3.org/2000/svg}path")
+
+
+def test_vector_files_parse_embed_fonts_repeat_and_carry_the_key(continuation):  # noqa: F811
+    files = [rendered_formats(bifurcation_diagram(continuation, title="theta"),
+                              ("png", "pdf", "svg"), 100, KEY) for _ in range(2)]
+    assert files[0] == files[1]  # the same bytes each time
+    check_pdf(files[0]["pdf"])
+    check_svg(files[0]["svg"])
+    assert stored_key_in(files[0]["pdf"]) == stored_key_in(files[0]["svg"]) == KEY
+    assert files[0]["png"].startswith(b"\x89PNG")
+
+
+def test_plot_command_writes_each_format(tmp_path, continuation):  # noqa: F811
+    result_file = tmp_path / "r.h5"
+    store.write(StudyResult("study", "classical", (continuation,), (), ()), result_file)
+    done = CliRunner().invoke(cli, ["plot", str(result_file), "--kind", "bifurcation",
+                                    "--format", "pdf,svg"])
+    assert done.exit_code == 0, done.output
+    stem = tmp_path / "r_hopf_K1_bifurcation"
+    check_pdf(stem.with_suffix(".pdf").read_bytes())
+    check_svg(stem.with_suffix(".svg").read_bytes())
+    assert stem.with_suffix(".png").read_bytes().startswith(b"\x89PNG")
+
+
+@pytest.mark.parametrize("given", ["jpg", "png,eps", ","])
+def test_unknown_format_is_refused(tmp_path, given):
+    done = CliRunner().invoke(cli, ["figures", str(tmp_path), "--format", given])
+    assert done.exit_code == 2
+    assert "expected formats among png, pdf, svg" in done.output
