@@ -6,6 +6,7 @@ results are still written, with each run's status); 2 usage errors (click).
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import sys
@@ -23,16 +24,34 @@ def _version() -> str:
     return installed()
 
 
+#: whirl's log: progress (INFO), notes (WARNING) and details (DEBUG), as lines on stderr;
+#: ``-q`` keeps warnings and errors only, ``-v`` adds the details.
+LOG = logging.getLogger("whirl")
+
+
+class _ToStderr(logging.Handler):
+    """Log records as plain lines on stderr, written through click (which tests capture)."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        click.echo(self.format(record), err=True)
+
+
+def _configure_log(verbose: bool, quiet: bool) -> None:
+    if not any(isinstance(h, _ToStderr) for h in LOG.handlers):
+        LOG.addHandler(_ToStderr())
+        LOG.propagate = False
+    LOG.setLevel(logging.WARNING if quiet else logging.DEBUG if verbose else logging.INFO)
+
+
 def _console():
     from rich.console import Console
 
-    return Console(stderr=True, highlight=False)
+    return Console(stderr=True, highlight=False, quiet=LOG.getEffectiveLevel() > logging.INFO)
 
 
-def _say(text: str, end: str = "\n") -> None:
-    """A line of ``whirl run``'s progress or a diagnostic, on stderr, as written (no markup,
-    no wrapping)."""
-    click.echo(text + end, err=True, nl=False)
+def _say(text: str) -> None:
+    """A line of progress on stderr, as written (no markup, no wrapping); not with ``-q``."""
+    LOG.info(text)
 
 
 def _tell(text: str, end: str = "\n") -> None:
@@ -103,20 +122,25 @@ def _reader_left() -> None:
 
 
 #: Every option can also come from the environment: WHIRL_<COMMAND>_<OPTION>, e.g.
-#: WHIRL_RUN_JOBS=4, WHIRL_SWEEP_OUTPUT_DIR=results (:func:`_environment_names`).
+#: WHIRL_RUN_JOBS=4, WHIRL_SWEEP_OUTPUT=results (:func:`_environment_names`).
 ENV_PREFIX = "WHIRL"
 
 
 @click.group(cls=_Whirl, context_settings={"help_option_names": ["-h", "--help"]})
 @click.option("--version", is_flag=True, expose_value=False, is_eager=True,
               callback=_show_version, help="Show the version and exit.")
-def cli() -> None:
+@click.option("-v", "--verbose", is_flag=True, envvar="WHIRL_VERBOSE",
+              help="Say more: each AUTO run as it starts, with its directory.")
+@click.option("-q", "--quiet", is_flag=True, envvar="WHIRL_QUIET",
+              help="No progress on stderr: warnings, errors and results only.")
+def cli(verbose: bool, quiet: bool) -> None:
     """Nonlinear whirl-flutter continuation studies with AUTO-07p: YAML in, HDF5 and plots out.
 
     STUDY_FILE may be - (the study's YAML on standard input). Every option can also be set
     in the environment as WHIRL_<COMMAND>_<OPTION> (e.g. WHIRL_RUN_JOBS=4). Shell completion:
     eval "$(_WHIRL_COMPLETE=bash_source whirl)" (zsh_source, fish_source for those shells).
     """
+    _configure_log(verbose, quiet)
 
 
 #: What ``-`` names as a study file: the YAML on standard input.
@@ -156,6 +180,12 @@ def _not_stdout(what: str, instead: str = ""):
 
 
 # ------------------------------------------------------------------------------------ run
+def _jobs_option(help_text: str):
+    """``-j/--jobs``: the same name, range and default in every command."""
+    return click.option("-j", "--jobs", type=click.IntRange(1, MAX_JOBS),
+                        default=default_jobs(), show_default=True, help=help_text)
+
+
 def _output_file(ctx: click.Context, param: click.Parameter, value: str | None) -> Path | None:
     """``-o``: a file path (not empty, not an existing directory, not ``-``)."""
     if value is None:
@@ -174,9 +204,7 @@ def _output_file(ctx: click.Context, param: click.Parameter, value: str | None) 
 @click.argument("study_file", type=click.Path(dir_okay=False, path_type=Path))
 @click.option("-o", "--output", callback=_output_file,
               help="HDF5 result file [default: <study name>.h5 in the current directory].")
-@click.option("-j", "--jobs", type=click.IntRange(1, MAX_JOBS), default=default_jobs(),
-              show_default=True,
-              help="AUTO runs (and time simulations, and plots) in parallel.")
+@_jobs_option("AUTO runs (and time simulations, and plots) in parallel.")
 @click.option("--overwrite", is_flag=True, help="Replace an existing output file.")
 @click.option("--plots/--no-plots", default=True, show_default=True,
               help="Write the study's plots (PNG) next to the output file.")
@@ -221,7 +249,7 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
         _tell(f"wrote {path}")
     found = verdict(result, published.plot_error)
     for note in found.notes:
-        _say(f"note: {note}")
+        LOG.warning(f"note: {note}")
     _tell(render(result, "table"), end="")
     checks = [x for c in result.continuations for x in c.cross_checks]
     if checks:
@@ -417,7 +445,8 @@ def _formats(ctx: click.Context, param: click.Parameter, value: str) -> tuple[st
                                  "orbit_diagram"]),
               help="Plot kind (repeatable) [default: every kind the file has the data for]; "
                    "a kind it lacks the data for is an error.")
-@click.option("-o", "--output-dir", type=click.Path(file_okay=False, path_type=Path),
+@click.option("-o", "--output", "--output-dir", "output_dir",
+              type=click.Path(file_okay=False, path_type=Path),
               callback=_not_stdout("PNG files into a directory"),
               help="Directory for the PNG files [default: next to RESULT_FILE].")
 @click.option("--state", help="State the bifurcation diagrams draw [default: the study's "
@@ -541,12 +570,12 @@ def doctor() -> None:
 @cli.command()
 @click.argument("paths", nargs=-1, required=True,
                 type=click.Path(exists=True, path_type=Path))
-@click.option("-o", "--output-dir", "out_dir", type=click.Path(file_okay=False, path_type=Path),
+@click.option("-o", "--output", "--output-dir", "out_dir",
+              type=click.Path(file_okay=False, path_type=Path),
               default=Path("results"), show_default=True,
               callback=_not_stdout("result files into a directory"),
               help="Directory for <study name>.h5 and the plots.")
-@click.option("-j", "--jobs", type=click.IntRange(1, 256), default=os.cpu_count() or 1,
-              show_default=True, help="Studies run in parallel (local worker processes).")
+@_jobs_option("Studies run in parallel (local worker processes).")
 @click.option("--dask", "dask_address", metavar="ADDRESS",
               help="Run the studies on this Dask scheduler instead (needs whirl[dask]).")
 @click.option("--force", is_flag=True, help="Rerun studies whose output is up to date.")
@@ -574,15 +603,15 @@ def sweep(paths: tuple[Path, ...], out_dir: Path, jobs: int, dask_address: str |
 # ------------------------------------------------------------------------------------ figures
 @cli.command()
 @click.argument("paths", nargs=-1, required=True, type=click.Path(path_type=Path))
-@click.option("-o", "--out-dir", type=click.Path(file_okay=False, path_type=Path),
+@click.option("-o", "--output", "--out-dir", "out_dir",
+              type=click.Path(file_okay=False, path_type=Path),
               default=Path("figures"), show_default=True,
               callback=_not_stdout("figures into a directory"),
               help="Directory for fig<n>.png and index.html.")
 @click.option("--results", "results_dir", type=click.Path(file_okay=False, path_type=Path),
               default=Path("results"), show_default=True,
               help="Directory of the studies' <study name>.h5 (reused when up to date).")
-@click.option("-j", "--jobs", type=click.IntRange(1, 256), default=os.cpu_count() or 1,
-              show_default=True, help="Studies run in parallel (local worker processes).")
+@_jobs_option("Studies run in parallel (local worker processes).")
 @click.option("--force", is_flag=True, help="Rerun studies whose output is up to date.")
 @click.option("--format", "formats", default="png,pdf", show_default=True, callback=_formats,
               metavar="png[,pdf][,svg]",
@@ -661,7 +690,7 @@ def _environment_names(group: click.Group) -> None:
     for name, command in group.commands.items():
         for param in command.params:
             if isinstance(param, click.Option) and param.envvar is None:
-                option = max(param.opts, key=len).lstrip("-")
+                option = next(o for o in param.opts if o.startswith("--")).lstrip("-")
                 param.envvar = f"{ENV_PREFIX}_{name}_{option}".upper().replace("-", "_")
 
 

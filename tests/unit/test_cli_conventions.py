@@ -79,7 +79,7 @@ def test_options_from_the_environment():
                  env={**os.environ, "WHIRL_RUN_JOBS": "0"})
     assert done.returncode == 2 and "0 is not in the range 1<=x<=64" in done.stderr
     done = whirl("plot", REFERENCE, "--kind", "law",
-                 env={**os.environ, "WHIRL_PLOT_OUTPUT_DIR": "-"})
+                 env={**os.environ, "WHIRL_PLOT_OUTPUT": "-"})
     assert done.returncode == 1 and done.stderr.startswith("-o -: whirl plot writes")
     done = whirl("summary", REFERENCE, "--format", "json",  # the command line wins
                  env={**os.environ, "WHIRL_SUMMARY_FORMAT": "csv"})
@@ -93,3 +93,38 @@ def test_shell_completion_through_the_console_script():
                            "from whirl_cli.entry import main; main()"],
                           capture_output=True, text=True, timeout=60, env=env)
     assert done.returncode == 0 and done.stdout.split() == ["plain,export"]
+
+
+def test_one_option_for_one_meaning_in_every_command():
+    """-j/--jobs has one range and default, and the file or folder a command writes is
+    -o/--output, in every command that has them."""
+    import click
+
+    from whirl_cli.cli import cli
+    from whirl_cli.jobs import MAX_JOBS, default_jobs
+
+    options = {name: {o: p for p in command.params if isinstance(p, click.Option)
+                      for o in p.opts}
+               for name, command in cli.commands.items()}
+    jobs = {name: found["--jobs"] for name, found in options.items() if "--jobs" in found}
+    assert set(jobs) == {"run", "sweep", "figures"}
+    for name, option in jobs.items():
+        assert "-j" in option.opts, name
+        assert (option.type.min, option.type.max, option.default) == (1, MAX_JOBS,
+                                                                      default_jobs()), name
+    written = {name for name, found in options.items() if "-o" in found}
+    assert written == {"run", "export", "plot", "sweep", "figures"}
+    assert all(options[name]["-o"].opts[:2] == ["-o", "--output"] for name in written)
+
+
+def test_quiet_and_verbose(tmp_path):
+    """``whirl -q run``: no progress on stderr, the results still on stdout; ``whirl -v
+    run``: each AUTO run's start too."""
+    study = ROOT / "tests" / "data" / "lagged_spring_mu.yaml"
+    runs = {flag: whirl(flag, "run", study, "-o", tmp_path / f"{flag}.h5", "--no-plots")
+            for flag in ("-q", "-v")}
+    assert all(r.returncode == 0 for r in runs.values()), runs
+    assert runs["-q"].stderr == ""
+    assert "main_up" in runs["-q"].stdout and "LP" in runs["-q"].stdout
+    assert "mu.main_up" in runs["-v"].stderr and " start in " in runs["-v"].stderr
+    assert runs["-v"].stdout == runs["-q"].stdout.replace("-q.h5", "-v.h5")

@@ -7,6 +7,7 @@ they wrote (an empty branch with the run's status and message where a run failed
 
 from __future__ import annotations
 
+import logging
 import threading
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
@@ -24,6 +25,8 @@ from ..results import STEP_LIMIT, Branch, BranchKind, PointType, RunRecord, Spec
 from .branches import special_points
 from .numerics import Numerics as Numerics  # re-exported: the recipes take it from here
 
+#: whirl's log (``whirl -v`` shows its DEBUG lines: each run as it starts).
+_LOG = logging.getLogger("whirl")
 
 @dataclass(frozen=True)
 class RunSpec:
@@ -108,6 +111,7 @@ class Engine:
             restart_file = self.outcomes[source].file("s")
             constants["IRS"] = label
         with self._slots.held(background):
+            _LOG.debug(f"  {spec.name.replace('/', '.'):<32} start in {self.workroot / spec.name}")
             outcome = runner.run(self.executable.path, constants, self.workroot / spec.name,
                                  spec.name.replace("/", "."), restart=restart_file,
                                  timeout=self.timeout, data=spec.data, on_slow=self.on_slow,

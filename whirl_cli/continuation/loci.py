@@ -73,7 +73,7 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
                   slices: tuple[float, ...], loci: tuple[str, ...],
                   parameters: dict[str, float], numerics: Numerics,
                   slice_orbits: tuple[tuple[OrbitStart, ...], ...] = (),
-                  snaking_folds: str = "all") -> tuple[ContinuationResult, list[Branch]]:
+                  snaking_folds: str = "outermost") -> tuple[ContinuationResult, list[Branch]]:
     """One-parameter runs at every slice of the second parameter, then the loci of their
     special points (both directions, each locus once). Returns the continuation (slice branches
     named ``slice_<k>.<branch>`` and the locus branches) and the locus branches.

@@ -408,12 +408,12 @@ class TwoParameterContinuation(_Strict):
         "too; drawn, not used for the unsafe region). Default: all but `torus`.",
     )
     snaking_folds: Literal["all", "outermost"] = Field(
-        "all",
+        "outermost",
         description="Folds of cycles of a family snaking toward a homoclinic orbit (three or "
-        "more of one family at one point of a slice, to 1e-3 of the ranges): `all` traces the "
-        "locus of each; `outermost` only those of the lowest- and highest-period ones, along "
-        "which the others' lie (on the chapter-3 boundaries within 3e-3 of the ranges, the "
-        "unsafe region the same; 20-30 % less AUTO time there).",
+        "more of one family at one point of a slice, to 1e-3 of the ranges): `outermost` "
+        "traces only the loci of the lowest- and highest-period ones, along which the others' "
+        "lie (on the chapter-3 boundaries within 3e-3 of the ranges, the unsafe region the "
+        "same; 20-30 % less AUTO time there); `all` the locus of each.",
     )
     method: Literal["loci", "slices"] = Field(
         "loci",

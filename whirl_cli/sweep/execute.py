@@ -13,6 +13,7 @@
 
 from __future__ import annotations
 
+import logging
 import pickle
 import shutil
 import signal
@@ -79,9 +80,11 @@ def _still_running(study: str, run: str, seconds: float) -> None:
 
 
 def _progress(line: str) -> None:
-    """``line`` on the sweep's stderr, from a worker (one write: lines never interleave)."""
-    sys.stderr.write(line + "\n")
-    sys.stderr.flush()
+    """``line`` on the sweep's stderr, from a worker (one write: lines never interleave);
+    nothing with ``whirl -q`` (the level of whirl's log, inherited by a forked worker)."""
+    if logging.getLogger("whirl").isEnabledFor(logging.INFO):
+        sys.stderr.write(line + "\n")
+        sys.stderr.flush()
 
 
 def portable(error: BaseException) -> BaseException:
