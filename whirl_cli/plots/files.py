@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import OutputError, WhirlError
+from ..kinds import MOTION_KINDS, PLOT_KINDS
 from ..output.guard import PLOT_CHARACTERS, plot_stem
 from ..results import Branch, ContinuationResult, PointType, StudyResult
 from .captions import Captions, captions
@@ -30,13 +31,6 @@ from .simulations import hub_path, time_history
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-PLOT_KINDS = ("bifurcation", "linear", "root_locus", "damping_multiples", "projections",
-              "period", "phase", "boundary", "amplitude", "time_history", "hub_path", "law",
-              "poincare", "spectrum", "orbit_diagram")
-"""Kinds accepted by :func:`save_study_plots`."""
-
-MOTION_KINDS = ("poincare", "spectrum", "orbit_diagram")
-"""Kinds drawn from a continuation's ``explore:`` classifications."""
 
 PHASE_ORBITS = 12
 """Most orbits a study's phase-plane figure draws (a long family stores one every 20 steps)."""

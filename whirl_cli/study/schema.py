@@ -28,6 +28,7 @@ from pydantic import (
 from pydantic_core import PydanticCustomError
 
 from ..continuation.numerics import Numerics
+from ..kinds import PLOT_KINDS
 from ..models import FAMILIES, Model, is_known, is_model_file
 from .resolve import Names, _is_number, _resolved, names_of
 
@@ -440,9 +441,7 @@ class TwoParameterContinuation(_Strict):
         return tuple(s.label for s in self.slices)
 
 
-PlotKind = Literal["bifurcation", "linear", "root_locus", "damping_multiples", "projections",
-                   "period", "phase", "boundary", "amplitude", "time_history", "hub_path",
-                   "law", "poincare", "spectrum", "orbit_diagram"]
+PlotKind = Literal[PLOT_KINDS]
 Continuation = Annotated[OneParameterContinuation | TwoParameterContinuation,
                         Field(discriminator="type")]
 
