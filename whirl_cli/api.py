@@ -72,11 +72,13 @@ def run(study: Study | str | os.PathLike[str], jobs: int | None = None,
         on_run: Callable[[Any], None] | None = None,
         keep_runs: str | os.PathLike[str] | None = None,
         preload: tuple[str, ...] = (),
-        on_slow: Callable[[str, float], None] | None = None) -> StudyResult:
+        on_slow: Callable[[str, float], None] | None = None,
+        on_plan: Callable[[int], None] | None = None) -> StudyResult:
     """Run every continuation, linear analysis and cross-check of ``study`` (a Study or a
     path); ``jobs`` AUTO runs at once (None: as ``whirl run``, one per CPU); ``on_run`` is
     called with each AUTO run's outcome as it ends, ``on_slow`` with a run's name and seconds
-    when it still runs after 10 s, 20 s, ...
+    when it still runs after 10 s, 20 s, ..., ``on_plan`` with the number of AUTO runs
+    about to start whenever more are (the runs planned so far).
     AUTO works in a temporary directory, removed afterwards, or kept under ``keep_runs``.
     ``preload``: modules needed afterwards, imported while AUTO runs (e.g.
     :data:`whirl_cli.plots.MODULES` before :func:`save` draws plots)."""
@@ -85,7 +87,7 @@ def run(study: Study | str | os.PathLike[str], jobs: int | None = None,
     study = study if isinstance(study, Study) else load_study(study)
     with _workroot(study, keep_runs) as workroot:
         return run_study(study, workroot, jobs=jobs_or_default(jobs), on_run=on_run,
-                         preload=preload, on_slow=on_slow)
+                         preload=preload, on_slow=on_slow, on_plan=on_plan)
 
 
 def save(result: StudyResult, path: str | os.PathLike[str], plots: Sequence[str] = (),
@@ -105,7 +107,8 @@ def run_and_save(study: Study | str | os.PathLike[str], path: str | os.PathLike[
                  on_run: Callable[[Any], None] | None = None,
                  keep_runs: str | os.PathLike[str] | None = None,
                  preload: tuple[str, ...] = (),
-                 on_slow: Callable[[str, float], None] | None = None
+                 on_slow: Callable[[str, float], None] | None = None,
+                 on_plan: Callable[[int], None] | None = None
                  ) -> tuple[StudyResult, Published]:
     """:func:`run`, then :func:`save` with the study's ``plot_state``: the same files, but
     the plots drawn while the cross-checks run (:func:`whirl_cli.pipeline.run_and_draw`):
@@ -121,7 +124,8 @@ def run_and_save(study: Study | str | os.PathLike[str], path: str | os.PathLike[
                    jobs=jobs)
     with _workroot(study, keep_runs) as workroot:
         result, drawn = run_and_draw(study, workroot, draw if kinds else None, jobs=jobs,
-                                     on_run=on_run, preload=preload, on_slow=on_slow)
+                                     on_run=on_run, preload=preload, on_slow=on_slow,
+                                     on_plan=on_plan)
     return result, publish_study(result, path, kinds, overwrite, state=study.plot_state,
                                  jobs=jobs, drawn=drawn)
 

@@ -223,12 +223,20 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     # before any work; the directory is made at the end
     ready(output, overwrite, study.path, plots=plots and bool(study.plots))
 
+    runs = {"planned": 0, "done": 0}  # overall progress, shown on a terminal
+
+    def planned(count: int) -> None:
+        runs["planned"] += count
+
     def report(outcome) -> None:
         # an MX is only said to be a problem at the end: at a period blow-up it is expected
         mark = "ok" if outcome.success else outcome.status.upper()
         detail = {"ok": "", "mx": "  no convergence (MX)"}.get(outcome.status,
                                                                f"  {outcome.message}")
-        _say(f"  {outcome.name:<32} {mark:<8} {outcome.n_points:>6} points "
+        runs["done"] += 1
+        width = len(str(runs["planned"]))
+        count = f"[{runs['done']:>{width}}/{runs['planned']}]" if sys.stderr.isatty() else " "
+        _say(f"{count} {outcome.name:<32} {mark:<8} {outcome.n_points:>6} points "
              f"{outcome.wall_seconds:7.3f} s{detail}")
 
     def slow(name: str, seconds: float) -> None:
@@ -245,7 +253,7 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
         later = PLOT_MODULES if plots and study.plots else ()
         result, published = api.run_and_save(
             study, output, study.plots if plots else (), overwrite, jobs=jobs, on_run=report,
-            keep_runs=keep_runs, preload=later, on_slow=slow)
+            keep_runs=keep_runs, preload=later, on_slow=slow, on_plan=planned)
     for path in published.paths:
         _tell(f"wrote {path}")
     found = verdict(result, published.plot_error)

@@ -43,7 +43,8 @@ T = TypeVar("T")
 def run_study(study: Study, workroot: Path, jobs: int = 1,
               on_run: Callable[[RunOutcome], None] | None = None,
               preload: tuple[str, ...] = (),
-              on_slow: Callable[[str, float], None] | None = None) -> StudyResult:
+              on_slow: Callable[[str, float], None] | None = None,
+              on_plan: Callable[[int], None] | None = None) -> StudyResult:
     """Run every continuation, linear sweep and simulation of ``study``; AUTO works under
     ``workroot`` (a study without continuations needs no AUTO). ``preload``: modules the
     caller needs afterwards (e.g. :data:`whirl_cli.plots.MODULES` to draw), imported in the
@@ -54,19 +55,22 @@ def run_study(study: Study, workroot: Path, jobs: int = 1,
     here (:func:`_only_checks_simulate`, ``jobs`` 1; see :func:`run_and_draw`), and the
     stages after the continuations join the import before they start. ``on_run`` is called
     with each AUTO run's outcome as it ends, ``on_slow`` with a run's name and seconds when it
-    is still running after 10 s, 20 s, 40 s ... (:func:`whirl_cli.auto.runner.run`).
+    is still running after 10 s, 20 s, 40 s ... (:func:`whirl_cli.auto.runner.run`),
+    ``on_plan`` with the number of AUTO runs about to start whenever more are (the runs
+    planned so far: a recipe decides its next runs from the last ones' results).
 
     In the main thread, SIGINT and SIGTERM kill the running AUTO processes at once and raise
     :class:`whirl_cli.interrupts.Interrupted` (a KeyboardInterrupt), see
     :func:`whirl_cli.auto.runner.interruptible`.
     """
-    return run_and_draw(study, workroot, None, jobs, on_run, preload, on_slow)[0]
+    return run_and_draw(study, workroot, None, jobs, on_run, preload, on_slow, on_plan)[0]
 
 
 def run_and_draw(study: Study, workroot: Path, draw: Callable[[StudyResult], T] | None,
                  jobs: int = 1, on_run: Callable[[RunOutcome], None] | None = None,
                  preload: tuple[str, ...] = (),
-                 on_slow: Callable[[str, float], None] | None = None
+                 on_slow: Callable[[str, float], None] | None = None,
+                 on_plan: Callable[[int], None] | None = None
                  ) -> tuple[StudyResult, T | None]:
     """:func:`run_study`, and ``draw(result)`` (None without ``draw``): work that needs
     everything but the cross-checks, such as rendering the plots
@@ -78,7 +82,8 @@ def run_and_draw(study: Study, workroot: Path, draw: Callable[[StudyResult], T] 
     ``draw`` run here. The same result and drawings for any ``jobs``."""
     with interruptible():
         return _run_study(study, workroot, jobs, partial(Engine, jobs=jobs, on_run=on_run,
-                                                         on_slow=on_slow), preload, draw)
+                                                         on_slow=on_slow, on_plan=on_plan),
+                          preload, draw)
 
 
 def _run_study(study: Study, workroot: Path, jobs: int, engine: Callable[..., Engine],

@@ -128,3 +128,37 @@ def test_quiet_and_verbose(tmp_path):
     assert "main_up" in runs["-q"].stdout and "LP" in runs["-q"].stdout
     assert "mu.main_up" in runs["-v"].stderr and " start in " in runs["-v"].stderr
     assert runs["-v"].stdout == runs["-q"].stdout.replace("-q.h5", "-v.h5")
+
+
+def test_run_counts_its_auto_runs_on_a_terminal_only(tmp_path):
+    """On a terminal each AUTO run's line starts with [done/planned] (the runs planned so
+    far; the last line's counts equal); piped, the lines carry no count."""
+    import pty
+    import re
+
+    study = ROOT / "tests" / "data" / "lorenz_rho.yaml"
+    leader, follower = pty.openpty()
+    process = subprocess.Popen([sys.executable, "-m", "whirl_cli", "run", str(study), "-o",
+                                str(tmp_path / "tty.h5"), "--no-plots"],
+                               stdout=subprocess.DEVNULL, stderr=follower)
+    os.close(follower)
+    chunks = []
+    while True:
+        try:
+            chunk = os.read(leader, 4096)
+        except OSError:  # the terminal closed: the process has ended
+            break
+        if not chunk:
+            break
+        chunks.append(chunk)
+    assert process.wait(timeout=120) == 0
+    os.close(leader)
+    counted = re.findall(r"^\[\s*(\d+)/(\d+)\] rho\.", b"".join(chunks).decode(), re.M)
+    assert len(counted) == 7
+    assert [int(done) for done, _ in counted] == list(range(1, 8))
+    assert all(int(done) <= int(planned) for done, planned in counted)
+    assert counted[-1][0] == counted[-1][1]
+    piped = whirl("run", study, "-o", tmp_path / "piped.h5", "--no-plots")
+    assert piped.returncode == 0
+    lines = [line for line in piped.stderr.splitlines() if " rho." in line]
+    assert len(lines) == 7 and not any(line.startswith("[") for line in lines)

@@ -82,13 +82,15 @@ class Engine:
 
     def __init__(self, model: Model, workroot: Path, jobs: int = 1, timeout: float = 120.0,
                  on_run: Callable[[runner.RunOutcome], None] | None = None,
-                 on_slow: Callable[[str, float], None] | None = None) -> None:
+                 on_slow: Callable[[str, float], None] | None = None,
+                 on_plan: Callable[[int], None] | None = None) -> None:
         self.model = model
         self.workroot = Path(workroot)
         self.jobs = max(1, jobs)
         self.timeout = timeout
         self.on_run = on_run
         self.on_slow = on_slow
+        self.on_plan = on_plan
         self.executable = toolchain.compile_equations(lambda: fortran_source(model), model.name,
                                                  source_key=source_key(model))
         self.outcomes: dict[str, runner.RunOutcome] = {}
@@ -101,6 +103,8 @@ class Engine:
         """Execute ``specs`` (independent of each other) and return outcomes in spec order;
         every run has ended when this returns or raises. ``background``: each run waits
         while a foreground run waits for a slot (work ahead of need)."""
+        if self.on_plan is not None:
+            self.on_plan(len(specs))
         return thread_map(lambda spec: self._execute(spec, background), specs, self.jobs)
 
     def _execute(self, spec: RunSpec, background: bool = False) -> runner.RunOutcome:
