@@ -34,7 +34,7 @@ from ..results import (
     positions,
 )
 from ..units import axis_label, display_unit
-from ..verdict import truncation
+from ..verdict import truncation, unjudged_seeds
 
 FORMATS = ("table", "csv", "json")
 """Formats of ``whirl summary --format``."""
@@ -333,7 +333,8 @@ def tables(result: StudyResult, dofs: Sequence[str] | None = None) -> list[Table
             f"{len(rows)} special point{'s' if len(rows) != 1 else ''}", names,
             tuple(name not in ("branch", "type", *LAST_COLUMNS[1:]) for name in names),
             tuple(cells), tuple(f"note: {truncation(b)}" for b in continuation.branches
-                                if b.truncated)))
+                                if b.truncated)
+            + tuple(f"note: {n}" for n in (unjudged_seeds(continuation),) if n)))
     return drawn
 
 
