@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..analysis.boundaries import range_warnings
 from ..results import (
     Branch,
     ContinuationResult,
@@ -334,7 +335,9 @@ def tables(result: StudyResult, dofs: Sequence[str] | None = None) -> list[Table
             tuple(name not in ("branch", "type", *LAST_COLUMNS[1:]) for name in names),
             tuple(cells), tuple(f"note: {truncation(b)}" for b in continuation.branches
                                 if b.truncated)
-            + tuple(f"note: {n}" for n in (unjudged_seeds(continuation),) if n)))
+            + tuple(f"note: {n}" for n in (unjudged_seeds(continuation),) if n)
+            + tuple(f"warning: {w}" for b in result.boundaries if b.name == continuation.name
+                    for w in range_warnings(b))))
     return drawn
 
 
