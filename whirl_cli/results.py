@@ -408,6 +408,7 @@ class Boundary:
     ``loci``: name -> (kind, curve (K, 2) in (first, second)); kinds hopf, branch_point, fold,
     fold_of_cycles. ``polygons``: closed (K, 2) outlines of the unsafe region. ``intervals``:
     the unsafe intervals per slice (``method`` "loci" or "slices" says how they were found).
+    ``first_range``, ``second_range``: the parameters' ranges (NaN in older files).
     """
 
     name: str
@@ -418,6 +419,8 @@ class Boundary:
     intervals: tuple[UnsafeInterval, ...]
     polygons: tuple[np.ndarray, ...]
     slices: tuple[float, ...]
+    first_range: tuple[float, float] = (np.nan, np.nan)
+    second_range: tuple[float, float] = (np.nan, np.nan)
 
     __repr__ = _brief_repr
 

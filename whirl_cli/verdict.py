@@ -11,7 +11,10 @@ A study has *problems* (``whirl run`` exits 1, a sweep counts it failed) when
 * a time-simulation cross-check failed;
 * a study simulation's integration failed (status -1; one stopped at the divergence bound,
   status 1, is a result, not a failure);
-* its plots could not be drawn.
+* its plots could not be drawn;
+* a continuation's seeds found nothing and some of them could not be judged (their motion
+  did not settle: ``unsettled``); where others led to a limit cycle, the summary's note on
+  the unjudged seeds says the cycles found may not be all.
 
 Either way the results are stored, with each branch's and run's status and message.
 """
@@ -20,7 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .results import OTHER_END, STEP_LIMIT, Branch, StudyResult
+from .results import OTHER_END, STEP_LIMIT, Branch, ContinuationResult, StudyResult
 
 
 @dataclass(frozen=True)
@@ -53,6 +56,25 @@ def truncation(branch: Branch) -> str:
             "end of its range")
 
 
+def unjudged_seeds(continuation: ContinuationResult) -> str:
+    """What a continuation's unsettled seeds leave open ("" if none): how many, why the
+    first could not be judged, and whether any other seed led to a limit cycle."""
+    unsettled = [s for s in continuation.seeds if s.kind == "unsettled"]
+    if not unsettled:
+        return ""
+    found = any(s.kind == "periodic" for s in continuation.seeds)
+    return (f"{continuation.name}: {len(unsettled)} of {len(continuation.seeds)} seeds could "
+            f"not be judged (seed {unsettled[0].index}: {unsettled[0].message}); "
+            + ("the limit cycles found from the others may not be all" if found else
+               "no other seed led to a limit cycle, so none was looked for"))
+
+
+def seeds_found_nothing(continuation: ContinuationResult) -> bool:
+    """True if some seeds could not be judged and none led to a limit cycle."""
+    return any(s.kind == "unsettled" for s in continuation.seeds) and not any(
+        s.kind == "periodic" for s in continuation.seeds)
+
+
 def verdict(result: StudyResult, plot_error: str = "") -> Verdict:
     """The problems and notes of ``result`` (see the module doc); ``plot_error``: why its
     plots could not be drawn, if so (a problem too)."""
@@ -68,5 +90,6 @@ def verdict(result: StudyResult, plot_error: str = "") -> Verdict:
                  for c in result.continuations for x in c.cross_checks if not x.passed]
     problems += [f"simulation {s.name} failed: {s.message}" for s in result.simulations
                  if s.status < 0]
+    problems += [unjudged_seeds(c) for c in result.continuations if seeds_found_nothing(c)]
     problems += [plot_error] if plot_error else []
     return Verdict(tuple(problems), notes)

@@ -8,17 +8,19 @@ slope K_out; at K_in = 0 the origin is inside the gap)."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.optimize import fsolve
+from scipy.optimize import brentq, fsolve
 
 from whirl_cli.analysis import linear
 from whirl_cli.models import get_model
 from whirl_cli.pipeline import run_study
 from whirl_cli.results import PointType
-from whirl_cli.study import validate_text
+from whirl_cli.study import load_study, validate_text
 
+from ..gimballed_exact import freeplay_simulation, matrices, maxima
 from .test_freeplay import offset_equilibria_at_zero
 
 pytestmark = pytest.mark.auto
@@ -115,3 +117,65 @@ def test_freeplay_on_a_gimbal_dof_runs_on_auto_and_its_hopf_point_is_the_jacobia
     np.testing.assert_allclose(2 * np.pi / abs(crossing.imag), hopf.period, rtol=1e-4)
     print(f"gimbal beta_y freeplay: Hopf at K_in = {value:.6f} N m/rad (AUTO), the Jacobian's "
           f"pair {crossing:.3g} there, period {hopf.period:.6f} s")
+
+
+# ------------------------------------------------------------ the shipped pitch freeplay study
+SHIPPED = Path(__file__).resolve().parents[2] / "studies" / "gimballed" / \
+    "freeplay_pitch_airspeed.yaml"
+
+
+def onset_at_k_out() -> float:
+    """The flutter speed of the linear gimballed model with K_theta = K_out, from the
+    eigenvalues of tests/gimballed_exact.py's matrices (bisection of the growth rate)."""
+    def growth(speed: float) -> float:
+        mass, damping, stiffness = matrices({"K_theta": K_OUT, "K_psi": 0.3, "V": speed})
+        minv = np.linalg.inv(mass)
+        system = np.block([[np.zeros((4, 4)), np.eye(4)], [-minv @ stiffness, -minv @ damping]])
+        return float(np.linalg.eigvals(system).real.max())
+
+    return float(brentq(growth, 6.0, 9.0, xtol=1e-10))
+
+
+def test_the_shipped_gimballed_pitch_freeplay_study_against_the_exact_law(tmp_path):
+    """studies/gimballed/freeplay_pitch_airspeed.yaml: its seeds at 4 and 8 delta settle on one
+    cycle, continued in airspeed; at 6.7 m/s the family's stable orbit is the one an exact-law
+    simulation from the 4-delta seed settles on (theta max to 2e-3, period to 1e-3); stable
+    cycles reach below the linear onset at K_out, which whirl stores as the eigenvalues of the
+    independent matrices give it; at 6.5 m/s, below the family's lowest fold, the exact law
+    from the same seed finds no cycle (the motion leaves the 4-delta seed and decays)."""
+    study = load_study(SHIPPED)
+    result = run_study(study, tmp_path, jobs=2)
+    (continuation,) = result.continuations
+    assert [s.kind for s in continuation.seeds] == ["equilibrium", "periodic", "periodic"]
+    family = next(b for b in continuation.branches if b.name == "periodic_o1")
+    at = np.flatnonzero(family.stable & family.stability_known
+                        & (np.abs(family.parameters[:, 0] - 6.7) < 2e-3))
+    assert at.size
+    row = at[np.argmin(np.abs(family.parameters[at, 0] - 6.7))]
+    speed = float(family.parameters[row, 0])
+
+    seed = np.zeros(8)
+    seed[0] = 4 * DELTA
+    t, y = freeplay_simulation({"K_psi": 0.3, "K_beta": 10.0, "V": speed}, "theta", DELTA,
+                               K_OUT, seed, 80.0)
+    times, peaks = maxima(t, y[:, 0])
+    late = times > 70.0
+    assert np.ptp(peaks[late]) < 1e-4 * peaks[late].max()  # settled
+    assert abs(peaks[late].max() / family.state_max[row, 0] - 1) < 2e-3
+    assert abs(np.diff(times[late]).mean() / family.period[row] - 1) < 1e-3
+
+    onset = onset_at_k_out()
+    (amplitudes,) = continuation.freeplay
+    np.testing.assert_allclose(amplitudes.onset, [onset], rtol=1e-6)
+    stable_speeds = family.parameters[family.stable & family.stability_known, 0]
+    assert stable_speeds.min() < 6.6 and stable_speeds.max() < onset
+    lowest = min(p.parameters[0] for p in continuation.special_points if p.type_name == "LPC")
+    assert 6.5 < lowest < 6.6
+
+    t, y = freeplay_simulation({"K_psi": 0.3, "K_beta": 10.0, "V": 6.5}, "theta", DELTA,
+                               K_OUT, seed, 40.0)
+    assert np.ptp(y[t > 30.0, 0]) < 0.1 * DELTA  # no cycle below the fold
+    print(f"\ngimballed pitch freeplay: cycle at {speed:.5f} m/s, theta max "
+          f"{family.state_max[row, 0] / DELTA:.5f} delta (AUTO), "
+          f"{peaks[late].max() / DELTA:.5f} (exact law); lowest fold {lowest:.5f} m/s, "
+          f"linear onset at K_out {onset:.5f} m/s")

@@ -1,16 +1,28 @@
-"""Limit cycles not born at a Hopf point, found from simulation (issue 15, item 3).
+"""Limit cycles not born at a Hopf point, found from simulation.
 
 A seed is an initial state. :func:`settle` simulates it (LSODA on the model's smoothed
-right-hand side) until the motion has settled, and says what it settled on:
+right-hand side) in chunks of :data:`CHUNK_PERIODS` reference periods and judges, after each,
+what the motion does on its return map: the points where the dof that moves most (in typical
+amplitudes) crosses the mean of its recent motion upwards, located on a cubic through the
+samples (:func:`whirl_cli.analysis.motion.poincare_section`), every dof (and first-order
+state) there in units of its size in the recent motion (at least 1e-2 of the largest, in
+typical amplitudes: a dof that hardly moves is not judged on its round-off).
 
-* "periodic": successive upward crossings of a Poincare section (the first dof through the
-  mean of its recent motion) repeat, in state and in time, to ``tolerance`` of the motion's
-  size; the orbit is the last period, for AUTO to start from (see
+* "periodic": for the smallest lag k <= 8 (a cycle that crosses the section k times a
+  period) the returns k apart, and the times between them, agree to ``tolerance`` over the
+  last half of the chunk (:func:`judge`); the orbit is the motion over the last k returns,
+  for AUTO to start from (see
   :func:`whirl_cli.continuation.periodic.orbit_families`);
 * "equilibrium": every dof has stopped moving (peak to peak below ``tolerance`` of the seed);
 * "diverged": a dof has left ``limit`` typical amplitudes;
-* "unsettled": none of these within ``max_periods`` periods of the slowest oscillatory
-  linear mode (:func:`reference_period`).
+* "unsettled": none of these. The return map's distances are followed as the motion goes on:
+  while they shrink steadily (a cycle approached) the simulation goes on past ``max_periods``
+  periods of the slowest oscillatory linear mode (:func:`reference_period`), up to
+  :data:`OVERRUN` times that, as long as their rate says the tolerance is reached within it;
+  the message says what the map did (shrinking at a rate too slow, or not converging).
+
+Rates are not judged: the fast content of a stiff mode (a gimbal's) makes their values at the
+section noisier than the motion's repetition, while the dofs at the section fix the orbit.
 
 :func:`auto_seeds` makes the seeds of ``seeds: auto``; :func:`distinct` keeps one of the seeds
 that settle on the same orbit. Time in s, states in SI units.
@@ -25,13 +37,16 @@ import numpy as np
 from ..models import Model
 from ..results import Orbit
 from ..units import display_unit
+from .motion import poincare_section, section_geometry
 from .simulate import integrate
 
 #: Samples per reference period in the simulation (and the rows of a settled orbit + 1).
 SAMPLES_PER_PERIOD = 200
 ORBIT_ROWS = 801
-#: Simulated in chunks of this many reference periods, at most ``max_periods`` in all.
+#: Simulated in chunks of this many reference periods, ``max_periods`` in all unless the
+#: return map converges (then up to OVERRUN times as many).
 CHUNK_PERIODS = 50
+OVERRUN = 4
 
 
 @dataclass(frozen=True)
@@ -65,11 +80,11 @@ def settle(model: Model, params: np.ndarray, seed: np.ndarray, max_periods: int 
     in typical amplitudes of each dof (and first-order state)."""
     seed = np.asarray(seed, dtype=float)
     period = reference_period(model, params)
-    k = model.n_dof
-    dofs = list(range(k)) + list(range(2 * k, model.n_states))  # and first-order states
+    dofs = list(model.positions)
     amplitudes = np.array(model.typical_amplitudes, dtype=float)[dofs]
-    state, elapsed = seed.copy(), 0.0
-    while elapsed < max_periods * period:
+    state, elapsed, budget = seed.copy(), 0.0, max_periods * period
+    judged = Judged(0, np.nan, np.nan, 0.0)
+    while elapsed < budget:
         t, y = integrate(model, params, state, CHUNK_PERIODS * period,
                          samples=CHUNK_PERIODS * SAMPLES_PER_PERIOD + 1)
         elapsed += t[-1]
@@ -82,38 +97,93 @@ def settle(model: Model, params: np.ndarray, seed: np.ndarray, max_periods: int 
         if size.max() < tolerance * max(np.abs(seed[dofs] / amplitudes).max(), 1e-12):
             return Settled("equilibrium", seed, state, None,
                            f"at rest after {elapsed:.3g} s")
-        orbit, message = _repeating_orbit(t, y, tolerance)
-        if orbit is not None:
-            return Settled("periodic", seed, state, orbit, f"{message} after {elapsed:.3g} s")
-    return Settled("unsettled", seed, state, None,
-                   f"no repeating motion within {max_periods} periods ({elapsed:.3g} s)")
+        times, points = returns(t, y, dofs, amplitudes)
+        judged = judge(times, points, tolerance)
+        if judged.lag:
+            orbit = _orbit(t, y, times[-1 - judged.lag], times[-1])
+            crossings = f", {judged.lag} returns a period" if judged.lag > 1 else ""
+            return Settled("periodic", seed, state, orbit,
+                           f"period {orbit.period:.6g} s{crossings}, returns repeat to "
+                           f"{judged.distance:.1e} of the motion's size after {elapsed:.3g} s")
+        if elapsed >= budget and elapsed + judged.needed(tolerance) <= \
+                OVERRUN * max_periods * period:
+            budget = elapsed + judged.needed(tolerance)
+    return Settled("unsettled", seed, state, None, judged.why(tolerance, elapsed, period))
 
 
-def _repeating_orbit(t: np.ndarray, y: np.ndarray, tolerance: float
-                     ) -> tuple[Orbit | None, str]:
-    """The last period of ``y`` if its last three returns to the Poincare section (the first
-    state through its recent mean, upwards) repeat to ``tolerance``: in every state relative
-    to that state's size, and in the return times."""
-    x = y[:, 0] - y[len(y) // 2:, 0].mean()
-    up = np.flatnonzero((x[:-1] < 0) & (x[1:] >= 0))
-    if len(up) < 4:
-        return None, ""
-    share = -x[up] / (x[up + 1] - x[up])
-    times = t[up] + share * (t[up + 1] - t[up])
-    returns = y[up] + share[:, None] * (y[up + 1] - y[up])
-    size = np.maximum(np.ptp(y[len(y) // 2:], axis=0), 1e-300)
-    mismatch = (np.abs(np.diff(returns[-3:], axis=0)) / size).max()
-    periods = np.diff(times[-3:])
-    drift = abs(periods[1] / periods[0] - 1)
-    if mismatch > tolerance or drift > tolerance:
-        return None, ""
-    begin, end = times[-2], times[-1]
+@dataclass(frozen=True)
+class Judged:
+    """What a return map did (:func:`judge`): ``lag`` the returns a period of the cycle it
+    repeats (0: none), ``distance`` the largest distance between returns that far apart over
+    the last half of them (lag 1 where none repeats; units of the dofs' sizes), ``rate`` the
+    factor by which those distances shrink per return where they shrink steadily (NaN where
+    they do not) and ``step`` the mean time between returns (s)."""
+
+    lag: int
+    distance: float
+    rate: float
+    step: float
+
+    def needed(self, tolerance: float) -> float:
+        """Seconds more until the distances reach ``tolerance`` at their rate (inf if they
+        do not shrink steadily)."""
+        if not 0 < self.rate < 1 or not self.distance > 0:
+            return np.inf
+        return max(np.log(tolerance / self.distance) / np.log(self.rate), 1.0) * self.step
+
+    def why(self, tolerance: float, elapsed: float, period: float) -> str:
+        """Why the motion counts as unsettled after ``elapsed`` s."""
+        spent = f"within {elapsed / period:.0f} periods ({elapsed:.3g} s)"
+        if not np.isfinite(self.distance):
+            return f"no repeating motion {spent}: too few returns to its section"
+        if np.isfinite(self.needed(tolerance)):
+            return (f"no repeating motion {spent}: its returns converge too slowly (their "
+                    f"distance {self.distance:.1e} of the motion's size shrinks by "
+                    f"{self.rate:.4g} a return; about {self.needed(tolerance):.3g} s more)")
+        return (f"no repeating motion {spent}: its returns stay {self.distance:.1e} of the "
+                "motion's size apart and do not converge")
+
+
+def returns(t: np.ndarray, y: np.ndarray, dofs: list[int], amplitudes: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """(times (m,), points (m, len(dofs))): the return map of a simulation, where the dof that
+    moves most in typical ``amplitudes`` crosses the mean of the last half of its motion
+    upwards, the ``dofs`` there in units of their size over that half (at least 1e-2 of the
+    largest, in typical amplitudes)."""
+    late = y[len(y) // 2:, dofs]
+    size = np.ptp(late, axis=0) / amplitudes
+    index = dofs[int(np.argmax(size))]
+    times, points = poincare_section(t, y, index, late[:, dofs.index(index)].mean())
+    scale = np.maximum(size, 1e-2 * size.max()) * amplitudes
+    return times, points[:, dofs] / np.maximum(scale, 1e-300)
+
+
+def judge(times: np.ndarray, points: np.ndarray, tolerance: float) -> Judged:
+    """The return map ``points`` (at ``times``; :func:`returns`) judged: a cycle repeats with
+    lag k where :func:`whirl_cli.analysis.motion.section_geometry` finds its points repeating
+    to ``tolerance`` over the last half of them, and the times between returns k apart agree
+    to ``tolerance`` too; otherwise the steady rate at which its lag distances shrink."""
+    if len(points) < 4:
+        return Judged(0, np.nan, np.nan, 0.0)
+    lag, _, distance, converging, rate = section_geometry(points, np.ones(points.shape[1]),
+                                                          tolerance)
+    step = float(np.mean(np.diff(times)))
+    if lag:
+        spans = (times[lag:] - times[:-lag])[(len(times) - lag) // 2:]
+        if np.ptp(spans) <= tolerance * spans.mean():
+            return Judged(lag, float(distance), np.nan, step)
+    if converging:
+        lags = np.max(np.abs(points[converging:] - points[:-converging]), axis=1)
+        return Judged(0, float(lags[-1]), rate, step)
+    return Judged(0, float(distance), np.nan, step)
+
+
+def _orbit(t: np.ndarray, y: np.ndarray, begin: float, end: float) -> Orbit:
+    """The simulated motion from ``begin`` to ``end`` (s) on :data:`ORBIT_ROWS` rows."""
     grid = np.linspace(begin, end, ORBIT_ROWS)
     states = np.column_stack([np.interp(grid, t, y[:, k]) for k in range(y.shape[1])])
-    orbit = Orbit(label=0, point_type=0, index=0, parameters=np.empty(0), period=float(end - begin),
-                  time=grid - begin, states=states)
-    return orbit, (f"period {end - begin:.6g} s, returns repeat to {mismatch:.1e} of the "
-                   f"motion's size")
+    return Orbit(label=0, point_type=0, index=0, parameters=np.empty(0),
+                 period=float(end - begin), time=grid - begin, states=states)
 
 
 def auto_seeds(model: Model, values: dict[str, float]) -> list[np.ndarray]:

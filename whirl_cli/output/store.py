@@ -51,7 +51,8 @@ Layout (units in a ``units`` attribute on every physical dataset)::
                                     (the study gave the range in multiples of the datum)
     /linear/grid/                   x, y, max_real (Ny, Nx) [1/s], oscillatory (Ny, Nx),
                                     flutter/line_<k>, divergence/line_<k> (K, 2): zero contour
-    /boundaries/<name>/             attrs: parameters, units, method (loci | slices), slices
+    /boundaries/<name>/             attrs: parameters, units, method (loci | slices), slices,
+                                    first_range, second_range (absent in older files)
         loci/<branch>               (K, 2) locus curve in the two parameters; attrs kind
         unsafe/polygon_<k>          (K, 2) closed outline of the unsafe region
         unsafe_intervals/           slice_value, lower, upper, cause (flutter | divergence)
@@ -250,6 +251,8 @@ BOUNDARY = (
     Field("parameter_names", "attribute", "text", key="parameters"),
     Field("parameter_units", "attribute", "text", key="units"),
     Field("method", "attribute", "text"), Field("slices", "attribute", "float"),
+    Field("first_range", "attribute", "float", default=(np.nan, np.nan)),
+    Field("second_range", "attribute", "float", default=(np.nan, np.nan)),
 )
 #: The :class:`UnsafeInterval` table of a boundary (``unsafe_intervals/``).
 UNSAFE_INTERVAL = (

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..analysis.boundaries import range_warnings
 from ..results import (
     Branch,
     ContinuationResult,
@@ -34,7 +35,7 @@ from ..results import (
     positions,
 )
 from ..units import axis_label, display_unit
-from ..verdict import truncation
+from ..verdict import truncation, unjudged_seeds
 
 FORMATS = ("table", "csv", "json")
 """Formats of ``whirl summary --format``."""
@@ -333,7 +334,10 @@ def tables(result: StudyResult, dofs: Sequence[str] | None = None) -> list[Table
             f"{len(rows)} special point{'s' if len(rows) != 1 else ''}", names,
             tuple(name not in ("branch", "type", *LAST_COLUMNS[1:]) for name in names),
             tuple(cells), tuple(f"note: {truncation(b)}" for b in continuation.branches
-                                if b.truncated)))
+                                if b.truncated)
+            + tuple(f"note: {n}" for n in (unjudged_seeds(continuation),) if n)
+            + tuple(f"warning: {w}" for b in result.boundaries if b.name == continuation.name
+                    for w in range_warnings(b))))
     return drawn
 
 
