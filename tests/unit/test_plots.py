@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -169,14 +170,23 @@ def test_curves_of_one_stability_are_the_segment_itself():
     assert stability_curves(np.array([]), np.array([]), np.array([], bool)) == []
 
 
-def test_flickering_stability_draws_two_lines():
-    """A neutral family (the equilibria of a linear model at its branch point: a zero
-    eigenvalue at every point) whose stability flips at every point is drawn as two lines,
-    one per style, holding every point, not as one line per run (hundreds)."""
+def test_a_neutral_line_of_equilibria_is_one_neutral_line():
+    """A line of equilibria at one parameter value (a linear model at its branch point: a
+    zero eigenvalue at every point), whose stability flag flips from point to point, is drawn
+    as one line in the neutral style, holding every point, with its legend entry; a branch
+    whose stability flips while its parameter moves is drawn as two lines, one per style."""
     n = 301
     flicker = make_branch("secondary_1a", BranchKind.EQUILIBRIUM, np.full(n, 0.039),
                           np.linspace(-1.5, 1.5, n), np.arange(n) % 2 == 0)
     ax = bifurcation_diagram(ContinuationResult("k1", "one-parameter", (flicker,), ())).axes[0]
+    (line,) = branch_lines(ax)
+    assert line_style(line) == ("grey", "-.")
+    np.testing.assert_allclose(line.get_ydata(), np.degrees(np.linspace(-1.5, 1.5, n)))
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == [
+        "neutral equilibria (zero eigenvalue)"]
+    moving = make_branch("secondary_1a", BranchKind.EQUILIBRIUM, np.linspace(0.03, 0.04, n),
+                         np.linspace(-1.5, 1.5, n), np.arange(n) % 2 == 0)
+    ax = bifurcation_diagram(ContinuationResult("k1", "one-parameter", (moving,), ())).axes[0]
     lines = branch_lines(ax)
     assert sorted(line_style(line) for line in lines) == [("green", "-"), ("magenta", "--")]
     drawn = np.concatenate([line.get_ydata() for line in lines])
@@ -1001,3 +1011,37 @@ def test_boundary_plot_torus_locus_carries_the_thesis_torus_mark():
     assert line_style(line) == ("green", ":")
     assert line.get_marker() == "o" and line.get_markerfacecolor() == "none"
     assert legend_labels(ax) == ["Hopf locus (flutter)", "torus locus (TR)", "unsafe (overhang)"]
+
+
+def test_the_overhang_is_shaded_from_the_subcritical_hopf_point_to_the_outermost_fold():
+    """Hardening case 2 (the committed reference): the family ending on the subcritical Hopf
+    point at K_theta = 0.0807 folds three times below it, where the origin is stable; the
+    band runs to the fold farthest from it (0.0586), its edges the stored values (read here
+    with h5py), its width written on top."""
+    import h5py
+    from matplotlib.patches import Rectangle
+
+    from whirl_cli.output import store
+    from whirl_cli.plots.diagrams import overhangs
+
+    path = Path(__file__).resolve().parents[1] / "regression" / "references" / "hardening_case2.h5"
+    with h5py.File(path) as handle:
+        points = handle["continuations/k1/special_points"]
+        kinds = [t.decode() for t in points["type_name"][()]]
+        values = points["parameters"][:, 0]
+        criticality = [c.decode() for c in points["criticality"][()]]
+        branches = [b.decode() for b in points["branch"][()]]
+    hopf = next(v for k, v, c in zip(kinds, values, criticality, strict=True)
+                if k == "HB" and c == "subcritical")
+    folds = [v for k, v, b in zip(kinds, values, branches, strict=True)
+             if k == "LPC" and b == "periodic_1"]
+    outermost = max(folds, key=lambda v: abs(v - hopf))
+    continuation = store.read(path).continuations[0]
+    assert overhangs(continuation) == [(outermost, hopf)]
+    ax = bifurcation_diagram(continuation).axes[0]
+    (band,) = [p for p in ax.patches if isinstance(p, Rectangle) and p.get_alpha() == 0.25]
+    np.testing.assert_allclose([band.get_x(), band.get_x() + band.get_width()],
+                               [outermost, hopf], rtol=1e-12)
+    assert f"{hopf - outermost:.3g} N m/rad" in [t.get_text() for t in ax.texts]
+    assert "unsafe (overhang)" in [
+        t.get_text() for t in ax.get_legend().get_texts()]

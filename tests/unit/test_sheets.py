@@ -140,7 +140,7 @@ def test_every_panel_kind_draws_or_names_what_is_missing(continuation):  # noqa:
         except WhirlError as error:
             drawn[kind] = str(error)
     (bifurcation,) = drawn["bifurcation"]
-    assert bifurcation.get_title() == "study"  # no stored study text: the name alone
+    assert bifurcation.get_title() == ""  # no stored study text, nothing fixed: no title
     assert len(branch_lines(bifurcation)) >= 2
     freq, damp = drawn["linear"]  # the linear kind splits its panel in two
     assert freq.get_ylabel() == "frequency [rad/s]"

@@ -32,19 +32,25 @@ class Captions:
     """The study's name, the parameters it overrides (in the order written), per
     two-parameter continuation one label per slice (empty: none given), and the datum of
     every parameter of its model (canonical names, SI; empty if the study does not
-    validate): what a file without a parameter set (schema 1) divides sweeps by."""
+    validate): what a file without a parameter set (schema 1) divides sweeps by. ``named``:
+    titles start with the study's name (a study's own plot files; a figure of several
+    panels names what it shows in its caption instead)."""
 
     study: str
     fixed: tuple[Fixed, ...] = ()
     slice_labels: dict[str, tuple[str, ...]] = field(default_factory=dict)
     datums: dict[str, float] = field(default_factory=dict)
+    named: bool = True
 
     def title(self, varied: Iterable[str] = ()) -> str:
         """``"<study>: <name> = <value> <unit>, ..."`` over the fixed parameters that are
-        not ``varied`` in the figure (just the study's name if none is left)."""
+        not ``varied`` in the figure (just the study's name if none is left); without the
+        study's name (and "" if none is left) unless ``named``."""
         varied = set(varied)
-        shown = [str(f) for f in self.fixed if f.name not in varied]
-        return f"{self.study}: {', '.join(shown)}" if shown else self.study
+        shown = ", ".join(str(f) for f in self.fixed if f.name not in varied)
+        if not self.named:
+            return shown
+        return f"{self.study}: {shown}" if shown else self.study
 
     def simulation_title(self, simulation: Simulation) -> str:
         """``"<study>: <fixed>, <the simulation's overrides>\n<simulation name>"``: the
@@ -54,7 +60,8 @@ class Captions:
             simulation.parameter_names, simulation.parameter_values,
             simulation.parameter_units, strict=True)]
         base = self.title(simulation.parameter_names)
-        shown = base + (": " if base == self.study else ", ") + ", ".join(own) if own else base
+        joint = ": " if base == self.study else ", " if base else ""
+        shown = base + joint + ", ".join(own) if own else base
         law = " (exact law)" if simulation.law == "exact" else ""
         return f"{shown}\n{simulation.name}{law}"
 

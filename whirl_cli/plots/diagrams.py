@@ -14,6 +14,7 @@ from ..results import Branch, ContinuationResult, PointType
 from .key import (
     _BLACK,
     _PLOTTED_KINDS,
+    BOUNDARY_KEY,
     MARKER_STYLE,
     PLOT_KEY,
     _colours,
@@ -22,6 +23,7 @@ from .key import (
     axis_label,
     branch_style,
     display_unit,
+    is_neutral_line,
     stability_curves,
 )
 
@@ -50,17 +52,84 @@ def bifurcation_diagram(continuation: ContinuationResult, state: str | None = No
     and stability. Special points get markers at (principal parameter, ``state`` value). Angle
     states are shown in degrees (rad -> deg, rad/s -> deg/s) unless ``degrees`` is False; the
     parameter keeps its SI unit. Draws on ``ax`` if given, else on a new figure; returns the
-    figure. The legend lists only styles present; the title is ``title`` (None: the
-    continuation's name).
+    figure. The overhang of each subcritical Hopf point (:func:`overhangs`) is shaded and
+    its width written at its top. The legend lists only styles present; the title is
+    ``title`` (None: the continuation's name).
     """
     which, branches, state = _checked_branches(continuation, state, which)
     if ax is None:
         ax = _new_figure().add_subplot()
     handles, labels = _draw_bifurcation(ax, continuation, branches, state, which, degrees)
+    bands = overhangs(continuation)
+    if bands:
+        unit = branches[0].parameter_units[0] if branches else ""
+        handles.append(_shade_overhangs(ax, bands, unit))
+        labels.append(OVERHANG_LABEL)
     if handles:
         ax.legend(handles, labels, fontsize="small")
     ax.set_title(continuation.name if title is None else title)
     return ax.figure
+
+
+#: The legend entry of a shaded overhang, and its shade (the unsafe region's colour, lighter:
+#: the curves stay legible on it).
+OVERHANG_LABEL = "unsafe (overhang)"
+OVERHANG_ALPHA = 0.25
+
+
+def overhangs(continuation: ContinuationResult) -> list[tuple[float, float]]:
+    """The overhangs of ``continuation``: for each subcritical Hopf point, the parameter
+    interval from it, towards the side where its equilibrium branch is stable, to the
+    farthest fold of cycles (LPC) on that side of a periodic family born at or ending on it
+    (its first or last row there, to 1e-3 of the parameter's span over the continuation: a
+    family that returns to a Hopf point stops just short of it): where stable equilibria and
+    limit cycles coexist beyond the linear onset. Each interval once (a mirror family gives
+    the same), sorted."""
+    values = [b.parameters[:, 0] for b in continuation.branches if len(b)]
+    span = float(np.ptp(np.concatenate(values))) if values else 0.0
+    by_name = {b.name: b for b in continuation.branches}
+    bands = set()
+    for hopf in continuation.special_points:
+        if hopf.point_type != PointType.HB or hopf.criticality != "subcritical":
+            continue
+        at = float(hopf.parameters[0])
+        side = _stable_side(by_name.get(hopf.branch), hopf.index, at)
+        folds = [float(p.parameters[0]) for family in continuation.branches
+                 if family.is_periodic and len(family) and any(
+                     abs(float(family.parameters[row, 0]) - at) <= 1e-3 * span
+                     for row in (0, -1))
+                 for p in continuation.special_points
+                 if p.branch == family.name and p.point_type == PointType.LPC
+                 and (float(p.parameters[0]) - at) * side > 0]
+        if side and folds:
+            far = max(folds, key=lambda value: abs(value - at))
+            bands.add((min(at, far), max(at, far)))
+    return sorted(bands)
+
+
+def _stable_side(branch: Branch | None, index: int, at: float) -> float:
+    """+1 or -1: the side of the parameter value ``at`` (row ``index`` of the equilibrium
+    ``branch``) on which the branch is stable, by its rows two steps either way; 0 if
+    neither or both."""
+    if branch is None or not 0 <= index < len(branch):
+        return 0.0
+    sides = [np.sign(float(branch.parameters[row, 0]) - at) for row in (index - 2, index + 2)
+             if 0 <= row < len(branch) and branch.stable[row]]
+    return float(sides[0]) if len(sides) == 1 else 0.0
+
+
+def _shade_overhangs(ax: Axes, bands: list[tuple[float, float]], unit: str):
+    """Each band shaded across the axes, its width written at its top; the legend handle."""
+    from matplotlib.patches import Patch
+
+    style = BOUNDARY_KEY["unsafe"]
+    for low, high in bands:
+        ax.axvspan(low, high, color=style["color"], alpha=OVERHANG_ALPHA, linewidth=0,
+                   zorder=0)
+        ax.annotate(f"{high - low:.3g} {unit}".strip(), xy=((low + high) / 2, 1.0),
+                    xycoords=("data", "axes fraction"), xytext=(0, -3),
+                    textcoords="offset points", ha="center", va="top", fontsize="small")
+    return Patch(color=style["color"], alpha=OVERHANG_ALPHA, linewidth=0)
 
 
 def _checked_branches(continuation: ContinuationResult, state: str | None,
@@ -298,6 +367,9 @@ def _draw_branch(ax: Axes, branch: Branch, state: str, which: tuple[str, ...], d
     tables = [w for w in ("max", "min") if w in which] if branch.is_periodic else [which[0]]
     for table in tables:
         y = branch.state(state, table) * factor
+        if not branch.is_periodic and is_neutral_line(x, branch.stable):
+            _plot_styled(ax, x, y, "neutral_equilibrium", first)
+            continue
         for xs, ys, stable in stability_curves(x, y, branch.stable,
                                                  branch.stability_known):
             _plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)

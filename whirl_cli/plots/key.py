@@ -30,6 +30,10 @@ PLOT_KEY: dict[str, dict[str, object]] = {
     "stable_equilibrium": {"color": "green", "linestyle": "-", "label": "stable equilibrium"},
     "unstable_equilibrium": {"color": "magenta", "linestyle": "--",
                              "label": "unstable equilibrium"},
+    # a line of equilibria at one parameter value (a linear model at its branch point): each
+    # has a zero eigenvalue, so AUTO's stability flag flickers along it
+    "neutral_equilibrium": {"color": "grey", "linestyle": "-.",
+                            "label": "neutral equilibria (zero eigenvalue)"},
     "stable_periodic": {"color": "blue", "linestyle": "-", "label": "stable periodic"},
     "unstable_periodic": {"color": "red", "linestyle": ":", "label": "unstable periodic"},
     # special points
@@ -98,6 +102,16 @@ def branch_style(kind: str, stable: bool) -> str:
     """Key of :data:`PLOT_KEY` for a branch piece of ``kind`` (a :class:`BranchKind`)."""
     family = "periodic" if kind == BranchKind.PERIODIC else "equilibrium"
     return f"{'stable' if stable else 'unstable'}_{family}"
+
+
+def is_neutral_line(x: np.ndarray, stable: np.ndarray) -> bool:
+    """True for a line of equilibria at one parameter value (``x`` constant to 1e-9 of its
+    size) whose stability flag takes both values: equilibria with a zero eigenvalue, neutral,
+    drawn as one line (not as flickering stable and unstable runs)."""
+    x = np.asarray(x, dtype=float)
+    stable = np.asarray(stable, dtype=bool)
+    return bool(len(x) > 1 and np.ptp(x) <= 1e-9 * max(1.0, float(np.abs(x).max()))
+                and stable.any() and not stable.all())
 
 
 def stability_segments(x: np.ndarray, y: np.ndarray, stable: np.ndarray,

@@ -11,7 +11,7 @@ from a result (which continuation, branch, sweep, slice) is said by :class:`Pane
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -65,13 +65,14 @@ def draw(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice = PanelCh
          ) -> list[Axes]:
     """Draw ``result``'s figure of ``kind`` (:data:`PANEL_KINDS`) onto ``ax``; return the
     axes drawn on (``linear``, ``projections``, ``damping_multiples`` and ``time_history``
-    replace ``ax`` by their own panels in its place). Titles name the study and its fixed
-    parameters unless ``choice.title`` is set. A result without what the kind needs is a
-    :class:`WhirlError` saying what is missing."""
+    replace ``ax`` by their own panels in its place). Titles name the study's fixed
+    parameters (not the study: a figure's caption says what it shows) unless
+    ``choice.title`` is set. A result without what the kind needs is a :class:`WhirlError`
+    saying what is missing."""
     panel = _PANELS.get(kind)
     if panel is None:
         raise WhirlError(f"unknown panel kind {kind!r}; choose from {', '.join(PANEL_KINDS)}")
-    return panel(result, ax, choice, captions(result))
+    return panel(result, ax, choice, replace(captions(result), named=False))
 
 
 def _continuation_title(continuation: ContinuationResult, choice: PanelChoice, caption
