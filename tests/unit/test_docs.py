@@ -7,8 +7,11 @@ import re
 from dataclasses import fields
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
+PAGES = sorted(DOCS.glob("*.md")) + [ROOT / "README.md"]
 
 
 def table_keys(text: str, heading: str) -> set[str]:
@@ -55,6 +58,53 @@ def test_study_doc_example_is_the_shipped_study():
     doc = (DOCS / "study-yaml.md").read_text()
     name, block = re.search(r"## Example\n\n`([^`]+)`:\n\n```yaml\n(.*?)```", doc, re.S).groups()
     assert block == (ROOT / name).read_text()
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+def test_links_lead_inside_the_repository(page):
+    text = page.read_text()
+    assert "../shared" not in text
+    for target in re.findall(r"\]\(([^)#]+)(?:#[^)]*)?\)", text):
+        if not target.startswith(("http://", "https://")):
+            assert (page.parent / target).exists(), f"{page.name}: {target}"
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+def test_paths_named_in_backquotes_exist(page):
+    """A repository path a page names (``studies/...yaml``, ``whirl_cli/...py``, ...) exists."""
+    prefixes = "whirl_cli/|studies/|tests/|sheets/|benchmarks/|examples/|docs/"
+    for path in re.findall(r"`((?:" + prefixes + r")[^`\s*<>{}]+)`", page.read_text()):
+        assert (ROOT / path.rstrip("/.,:")).exists(), f"{page.name}: {path}"
+
+
+
+def test_plots_doc_names_every_plot_kind():
+    from whirl_cli.plots.files import PLOT_KINDS
+
+    documented = table_keys((DOCS / "plots.md").read_text(), "## Plot kinds and their files")
+    assert documented >= set(PLOT_KINDS)
+
+
+def test_readme_first_study_is_the_shipped_study():
+    readme = (ROOT / "README.md").read_text()
+    section = readme[readme.index("## A first study"):]
+    name = re.search(r"`(studies/[^`]+\.yaml)`", section).group(1)
+    block = re.search(r"```yaml\n(.*?)```", section, re.S).group(1)
+    assert block == (ROOT / name).read_text()
+
+
+def test_readme_first_model_file_and_its_study_are_valid(tmp_path):
+    from whirl_cli.study import load_study
+
+    readme = (ROOT / "README.md").read_text()
+    section = readme[readme.index("## A first model file"):]
+    names = re.findall(r"`(\w+(?:\.model)?\.yaml)`", section)[:2]
+    blocks = re.findall(r"```yaml\n(.*?)```", section, re.S)[:2]
+    for name, block in zip(names, blocks, strict=True):
+        (tmp_path / name).write_text(block)
+    study = load_study(tmp_path / names[1])
+    assert study.variant().family.name == "oscillator"
+    assert [c.parameter for c in study.continuations] == ["mu"]
 
 
 # ------------------------------------------------------------------ docs/code-layout.md
