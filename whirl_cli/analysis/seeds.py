@@ -1,4 +1,4 @@
-"""Limit cycles not born at a Hopf point, found from simulation (issue 15, item 3).
+"""Limit cycles not born at a Hopf point, found from simulation.
 
 A seed is an initial state. :func:`settle` simulates it (LSODA on the model's smoothed
 right-hand side) until the motion has settled, and says what it settled on:
