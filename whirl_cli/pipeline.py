@@ -312,7 +312,7 @@ def seeded_orbits(model, overrides: dict[str, float], parameter: str, start: flo
                   jobs: int = 1) -> tuple[tuple[OrbitStart, ...], tuple[SeedOutcome, ...]]:
     """A continuation's seeds (``given``: ``auto`` or state mappings) simulated with
     ``parameter`` at ``start``, ``jobs`` at a time (forked processes): one orbit start per
-    distinct limit cycle they settle on, and what became of every seed (issue 15, item 3)."""
+    distinct limit cycle they settle on, and what became of every seed."""
     if not given:
         return (), ()
     values = {**overrides, parameter: float(start)}

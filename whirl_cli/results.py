@@ -466,7 +466,7 @@ class CrossCheck:
 @dataclass(frozen=True)
 class FreeplayAmplitudes:
     """A periodic branch in the units of a freeplay law on one of its dofs
-    (:mod:`whirl_cli.analysis.freeplay`, ``../shared/models.md`` section 7).
+    (:mod:`whirl_cli.analysis.freeplay`).
 
     ``amplitude_ratio`` (N,): A/delta per row of ``branch``, A the dof's half peak-to-peak
     value over the orbit and delta the law's half-gap at that row (both in the dof's unit).

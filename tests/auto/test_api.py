@@ -1,5 +1,6 @@
-"""The Python API: the README's example runs as written (real AUTO), and its results are the
-CLI's (same dataclasses, the same numbers as an independent eigenvalue computation)."""
+"""The Python API: the example in docs/api-and-export.md runs as written (real AUTO), and its
+results are the CLI's (same dataclasses, the same numbers as an independent eigenvalue
+computation)."""
 
 from __future__ import annotations
 
@@ -18,20 +19,20 @@ from whirl_cli.errors import WhirlError
 from ..conftest import ROOT
 
 
-def readme_example() -> str:
-    text = (ROOT / "README.md").read_text()
+def doc_example() -> str:
+    text = (ROOT / "docs" / "api-and-export.md").read_text()
     section = text[text.index("## Python API"):]
     return re.search(r"```python\n(.*?)```", section, re.S).group(1)
 
 
-def test_readme_example_runs(tmp_path, monkeypatch):
+def test_doc_example_runs(tmp_path, monkeypatch):
     pytest.importorskip("matplotlib")
     monkeypatch.chdir(tmp_path)
     os.symlink(ROOT / "studies", tmp_path / "studies")
     printed = io.StringIO()
     namespace: dict = {}
     with contextlib.redirect_stdout(printed):
-        exec(compile(readme_example(), "README.md", "exec"), namespace)  # noqa: S102
+        exec(compile(doc_example(), "docs/api-and-export.md", "exec"), namespace)  # noqa: S102
     assert (tmp_path / "linear-case2.h5").is_file()
     assert (tmp_path / "linear-case2.png").read_bytes()[:4] == b"\x89PNG"
     table = namespace["table"]

@@ -683,13 +683,13 @@ def test_every_field_has_a_description():
             assert field.description, f"{model.__name__}.{name}"
 
 
-def test_readme_yaml_reference_is_generated_from_the_schema():
+def test_docs_yaml_reference_is_generated_from_the_schema():
     from pathlib import Path
 
     from whirl_cli.study import schema_reference
 
-    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
-    assert schema_reference() in readme
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "study-yaml.md").read_text()
+    assert schema_reference() in doc
 
 
 # --------------------------------------------------------------------------- issue 13: 3, 4

@@ -1,5 +1,4 @@
-"""Periodic branches in the units of a freeplay law, and the describing-function estimate
-(``../shared/models.md`` section 7, points 1 and 3).
+"""Periodic branches in the units of a freeplay law, and the describing-function estimate.
 
 With freeplay on a dof, every amplitude is proportional to the half-gap delta (exactly for
 K_in = 0 with epsilon/delta fixed), so amplitudes are reported as A/delta, A the dof's half

@@ -416,16 +416,11 @@ def classify_model(model, overrides: dict[str, float] | None = None, y0=None, *,
     steps over the lightly excited fast gimbal modes of the gimballed model where DOP853 has
     to resolve them: half the cost) at ``rtol`` (1e-6; atol ``rtol`` x 1e-3 x the state
     scales, i.e. 1e-9 rad for the classical model's angles), on the generated field with
-    Python-float states (the generated scalar code runs several times faster on them than on
-    numpy scalars); |y_i| > ``bound`` x the state scale (10 rad) is divergence. ``options``:
-    the other keywords of :func:`classify`. Cost: the gimballed model (8 states; whirl at
-    1.2-9 Hz, gimbal modes at up to ~88 Hz that set LSODA's step: ~2000 evaluations of f per
-    second simulated) takes 0.3-0.8 s CPU per value with the default 60-period transient of
-    ``explore`` (f ~5 us, J ~12 us), up to 2 s where the whirl mode is slow (1.2 Hz: 80
-    periods are 67 s simulated; the transient ended at rest at 17 s) and 1.1-1.5 s with the
-    window doubled, measured under a load of 8-11 on the 2 cores (README, Performance).
-    Fewer periods leave more orbits 'not settled' (the frequency of a gimballed LCO was then
-    0.3 % off the settled one)."""
+    Python-float states (the generated scalar code is faster on them than on numpy scalars);
+    |y_i| > ``bound`` x the state scale (10 rad) is divergence. ``options``: the other
+    keywords of :func:`classify`. The cost grows with the simulated time (a slow whirl mode
+    means long periods) and with the fastest mode, which sets LSODA's step (the gimballed
+    model's gimbal modes); ``docs/performance.md`` gives the current figures."""
     params = model.parameter_vector(overrides or {})
     field, jacobian = model.field_at(params)
     scale = np.asarray(model.state_scale, dtype=float)

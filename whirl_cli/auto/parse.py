@@ -1,6 +1,6 @@
 """Parsing AUTO-07p's output files into whirl's result dataclasses.
 
-File formats (AUTO-07p 0.9.2, verified against its Fortran writers; ``../shared/reference``):
+File formats (AUTO-07p 0.9.2, verified against its Fortran writers):
 
 * ``b.NAME``: header lines start with BR = 0 (constants echo, "Active continuation parameters",
   then a column title). Data lines are ``BR PT TY LAB`` then PAR(ICP(1)), the L2 norm, the

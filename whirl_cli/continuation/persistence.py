@@ -1,14 +1,13 @@
-"""Persistence of special points as a smoothed law sharpens (issue 15, item 4).
+"""Persistence of special points as a smoothed law sharpens.
 
-A smoothing (freeplay's epsilon) can create bifurcations of its own that vanish as it shrinks
-(``../shared/models.md`` section 7), so a special point of such a model counts as physical only
-if it persists: it is recomputed with every smoothing width halved and quartered, by short runs
-near it where they succeed (:mod:`whirl_cli.continuation.shrinking`), else by repeating the
-continuation at those widths and looking for it there (the same type, the nearest in the
-principal parameter). :func:`annotate` stores the two values (``SpecialPoint.refined``, and
-how they were found in ``refined_by``) and flags a point that is not found again, or moves by
-more than ``tolerance`` of the range, as a smoothing artefact (``artefact``, and why in its
-``note``).
+A smoothing (freeplay's epsilon) can create bifurcations of its own that vanish as it shrinks,
+so a special point of such a model counts as physical only if it persists: it is recomputed
+with every smoothing width halved and quartered, by short runs near it where they succeed
+(:mod:`whirl_cli.continuation.shrinking`), else by repeating the continuation at those widths
+and looking for it there (the same type, the nearest in the principal parameter).
+:func:`annotate` stores the two values (``SpecialPoint.refined``, and how they were found in
+``refined_by``) and flags a point that is not found again, or moves by more than ``tolerance``
+of the range, as a smoothing artefact (``artefact``, and why in its ``note``).
 """
 
 from __future__ import annotations

@@ -1,17 +1,18 @@
 """Model files: a model declared as YAML data, read into a :class:`~.declaration.Family`.
 
-A model file gives what a built-in family declares in Python (see ``docs`` and README "Your
-own model"): its dofs (in state order, each with the parameter of its linear structural
-stiffness), first-order ``states`` if any, parameters (datum value, unit, bounds, aliases),
-optional named ``definitions``, the mass matrix, the generalised forces G per dof and the
-``rates`` F per first-order state, all in the form
+A model file (format: ``docs/model-files.md``) declares a family: its dofs (in state order,
+each with the parameter of its linear structural stiffness), first-order ``states`` if any,
+parameters (datum value, unit, bounds, aliases), optional named ``definitions``, the mass
+matrix, the generalised forces G per dof and the ``rates`` F per first-order state, all in the
+form
 
     M(p) q'' = G(q, q', x, p) - S(q, p),     S_i = K_i q_i   (or a stiffness law),
     x' = F(q, q', x, p),
 
 with expressions written as text and read by :mod:`~.expressions` (a whitelist, never
-``eval``). Every problem of a file is reported at once as ``file:line: key: reason``
-(:class:`~whirl_cli.errors.StudyError`), nothing run. What a file leaves out is derived:
+``eval``). Problems are reported together as ``file:line: key: reason`` lines
+(:class:`~whirl_cli.errors.StudyError`), nothing run; the checks at the datum follow once every
+name resolves. What a file leaves out is derived:
 ``time_scale`` from the linear frequencies at the datum, ``symmetric`` and ``linear`` from
 the forces (probed at the datum), each dof's rate name ``d<dof>``.
 

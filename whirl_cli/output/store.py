@@ -1,68 +1,7 @@
 """HDF5 output: the one writer and the one reader of whirl's result files (schema 2; reads 1).
 
-Layout (units in a ``units`` attribute on every physical dataset)::
-
-    /                               attrs: whirl_schema, whirl_version, auto_version, study_name,
-                                           study_yaml, study_sha256, model, created, git_describe;
-                                           a model file's model_file, model_file_yaml,
-                                           model_file_sha256, model_key, first_order_states
-                                           (comma-separated; only if it has any)
-    /continuations/<name>/          attrs: kind (one-parameter | two-parameter)
-        branches/<branch>/          attrs: kind, origin, status, message, run
-            parameters   (N, P)     attrs: names, units
-            state_max, state_min (N, n)  attrs: names, units
-            l2_norm (N,) ; period (N,) [s] ; stable (N,) bool (AUTO's flag) ;
-            stability_known (N,) bool (False: no eigenvalues/multipliers, or a locus;
-                                       absent in older files: all known)
-            point_type (N,) int (whirl PointType = AUTO TY codes) ; label (N,) int
-            eigenvalues (N, n) complex [1/s]   (equilibria)  or
-            floquet_multipliers (N, n) complex (periodic orbits)
-            torus_angle (N,) [rad]  (torus loci only: the Neimark-Sacker angle, AUTO's PAR(12))
-            orbits/<label>/ time (K,) [s], states (K, n)  attrs: point_type, index, period,
-                                                                parameters
-            freeplay_<dof>/ (periodic, freeplay law on dof) amplitude_ratio (N,) = A/delta;
-                            describing_function/ amplitude_ratio, stiffness, parameter (M,)
-                            attrs: dof
-        special_points/             columns: branch, index, point_type, type_name, label,
-                                    parameters (K, P), state (K, n), period, stable, status,
-                                    criticality, note, bracket (K, 2), residual,
-                                    lyapunov (first Lyapunov coefficient of Hopf points),
-                                    refined (K, 2), artefact (persistence as epsilon shrinks),
-                                    refined_by (restart | epsilon locus | repetition | ""),
-                                    torus_angle (TR points, rad)
-        seeds/                      (continuation `seeds`) columns: index, seed (K, n), kind,
-                                    period, branch, message
-        explorations/<k>/           (continuation `explore`, k from 0 in its order) attrs:
-                                    parameter, kind (equilibrium | periodic | quasi-periodic
-                                    | chaotic | diverged), multiplicity, evidence; value
-                                    (scalar, the parameter's unit), initial (n,) (attrs
-                                    names, units), lyapunov, lyapunov_error [1/s],
-                                    frequencies [Hz], section (m, n) Poincare points (attrs
-                                    names, units), section_dimension [1], peaks [Hz],
-                                    broadband [1]
-        cross_checks/               (study `cross_check: true`) columns: branch, index, kind
-                                    (orbit | equilibrium), parameter, expected, simulated,
-                                    passed, state (the dof an orbit check compares), exact
-                                    (an orbit's max by the exact piecewise law; NaN where
-                                    none)
-    /linear/sweeps/<parameter>/     values, eigenvalues [1/s], damping_ratio, frequency [rad/s],
-                                    whirl (FW | BW | --), datum (scalar, the parameter's
-                                    unit; absent in older files); attrs: parameter, multiples
-                                    (the study gave the range in multiples of the datum)
-    /linear/grid/                   x, y, max_real (Ny, Nx) [1/s], oscillatory (Ny, Nx),
-                                    flutter/line_<k>, divergence/line_<k> (K, 2): zero contour
-    /boundaries/<name>/             attrs: parameters, units, method (loci | slices), slices,
-                                    first_range, second_range (absent in older files)
-        loci/<branch>               (K, 2) locus curve in the two parameters; attrs kind
-        unsafe/polygon_<k>          (K, 2) closed outline of the unsafe region
-        unsafe_intervals/           slice_value, lower, upper, cause (flutter | divergence)
-    /parameters/                    columns: name, value, datum, unit (the resolved set)
-    /simulations/<name>/            (study `simulations`) attrs: law, status, message;
-                                    parameters (P,) the simulation's overrides (attrs names,
-                                    units), initial (n,), time (K,) [s], states (K, n) (attrs
-                                    names, units), hub (K, 2) (attr units)
-    /runs/<run>                     attrs: status, message, constants, returncode,
-                                           wall_seconds, n_points
+The layout, group by group, is described in ``docs/hdf5-layout.md`` (a test checks that it
+names every field declared below).
 
 The groups holding collections (continuations, branches, orbits, explorations, sweeps,
 boundaries, loci, polygons, contour lines, simulations, runs) track the creation order of their
@@ -251,8 +190,6 @@ BOUNDARY = (
     Field("parameter_names", "attribute", "text", key="parameters"),
     Field("parameter_units", "attribute", "text", key="units"),
     Field("method", "attribute", "text"), Field("slices", "attribute", "float"),
-    Field("first_range", "attribute", "float", default=(np.nan, np.nan)),
-    Field("second_range", "attribute", "float", default=(np.nan, np.nan)),
 )
 #: The :class:`UnsafeInterval` table of a boundary (``unsafe_intervals/``).
 UNSAFE_INTERVAL = (

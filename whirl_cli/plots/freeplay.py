@@ -1,5 +1,5 @@
 """Freeplay figures: periodic branches as A/delta against the continuation parameter, with the
-describing-function estimate dashed (``../shared/models.md`` section 7)."""
+describing-function estimate dashed (:mod:`whirl_cli.analysis.freeplay`)."""
 
 from __future__ import annotations
 

@@ -205,9 +205,8 @@ def _settled_layout_class():
     :data:`POSITION_STEP` (made once, matplotlib imported here).
     kiwisolver, which solves the layout, orders its variables by their memory addresses, so
     its solution varies in the last bits of a double from one drawing of the same figure to
-    the next (after a garbage collection, after other figures): measured 8e-16 on thesis
-    figure 3.21, which moved an axes edge by a pixel (11646 values of its PNG differed).
-    Rounded, the same figure gives the same pixels."""
+    the next (after a garbage collection, after other figures), enough to move an axes edge
+    by a pixel. Rounded, the same figure gives the same pixels."""
     from matplotlib.layout_engine import ConstrainedLayoutEngine
 
     class SettledLayout(ConstrainedLayoutEngine):

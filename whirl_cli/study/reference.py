@@ -1,5 +1,5 @@
-"""The study YAML reference: a Markdown table of every key, read off the schema (the README's
-"Study YAML reference" is this table).
+"""The study YAML reference: a Markdown table of every key, read off the schema (the table of
+docs/study-yaml.md, tested to be this one).
 """
 
 from __future__ import annotations

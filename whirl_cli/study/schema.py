@@ -191,8 +191,8 @@ _TYPE_DOC = (
     "Stiffness law: `linear` (linear springs; the polynomial law with K2 = K3 = 0), "
     "`polynomial` (restoring force K x + K2 x^3 + K3 x^5 on `dof`, K the dof's linear "
     "stiffness, e.g. K_theta; x in the dof's unit, rad for angles) or `freeplay` (whirl's "
-    "law, models.md 7: a deadband of half-gap `delta`, stiffness `K_in` inside and `K_out` "
-    "outside, smoothed over `epsilon` by ln cosh)."
+    "law: a deadband of half-gap `delta`, stiffness `K_in` inside and `K_out` outside, "
+    "smoothed over `epsilon` by ln cosh)."
 )
 _DOF_DOC = (
     "Degree of freedom the law acts on (classical: `theta` pitch, `psi` yaw); a dof has at most "
@@ -219,7 +219,7 @@ class Polynomial(_Strict):
 
 
 class Freeplay(_Strict):
-    """whirl's freeplay law on one degree of freedom (models.md section 7).
+    """whirl's freeplay law on one degree of freedom (see :mod:`whirl_cli.models.laws.freeplay`).
 
     After validation ``epsilon`` is filled (delta/100 when the study gives none); ``K_out``
     unset leaves the dof's stiffness at its datum."""
