@@ -207,9 +207,9 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
 
     _say(f"whirl {_version()}: {study.path} -> {output}")
     from . import api
-    from .interrupts import catching
     from .output.summary import render
     from .plots import MODULES as PLOT_MODULES
+    from .runtime import catching
     from .verdict import verdict
 
     with catching():  # an interrupt while plots are drawn is never lost either

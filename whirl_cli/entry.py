@@ -16,7 +16,7 @@ import sys
 
 def main() -> None:
     try:
-        from .signals import terminate_as_interrupt
+        from .runtime import terminate_as_interrupt
 
         terminate_as_interrupt()  # SIGTERM ends whirl as Ctrl-C does, from here on
         # whirl uses no pydantic plugins: skip their lookup (a scan of every installed

@@ -15,7 +15,7 @@ import weakref
 
 import pytest
 
-from whirl_cli.interrupts import (
+from whirl_cli.runtime import (
     Interrupted,
     Standby,
     catching,
@@ -70,20 +70,43 @@ def test_a_swallowed_signal_is_raised_after_the_next_item_of_a_map(mapped):
     assert reached == ["the block went on"]
 
 
-def test_an_interrupted_forked_map_leaves_no_pool_thread_behind():
-    """Interrupted while its workers run, forked_map kills them and joins the pool's manager
-    thread: one left running races Python's exit (it closes a pipe the exit hook writes to:
-    "Exception ignored in threading ... Bad file descriptor")."""
+def test_an_interrupted_forked_map_kills_its_workers_and_leaves_no_thread(tmp_path):
+    """Interrupted while its workers run, forked_map kills them at once (none finishes its
+    item, none is left) and leaves no thread of its own behind."""
+    import multiprocessing
+
+    def item(k: int) -> None:
+        time.sleep(30)
+        (tmp_path / f"finished{k}").touch()
+
+    children, threads = set(multiprocessing.active_children()), set(threading.enumerate())
     timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
-    started = time.monotonic()
     with pytest.raises(Interrupted):
         with catching():
             timer.start()
-            forked_map(lambda k: time.sleep(30), 2, 2)
+            forked_map(item, 2, 2)
     timer.join()
-    assert time.monotonic() - started < 10  # the workers were killed, not waited for
-    managers = [t for t in threading.enumerate() if type(t).__name__ == "_ExecutorManagerThread"]
-    assert managers == []
+    assert set(multiprocessing.active_children()) <= children
+    assert set(threading.enumerate()) <= threads
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_forked_map_raises_the_error_of_the_first_failing_item_with_its_traceback():
+    def item(k: int) -> int:
+        if k in (1, 3):
+            raise ValueError(f"item {k}")
+        return k
+
+    with pytest.raises(ValueError, match="item 1") as caught:
+        forked_map(item, 5, 2)
+    assert "raise ValueError" in str(caught.value.__cause__)  # the worker's traceback
+
+
+def test_a_forked_map_worker_that_dies_or_returns_what_does_not_pickle_is_an_error():
+    with pytest.raises(RuntimeError, match="exit code 3"):
+        forked_map(lambda k: os._exit(3) if k == 2 else k, 4, 2)
+    with pytest.raises(RuntimeError, match="not returned whole"):
+        forked_map(lambda k: (lambda: k), 2, 2)  # a lambda does not pickle
 
 
 def test_a_swallowed_signal_is_raised_by_the_next_signal_and_by_check():
@@ -132,7 +155,7 @@ def test_no_thread_outlives_thread_map_when_an_interrupt_lands_in_thread_start(m
     import threading
     import time
 
-    from whirl_cli.interrupts import thread_map
+    from whirl_cli.runtime import thread_map
 
     real_start = threading.Thread.start
 
@@ -159,7 +182,7 @@ def test_no_thread_outlives_thread_map_when_an_interrupt_lands_in_thread_start(m
 
 
 def test_thread_map_returns_in_item_order():
-    from whirl_cli.interrupts import thread_map
+    from whirl_cli.runtime import thread_map
 
     assert thread_map(lambda x: x * x, range(10), workers=3) == [x * x for x in range(10)]
 
@@ -263,7 +286,7 @@ def test_a_standby_worker_raises_its_error_here_and_ends_with_the_block():
             standby.result()
     with Standby(lambda _argument: time.sleep(60)) as standby:
         standby.submit(None)
-        process = standby._process  # noqa: SLF001 - what the block must end
+        process = standby.process  # what the block must end
         assert process.is_alive()
     assert not process.is_alive()  # killed on leaving, not waited for
     assert process.exitcode == -signal.SIGKILL

@@ -34,7 +34,7 @@ from functools import cache
 from pathlib import Path
 
 from ..errors import WhirlError
-from ..interrupts import Interrupted, catching
+from ..runtime import Interrupted, catching
 from .constants import START_FILE, constants_text
 
 #: stdout texts meaning AUTO did not do what was asked, although it exits 0 -> message shown.
@@ -77,7 +77,7 @@ def kill_group(pid: int) -> None:
 @contextmanager
 def interruptible() -> Iterator[None]:
     """While inside (main thread only): SIGINT and SIGTERM kill the AUTO runs and raise
-    :class:`Interrupted` (a KeyboardInterrupt) in the main thread (:func:`whirl_cli.interrupts.
+    :class:`Interrupted` (a KeyboardInterrupt) in the main thread (:func:`whirl_cli.runtime.
     catching`, so an interrupt is never lost), and no new AUTO run starts."""
     if threading.current_thread() is not threading.main_thread():
         yield

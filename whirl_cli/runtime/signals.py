@@ -1,7 +1,8 @@
 """The exception SIGINT and SIGTERM raise in whirl, and SIGTERM's handler from the first moment.
 
-Only :mod:`signal` is imported here: :func:`whirl_cli.entry.main` installs
-:func:`raise_interrupted` for SIGTERM before it imports anything else, so that a batch system's
+Only :mod:`signal` is imported here (and light modules by the package):
+:func:`whirl_cli.entry.main` installs :func:`raise_interrupted` for SIGTERM before it imports
+anything else, so that a batch system's
 cancel ends whirl as Ctrl-C does (Python's own handler raises KeyboardInterrupt for SIGINT)
 instead of by the signal's default action, however early it lands.
 """
