@@ -696,6 +696,12 @@ def _main() -> None:
         click.echo("interrupted", err=True)
         sys.exit(128 + getattr(error, "signum", 2))
     except Exception as error:  # a bug: say so plainly, traceback only on request
+        from .runtime import wrapped_interrupt
+
+        interrupt = wrapped_interrupt(error)
+        if interrupt is not None:
+            click.echo("interrupted", err=True)
+            sys.exit(128 + getattr(interrupt, "signum", 2))
         if os.environ.get("WHIRL_DEBUG"):
             raise
         click.echo(f"whirl: internal error: {type(error).__name__}: {error} "

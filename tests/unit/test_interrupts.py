@@ -383,3 +383,50 @@ def test_an_interrupted_command_says_interrupted_on_one_line(monkeypatch, capsys
         cli._main()
     assert end.value.code == 143
     assert capsys.readouterr().err == "interrupted\n"
+
+
+class _Interrupting:
+    """A descriptor whose ``__set_name__`` is interrupted (as by a signal while a class such as
+    a pydantic model is made): Python 3.11 wraps the interrupt in a RuntimeError."""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        raise Interrupted(signal.SIGTERM)
+
+
+def test_an_interrupt_python_wrapped_in_another_exception_ends_whirl_as_an_interrupt(
+        monkeypatch, capsys):
+    """Seen as "internal error: RuntimeError: Error calling __set_name__" for a SIGTERM early
+    in ``whirl figures``: exit 143 and "interrupted" instead."""
+    from whirl_cli import cli
+
+    def command(**_options):
+        class Model:  # noqa: F841 - made only to be interrupted
+            field = _Interrupting()
+
+    monkeypatch.setattr(cli.cli, "main", command)
+    with pytest.raises(SystemExit) as ended:
+        cli.main()
+    assert ended.value.code == 128 + signal.SIGTERM
+    assert capsys.readouterr().err == "interrupted\n"
+
+
+def test_an_interrupt_wrapped_while_the_command_line_is_imported_ends_whirl_too():
+    """The console script's import of the command line (:func:`whirl_cli.entry.main`): here
+    a stand-in module whose ``main`` is a class interrupted while it is made."""
+    import subprocess
+
+    script = ("import signal, sys, types\n"
+              "from whirl_cli.runtime import Interrupted\n"
+              "class Interrupting:\n"
+              "    def __set_name__(self, owner, name): raise Interrupted(signal.SIGTERM)\n"
+              "def attribute(name):\n"
+              "    class Model:\n"
+              "        field = Interrupting()\n"
+              "stand_in = types.ModuleType('whirl_cli.cli')\n"
+              "stand_in.__getattr__ = attribute\n"
+              "sys.modules['whirl_cli.cli'] = stand_in\n"
+              "from whirl_cli.entry import main\n"
+              "main()\n")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=60, check=False)
+    assert (done.returncode, done.stderr) == (143, "interrupted\n")

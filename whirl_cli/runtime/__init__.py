@@ -4,7 +4,8 @@ processes.
 * :class:`Interrupted` is the KeyboardInterrupt whirl raises for SIGINT and SIGTERM; it
   survives pickling, so it can travel back from a worker process.
 * :func:`catching`: signals raise :class:`Interrupted` inside, and one Python would drop is
-  raised again (:func:`check`); :func:`held_signals`: signals wait until the block ends.
+  raised again (:func:`check`); :func:`held_signals`: signals wait until the block ends;
+  :func:`wrapped_interrupt` finds one Python wrapped in another exception.
 * :func:`thread_map` maps over threads that never outlive the call, an interrupt included;
   :func:`forked_map` over forked worker processes (CPU-bound Python: simulations, plots);
   :class:`Standby` is one worker forked early, importing what a later call needs.
@@ -27,6 +28,7 @@ TYPE_CHECKING = False  # typing's, without importing typing
 _MODULES = {
     "Interrupted": "signals",
     "terminate_as_interrupt": "signals",
+    "wrapped_interrupt": "signals",
     "catching": "blocks",
     "check": "blocks",
     "held_signals": "blocks",
@@ -52,12 +54,13 @@ __all__ = [
     "quiet_worker",
     "terminate_as_interrupt",
     "thread_map",
+    "wrapped_interrupt",
 ]
 
 if TYPE_CHECKING:
     from .blocks import catching, check, held_signals
     from .processes import Standby, forked_map, forking, quiet_worker
-    from .signals import Interrupted, terminate_as_interrupt
+    from .signals import Interrupted, terminate_as_interrupt, wrapped_interrupt
     from .threads import preload, preloaded, thread_map
 
 

@@ -27,6 +27,19 @@ class Interrupted(KeyboardInterrupt):
         return type(self), (self.signum,)
 
 
+def wrapped_interrupt(error: BaseException) -> KeyboardInterrupt | None:
+    """The interrupt that caused ``error`` (its ``__cause__`` or ``__context__``, at any
+    depth), if any: Python turns an interrupt raised inside some of its hooks into another
+    exception (3.11: a RuntimeError for one inside ``__set_name__``)."""
+    seen: set[int] = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, KeyboardInterrupt):
+            return error
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return None
+
+
 def raise_interrupted(signum: int, _frame: object) -> None:
     """A signal handler: raise :class:`Interrupted` for ``signum``."""
     raise Interrupted(signum)
