@@ -223,12 +223,20 @@ def slow_module(tmp_path, monkeypatch, name: str, body: str = "") -> str:
 
 
 def test_preload_imports_in_the_background_and_a_fork_waits_for_it(tmp_path, monkeypatch):
-    name = slow_module(tmp_path, monkeypatch, "whirl_preload_probe", "DONE = True")
-    started = time.perf_counter()
+    """The module's import ends only once this test has gone on past ``preload`` (or after
+    20 s, then without DONE): ``preload`` did not wait for it, and the forked workers see it
+    imported whole (a module being imported is in sys.modules already, without DONE)."""
+    flag = tmp_path / "went_on"
+    name = "whirl_preload_probe"
+    (tmp_path / f"{name}.py").write_text(
+        "import os, time\ndeadline = time.monotonic() + 20\n"
+        f"while not os.path.exists({str(flag)!r}) and time.monotonic() < deadline:\n"
+        "    time.sleep(0.01)\n"
+        f"DONE = os.path.exists({str(flag)!r})\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, name, raising=False)
     preload(name)
-    assert time.perf_counter() - started < 0.2  # the caller goes on at once
-    # the forked workers see the module imported whole (forking waited for the preload
-    # thread; a module being imported is in sys.modules already, without DONE)
+    flag.touch()
     seen = forked_map(lambda _k: getattr(sys.modules.get(name), "DONE", False), 2, 2)
     assert seen == [True, True]
     assert not [t for t in threading.enumerate() if t.name == "whirl-preload"]
@@ -256,23 +264,21 @@ def test_a_standby_worker_imports_first_and_computes_from_what_is_submitted_late
     (tmp_path / f"{name}.py").write_text(
         "import os, time\ndeadline = time.monotonic() + 20\n"
         f"while not os.path.exists({str(flag)!r}) and time.monotonic() < deadline:\n"
-        "    time.sleep(0.01)\n")
+        "    time.sleep(0.01)\n"
+        f"SUBMITTED_FIRST = os.path.exists({str(flag)!r})\n")
     monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.delitem(sys.modules, name, raising=False)
     inherited = {"offset": 10}  # made before the fork: the worker sees it without pickling
 
     def work(values):  # a closure: it does not pickle, it is inherited at the fork
-        return [v + inherited["offset"] for v in values], name in sys.modules
+        return [v + inherited["offset"] for v in values], sys.modules[name].SUBMITTED_FIRST
 
-    started = time.monotonic()
     with Standby(work, (name,)) as standby:
         standby.submit(list(range(100_000)))  # more than a pipe holds: read while importing
-        submitted = time.monotonic() - started
         flag.touch()
-        values, imported = standby.result()
-    assert submitted < 10  # neither the fork nor the submission waited for the import
+        values, submitted_first = standby.result()
     assert values == [v + 10 for v in range(100_000)]
-    assert imported  # in the worker, before the work
+    assert submitted_first  # imported in the worker, before the work, but not waited for
     assert name not in sys.modules  # not here
 
 
