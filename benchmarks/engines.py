@@ -29,8 +29,9 @@ from bench import launched  # benchmarks/ is this script's directory
 
 ROOT = Path(__file__).resolve().parents[1]
 WHIRL = ROOT / ".venv" / "bin" / "whirl"
+WITH_CONSTANTS = Path(__file__).with_name("with_constants.py")
 #: ``ENGINE+ISP2``: fold-of-cycles loci with ISP=2 (stability and bifurcation detection) instead
-#: of whirl's ISP=0, through the testing hook WHIRL_AUTO_EXTRA_CONSTANTS.
+#: of whirl's ISP=0, through ``with_constants.py``.
 LPC_ISP2 = {"*.fold_of_cycles_*": {"ISP": 2}}
 
 
@@ -50,11 +51,11 @@ def run_once(study: Path, engine: str, out: Path, cache: Path) -> dict[str, floa
     if path:
         env["PYTHONPATH"] = path
         env["WHIRL_CACHE_DIR"] += path.replace("/", "_")
-    if isp2:
-        env["WHIRL_AUTO_EXTRA_CONSTANTS"] = json.dumps(LPC_ISP2)
+    command = [sys.executable, str(WITH_CONSTANTS), json.dumps(LPC_ISP2)] if isp2 \
+        else [str(WHIRL)]
     load = os.getloadavg()[0]
     start = time.perf_counter()
-    done = subprocess.run([str(WHIRL), "run", str(study), "-o", str(out), "--no-plots",
+    done = subprocess.run([*command, "run", str(study), "-o", str(out), "--no-plots",
                            "--overwrite"], env=env, capture_output=True, text=True, check=False)
     wall = time.perf_counter() - start
     if not out.exists():

@@ -33,3 +33,37 @@ def pytest_collection_modifyitems(items):
     for item in items:
         if "/tests/auto/" in str(item.fspath) or "/tests/regression/" in str(item.fspath):
             item.add_marker(pytest.mark.auto)
+
+
+@pytest.fixture
+def extra_auto_constants(monkeypatch):
+    """``add({"<glob>": {constants}})``: the AUTO runs whose name (``<continuation>.<branch>``)
+    matches a glob get those constants merged in (mapping values such as ``PAR`` one level
+    deep), for this test; constants no study can write, to provoke AUTO failures."""
+    import fnmatch
+
+    from whirl_cli.auto import runner
+
+    def add(table: dict[str, dict]) -> None:
+        real = runner.run
+
+        def run(executable, constants, workdir, name, *args, **kwargs):
+            for pattern, extra in table.items():
+                if fnmatch.fnmatchcase(name, pattern):
+                    constants = merged(constants, extra)
+            return real(executable, constants, workdir, name, *args, **kwargs)
+
+        monkeypatch.setattr(runner, "run", run)
+
+    return add
+
+
+def merged(constants: dict, extra: dict) -> dict:
+    """``constants`` updated with ``extra``, mapping values one level deep."""
+    result = dict(constants)
+    for key, value in extra.items():
+        if isinstance(value, dict) and isinstance(result.get(key), dict):
+            result[key] = {**result[key], **value}
+        else:
+            result[key] = value
+    return result

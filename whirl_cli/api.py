@@ -136,7 +136,7 @@ def _workroot(study: Study, keep_runs: str | os.PathLike[str] | None) -> Iterato
     when an interrupt held while it is made is raised), or one kept under ``keep_runs``.
     Nothing is made for an unknown AUTO engine."""
     from .auto.toolchain import engine_name
-    from .interrupts import held_signals
+    from .runtime import held_signals
 
     engine_name()  # WHIRL_AUTO_ENGINE checked first
     workroot = None

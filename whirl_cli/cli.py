@@ -244,9 +244,9 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
 
     _say(f"whirl {_version()}: {study.path} -> {output}")
     from . import api
-    from .interrupts import catching
     from .output.summary import render
     from .plots import MODULES as PLOT_MODULES
+    from .runtime import catching
     from .verdict import verdict
 
     with catching():  # an interrupt while plots are drawn is never lost either
@@ -731,6 +731,12 @@ def _main() -> None:
         click.echo("interrupted", err=True)
         sys.exit(128 + getattr(error, "signum", 2))
     except Exception as error:  # a bug: say so plainly, traceback only on request
+        from .runtime import wrapped_interrupt
+
+        interrupt = wrapped_interrupt(error)
+        if interrupt is not None:
+            click.echo("interrupted", err=True)
+            sys.exit(128 + getattr(interrupt, "signum", 2))
         if os.environ.get("WHIRL_DEBUG"):
             raise
         click.echo(f"whirl: internal error: {type(error).__name__}: {error} "

@@ -16,7 +16,7 @@ import sys
 
 def main() -> None:
     try:
-        from .signals import terminate_as_interrupt
+        from .runtime import terminate_as_interrupt
 
         terminate_as_interrupt()  # SIGTERM ends whirl as Ctrl-C does, from here on
         # whirl uses no pydantic plugins: skip their lookup (a scan of every installed
@@ -24,13 +24,25 @@ def main() -> None:
         os.environ.setdefault("PYDANTIC_DISABLE_PLUGINS", "__all__")
         from .cli import main as run_cli
     except KeyboardInterrupt as error:
-        sys.stderr.write("interrupted\n")
-        sys.exit(128 + getattr(error, "signum", 2))  # 130 SIGINT, 143 SIGTERM
+        interrupted(error)
+    except Exception as error:  # an interrupt Python wrapped (e.g. in a class's __set_name__)
+        from .runtime import wrapped_interrupt
+
+        interrupt = wrapped_interrupt(error)
+        if interrupt is None:
+            raise
+        interrupted(interrupt)
     try:
         run_cli()
     except SystemExit as end:
         leave(end.code)
     leave(0)
+
+
+def interrupted(error: KeyboardInterrupt) -> None:
+    """End whirl for ``error``: "interrupted", exit 130 for SIGINT, 143 for SIGTERM."""
+    sys.stderr.write("interrupted\n")
+    sys.exit(128 + getattr(error, "signum", 2))
 
 
 def leave(code: object) -> None:

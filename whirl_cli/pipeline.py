@@ -24,7 +24,6 @@ from .continuation.engine import Engine, Numerics
 from .continuation.loci import two_parameter
 from .continuation.one_parameter import one_parameter
 from .continuation.periodic import OrbitStart
-from .interrupts import Standby, forked_map, preload, preloaded, thread_map
 from .output.provenance import provenance
 from .results import (
     Boundary,
@@ -35,6 +34,7 @@ from .results import (
     Simulation,
     StudyResult,
 )
+from .runtime import Standby, forked_map, preload, preloaded, thread_map
 from .study import Study
 
 T = TypeVar("T")
@@ -48,7 +48,7 @@ def run_study(study: Study, workroot: Path, jobs: int = 1,
     """Run every continuation, linear sweep and simulation of ``study``; AUTO works under
     ``workroot`` (a study without continuations needs no AUTO). ``preload``: modules the
     caller needs afterwards (e.g. :data:`whirl_cli.plots.MODULES` to draw), imported in the
-    background once AUTO starts (:func:`whirl_cli.interrupts.preload`). Only modules nothing
+    background once AUTO starts (:func:`whirl_cli.runtime.preload`). Only modules nothing
     imports while AUTO runs: two threads importing parts of one package at once can meet in
     its circular imports (Python then raises its import-deadlock error in one of them): scipy's
     integrators are added only where the cross-checks are the first to use scipy and run
@@ -60,7 +60,7 @@ def run_study(study: Study, workroot: Path, jobs: int = 1,
     planned so far: a recipe decides its next runs from the last ones' results).
 
     In the main thread, SIGINT and SIGTERM kill the running AUTO processes at once and raise
-    :class:`whirl_cli.interrupts.Interrupted` (a KeyboardInterrupt), see
+    :class:`whirl_cli.runtime.Interrupted` (a KeyboardInterrupt), see
     :func:`whirl_cli.auto.runner.interruptible`.
     """
     return run_and_draw(study, workroot, None, jobs, on_run, preload, on_slow, on_plan)[0]
@@ -75,7 +75,7 @@ def run_and_draw(study: Study, workroot: Path, draw: Callable[[StudyResult], T] 
     """:func:`run_study`, and ``draw(result)`` (None without ``draw``): work that needs
     everything but the cross-checks, such as rendering the plots
     (:func:`whirl_cli.output.study_files.drawn_plots`). With ``jobs`` > 1 the cross-checks do
-    not hold it up: a worker forked before AUTO starts (:class:`whirl_cli.interrupts.Standby`)
+    not hold it up: a worker forked before AUTO starts (:class:`whirl_cli.runtime.Standby`)
     imports scipy's integrators meanwhile, on another core (in a short study that import,
     behind matplotlib's in one background thread, was the last thing to end), and checks the
     continuations as soon as they are done, while the linear analysis, the simulations and
@@ -241,7 +241,7 @@ def _import_integrators() -> None:
 def simulations(study: Study, model, jobs: int = 1) -> list[Simulation]:
     """The study's ``simulations:``, each from its initial state (degrees -> SI) with its
     overrides on top of the study's parameters (scipy; a failure is in the result), ``jobs``
-    at a time in forked processes (:func:`whirl_cli.interrupts.forked_map`: each is
+    at a time in forked processes (:func:`whirl_cli.runtime.forked_map`: each is
     independent of the others, so the results are identical for any ``jobs``, in the study's
     order)."""
     specs = study.simulations
@@ -268,7 +268,7 @@ def explorations(model, overrides: dict[str, float], spec,
     ``explore_transient`` whirl periods, on the section where ``explore_section`` (default:
     the first dof's rate, i.e. at that dof's minima) crosses its mean upwards.
 
-    ``jobs`` values at a time in forked processes (:func:`whirl_cli.interrupts.forked_map`:
+    ``jobs`` values at a time in forked processes (:func:`whirl_cli.runtime.forked_map`:
     each value's simulation is independent of the others, so the results are identical for
     any ``jobs``, in the order of ``explore``). A failure is the result ``diverged`` with its
     message, never raised."""

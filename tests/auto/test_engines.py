@@ -62,13 +62,26 @@ def test_doctor_names_the_engine_that_runs(engine):
 @pytest.mark.parametrize("engine", toolchain.ENGINES)
 def test_engine_gives_softening_case2_reference_numbers(engine, tmp_path, monkeypatch):
     """Softening case 2 (K_psi = 0.3, K2 = -10) with each engine: every run ok, Hopf points at
-    K1 = 0.0807 and 0.2888, the pitchfork at 0.03598 (models.md 4) and the fold of cycles at
-    K1 = 0.451878 (README, Performance (f)), and the engine stored as auto_version."""
+    K1 = 0.0807 and 0.2888, the pitchfork at 0.03598 (models.md 4), folds of cycles that are
+    folds: the periodic family turns there (three points on either side lie on the same
+    side in K1) and no point near it goes further in K1 than AUTO's location accuracy
+    (2e-4 relative); and the engine stored as auto_version."""
     result = _study(engine, "softening_case2", tmp_path, monkeypatch)
     assert [r.status for r in result.runs] == ["ok"] * len(result.runs), result.runs
     assert _points(result, PointType.HB) == pytest.approx([0.0807, 0.2888], abs=1e-4)
     assert _points(result, PointType.BP) == pytest.approx([0.03598], abs=1e-5)
-    assert max(_points(result, PointType.LPC)) == pytest.approx(0.451878, abs=1e-5)
+    folds = [(c, p) for c in result.continuations for p in c.special_points
+             if p.point_type == PointType.LPC and p.status == "located"]
+    assert folds
+    for continuation, fold in folds:
+        (branch,) = [b for b in continuation.branches if b.name == fold.branch]
+        k1, i = branch.parameters[:, 0], fold.index
+        assert k1[i] == pytest.approx(float(fold.parameters[0]), abs=1e-12)
+        assert 3 <= i < len(k1) - 3, fold
+        side = np.sign(k1[i] - k1[i - 3])  # +1: the family turns back at a largest K1
+        assert side != 0 and side == np.sign(k1[i] - k1[i + 3]), fold
+        extreme = side * (side * k1[i - 3:i + 4]).max()
+        assert k1[i] == pytest.approx(extreme, rel=2e-4), fold
     assert result.attributes["auto_version"] == toolchain.auto_version(engine)
 
 

@@ -18,9 +18,8 @@ WHIRL = Path(sys.executable).with_name("whirl")
 
 def environment(cache: Path | None = None, **extra: str) -> dict[str, str]:
     """The test process's environment with WHIRL_CACHE_DIR (shared session cache by default)
-    and ``extra`` set; WHIRL_AUTO_EXTRA_CONSTANTS and WHIRL_DEBUG removed unless given."""
-    env = {k: v for k, v in os.environ.items()
-           if k not in ("WHIRL_AUTO_EXTRA_CONSTANTS", "WHIRL_DEBUG")}
+    and ``extra`` set; WHIRL_DEBUG removed unless given."""
+    env = {k: v for k, v in os.environ.items() if k != "WHIRL_DEBUG"}
     if cache is not None:
         env["WHIRL_CACHE_DIR"] = str(cache)
     env.update(extra)

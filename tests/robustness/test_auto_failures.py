@@ -5,13 +5,12 @@ and the other continuations intact, and ``whirl run`` exits 1 naming the failed 
 Provoked with real study settings where one exists: no convergence (MX) and a hanging run
 (timeout) from too tight a Newton tolerance on the secondary branches, NaN from a continuation
 that starts at zero inertia. A crash needs constants no study can write (a wrong NDIM): the
-testing hook WHIRL_AUTO_EXTRA_CONSTANTS (whirl_cli/auto/runner.py) provides them. Missing gfortran
+fixture extra_auto_constants (tests/conftest.py) provides them. Missing gfortran
 or AUTO-07p are run through the console script with a stripped environment.
 """
 
 from __future__ import annotations
 
-import json
 import subprocess
 from pathlib import Path
 
@@ -113,12 +112,12 @@ def test_a_hanging_run_times_out_and_keeps_its_points(tmp_path):
         assert run_record["returncode"] == -1 and 1.0 <= run_record["wall_seconds"] < 5
 
 
-def test_nan_from_the_equations_is_an_error_with_an_empty_branch(tmp_path, monkeypatch):
-    """The inertia I_y set to 0 in one run (testing hook; a study cannot ask for it, I_y > 0
+def test_nan_from_the_equations_is_an_error_with_an_empty_branch(tmp_path,
+                                                                 extra_auto_constants):
+    """The inertia I_y set to 0 in one run (extra_auto_constants; a study cannot ask for it, I_y > 0
     is its bound): 1/I_y is infinite, LAPACK refuses the Jacobian. The failed branch is stored
     empty, and the plots still work."""
-    monkeypatch.setenv("WHIRL_AUTO_EXTRA_CONSTANTS",
-                       json.dumps({"bad.main_up": {"PAR": {"I_y": 0.0}}}))
+    extra_auto_constants({"bad.main_up": {"PAR": {"I_y": 0.0}}})
     body = ("continuations:\n" + GOOD
             + "  - {name: bad, type: one-parameter, parameter: V, start: 0.0, "
               "range: [0.0, 10.0]}\nplots: [bifurcation]\n")
@@ -133,11 +132,12 @@ def test_nan_from_the_equations_is_an_error_with_an_empty_branch(tmp_path, monke
     assert (output.parent / "failing_good_bifurcation.png").exists()
 
 
-def test_a_crash_is_stored_and_no_stale_fort2_leaks_into_later_runs(tmp_path, monkeypatch):
-    """NDIM = 3 (testing hook) makes AUTO crash with SIGSEGV on bad.main_up. The runs after it
+def test_a_crash_is_stored_and_no_stale_fort2_leaks_into_later_runs(tmp_path,
+                                                                    extra_auto_constants):
+    """NDIM = 3 (a test fixture) makes AUTO crash with SIGSEGV on bad.main_up. The runs after it
     (the secondary branches of the same continuation) get fresh directories and their own
     constants; no fort.2 is left anywhere, nor taken from the --keep-runs directory."""
-    monkeypatch.setenv("WHIRL_AUTO_EXTRA_CONSTANTS", json.dumps({"bad.main_up": {"NDIM": 3}}))
+    extra_auto_constants({"bad.main_up": {"NDIM": 3}})
     keep = tmp_path / "keep"
     keep.mkdir()
     (keep / "fort.2").write_text("NDIM = 3\nIPS = 99\n")  # stale, must never be read

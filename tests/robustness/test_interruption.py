@@ -321,7 +321,7 @@ def test_a_signal_stops_cleanly_and_kills_auto(tmp_path, signum, status):
 
 
 def test_interrupted_is_a_keyboard_interrupt_with_the_signal():
-    from whirl_cli.interrupts import Interrupted
+    from whirl_cli.runtime import Interrupted
 
     assert issubclass(Interrupted, KeyboardInterrupt)
     assert Interrupted(signal.SIGTERM).signum == signal.SIGTERM

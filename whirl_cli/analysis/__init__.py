@@ -1,7 +1,7 @@
 """Analysis without AUTO: numpy and scipy on the symbolic model's right-hand side.
 
 It depends only on :mod:`whirl_cli.models`, :mod:`whirl_cli.results` and
-:mod:`whirl_cli.interrupts` (the continuation recipes use it, never the reverse); scipy is
+:mod:`whirl_cli.runtime` (the continuation recipes use it, never the reverse); scipy is
 imported inside functions.
 
 * :mod:`~whirl_cli.analysis.linear` -- eigenvalues of the equilibrium: damping, frequency,

@@ -23,9 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..interrupts import thread_map
 from ..models import Model
 from ..results import LinearGrid, LinearSweep
+from ..runtime import thread_map
 
 FORWARD, BACKWARD, NON_OSCILLATORY = "FW", "BW", "--"
 

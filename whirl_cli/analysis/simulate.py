@@ -20,9 +20,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..interrupts import forked_map, preloaded
 from ..models import Model
 from ..results import Branch, BranchKind, CrossCheck, Orbit, PointType, Simulation
+from ..runtime import forked_map, preloaded
 from .global_bifurcations import BLOWUP_FACTOR
 
 #: What simulating imports (scipy's integrators, with scipy.optimize: about 0.5 s): imported
@@ -327,7 +327,7 @@ def cross_check(model: Model, overrides: dict[str, float], branches: tuple[Branc
     branches, perturbations for equilibria), spread along each branch. Not checked: points next
     to bifurcations, orbits in a period blow-up (T > 3 T_Hopf) and equilibria too weakly damped
     or too stiff to simulate in bounded time. ``jobs`` > 1 simulates in that many forked
-    processes (:func:`whirl_cli.interrupts.forked_map`: results identical, in the same
+    processes (:func:`whirl_cli.runtime.forked_map`: results identical, in the same
     order; an interrupt of the parent kills them at once)."""
     preloaded()  # scipy may be being imported in the background (it is then used here)
     tasks = planned_checks(branches, per_branch)

@@ -10,16 +10,10 @@
   --pdeathsig``, util-linux, when available), so even a SIGKILLed whirl leaves none running;
   inside :func:`interruptible` (what ``run_study`` uses) SIGINT and SIGTERM kill every running
   AUTO process group at once, refuse new runs and raise :class:`Interrupted`.
-* Testing hook: ``WHIRL_AUTO_EXTRA_CONSTANTS`` = a JSON object ``{"<glob>": {constants}}``;
-  runs whose name (``<continuation>.<branch>``) matches a glob get those constants merged in
-  (mapping values such as ``PAR`` one level deep). It exists to provoke AUTO failures in tests
-  (e.g. ``{"bad.*": {"NDIM": 3}}``); the constants used are stored with every run.
 """
 
 from __future__ import annotations
 
-import fnmatch
-import json
 import os
 import re
 import shutil
@@ -33,8 +27,7 @@ from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
 
-from ..errors import WhirlError
-from ..interrupts import Interrupted, catching
+from ..runtime import Interrupted, catching
 from .constants import START_FILE, constants_text
 
 #: stdout texts meaning AUTO did not do what was asked, although it exits 0 -> message shown.
@@ -77,7 +70,7 @@ def kill_group(pid: int) -> None:
 @contextmanager
 def interruptible() -> Iterator[None]:
     """While inside (main thread only): SIGINT and SIGTERM kill the AUTO runs and raise
-    :class:`Interrupted` (a KeyboardInterrupt) in the main thread (:func:`whirl_cli.interrupts.
+    :class:`Interrupted` (a KeyboardInterrupt) in the main thread (:func:`whirl_cli.runtime.
     catching`, so an interrupt is never lost), and no new AUTO run starts."""
     if threading.current_thread() is not threading.main_thread():
         yield
@@ -102,37 +95,6 @@ def _pdeathsig_prefix() -> tuple[str, ...]:
     except (OSError, subprocess.TimeoutExpired):
         return ()
     return prefix if probe.returncode == 0 else ()
-
-
-EXTRA_CONSTANTS = "WHIRL_AUTO_EXTRA_CONSTANTS"
-
-
-def _extra_constants(name: str) -> dict:
-    """The constants the testing hook ``WHIRL_AUTO_EXTRA_CONSTANTS`` adds to run ``name``."""
-    text = os.environ.get(EXTRA_CONSTANTS, "").strip()
-    if not text:
-        return {}
-    try:
-        table = json.loads(text)
-    except ValueError as error:
-        raise WhirlError(f"{EXTRA_CONSTANTS}: not JSON ({error})") from None
-    if not isinstance(table, dict) or not all(isinstance(v, dict) for v in table.values()):
-        raise WhirlError(f'{EXTRA_CONSTANTS}: expected {{"<glob>": {{constants}}}}')
-    extra: dict = {}
-    for pattern, constants in table.items():
-        if fnmatch.fnmatchcase(name, pattern):
-            extra.update(constants)
-    return extra
-
-
-def _merged(constants: dict, extra: dict) -> dict:
-    merged = dict(constants)
-    for key, value in extra.items():
-        if isinstance(value, dict) and isinstance(merged.get(key), dict):
-            merged[key] = {**merged[key], **value}
-        else:
-            merged[key] = value
-    return merged
 
 
 @dataclass(frozen=True)
@@ -204,7 +166,7 @@ def run(executable: Path, constants: dict, workdir: Path, name: str,
     not silent meanwhile).
     """
     workdir.mkdir(parents=True, exist_ok=False)
-    constants = dict(_merged(constants, _extra_constants(name)), sv=name)
+    constants = dict(constants, sv=name)
     if restart is not None:
         restart_name = "restart"
         shutil.copyfile(restart, workdir / f"s.{restart_name}")

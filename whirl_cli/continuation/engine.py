@@ -19,9 +19,9 @@ import numpy as np
 from ..auto import runner, toolchain
 from ..auto.codegen import fortran_source, source_key
 from ..auto.parse import parse_s, read_branch
-from ..interrupts import thread_map
 from ..models import Model
 from ..results import STEP_LIMIT, Branch, BranchKind, PointType, RunRecord, SpecialPoint
+from ..runtime import thread_map
 from .branches import special_points
 from .numerics import Numerics as Numerics  # re-exported: the recipes take it from here
 

@@ -11,9 +11,9 @@ import numpy as np
 
 from ..auto import runner
 from ..auto.constants import TORUS_ANGLE_INDEX, par_layout
-from ..interrupts import thread_map
 from ..models import Model
 from ..results import STEP_LIMIT, Branch, BranchKind, ContinuationResult, PointType, SpecialPoint
+from ..runtime import thread_map
 from .branches import _same_point, head, join, special_points, typical_amplitudes
 from .engine import Engine, Numerics, RunSpec, _read
 from .equilibria import equilibrium_constants

@@ -15,9 +15,9 @@ import numpy as np
 
 from ..analysis import global_bifurcations
 from ..auto.constants import AMPLITUDE, par_layout
-from ..interrupts import thread_map
 from ..models import Model
 from ..results import OTHER_END, STEP_LIMIT, Branch, BranchKind, Orbit, PointType, SpecialPoint
+from ..runtime import thread_map
 from .branches import amplitude, head, join, reverse, special_points
 from .engine import Engine, Numerics, RunSpec, _read
 from .equilibria import equilibrium_constants

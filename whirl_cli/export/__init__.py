@@ -84,8 +84,8 @@ def export(result: StudyResult, output: str | os.PathLike[str], branches: bool =
            overwrite: bool = False) -> tuple[Path, ...]:
     """Write ``result`` to ``output`` in the format of its suffix (:data:`FORMATS`), and
     for CSV with ``branches`` each branch to a file beside it; the paths written."""
-    from ..interrupts import held_signals
     from ..output import atomic
+    from ..runtime import held_signals
 
     output = Path(output)
     chosen = format_of(output)

@@ -184,7 +184,7 @@ class _Artist:
                 self.done[sheet.path] = reused
         todo = sorted((s for s in todo if s.path not in self.done),
                       key=lambda s: len(s.panels), reverse=True)
-        from ..interrupts import forked_map
+        from ..runtime import forked_map
 
         images = forked_map(lambda k: self._image(todo[k], keys[todo[k].path]), len(todo),
                             jobs)

@@ -33,8 +33,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from ..errors import OutputError
-from ..interrupts import forked_map, held_signals
 from ..results import StudyResult
+from ..runtime import forked_map, held_signals
 from . import atomic, store
 from .guard import IMAGE, RESULT, check, plot_stem, refusal
 

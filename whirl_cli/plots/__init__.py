@@ -34,5 +34,5 @@ Modules, lowest first:
 """
 
 #: The modules drawing imports (matplotlib's Figure and Agg canvas, about 0.7 s): what a caller
-#: that will draw can :func:`~whirl_cli.interrupts.preload` while AUTO runs.
+#: that will draw can :func:`~whirl_cli.runtime.preload` while AUTO runs.
 MODULES = ("matplotlib.figure", "matplotlib.backends.backend_agg")

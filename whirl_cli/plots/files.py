@@ -191,9 +191,9 @@ def render_study_plots(result: StudyResult, kinds: tuple[str, ...], stem: str,
                        ) -> list[tuple[str, bytes]]:
     """(file name, bytes) of every figure of :func:`save_study_plots` in each of ``formats``
     (the PNG always, first), rendered in memory, in ``jobs`` forked processes
-    (:func:`whirl_cli.interrupts.forked_map`; the same bytes in the same order for any
+    (:func:`whirl_cli.runtime.forked_map`; the same bytes in the same order for any
     ``jobs``); nothing is written."""
-    from ..interrupts import forked_map
+    from ..runtime import forked_map
 
     if tuple(formats) == ("png",):
         tasks = render_tasks(result, kinds, stem, state, dpi, view)

@@ -26,9 +26,9 @@ from functools import partial
 from pathlib import Path
 
 from ..errors import WhirlError
-from ..interrupts import catching, held_signals, quiet_worker
 from ..output.study_files import publish_plots, publish_study
 from ..results import StudyResult
+from ..runtime import catching, held_signals, quiet_worker
 from ..study import Study
 from ..verdict import verdict
 from .plan import INVALID, PLOT, RUN, SKIP, SweepItem
@@ -38,7 +38,7 @@ _CANCELLED = None
 
 
 def _init_worker(cancelled) -> None:
-    """Initializer of local worker processes: :func:`whirl_cli.interrupts.quiet_worker` with
+    """Initializer of local worker processes: :func:`whirl_cli.runtime.quiet_worker` with
     SIGTERM ignored as SIGINT is (a process group's SIGTERM, a batch system's cancel, must not
     end a worker inside the pool's queue code, where it would leave a lock held and the
     parent waiting: the parent, which receives it too, ends its workers), except inside
@@ -52,7 +52,7 @@ def _init_worker(cancelled) -> None:
 def compute(study: Study) -> StudyResult:
     """Run ``study`` (AUTO runs one at a time) in a fresh temporary directory, removed
     afterwards; the worker-side task of a sweep. In a local worker SIGINT and SIGTERM raise
-    :class:`whirl_cli.interrupts.Interrupted` inside it (the work directory is made and
+    :class:`whirl_cli.runtime.Interrupted` inside it (the work directory is made and
     removed with them held: none is left behind)."""
     from ..pipeline import run_study
 
@@ -66,7 +66,7 @@ def compute(study: Study) -> StudyResult:
             with held_signals():
                 workroot = Path(tempfile.mkdtemp(prefix=f"whirl-sweep-{study.name}-"))
             return run_study(study, workroot, jobs=1, on_slow=partial(_still_running, study.name))
-        except BaseException as error:  # run_study's threads have ended (interrupts.thread_map)
+        except BaseException as error:  # run_study's threads have ended (runtime.thread_map)
             raise portable(error) from None
         finally:
             with held_signals():  # an interrupt meanwhile is raised once it is removed

@@ -7,13 +7,14 @@ from __future__ import annotations
 import multiprocessing
 import os
 import signal
+import threading
 import time
 from collections.abc import Iterator, Sequence
 from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import contextmanager
 
 from ..errors import WhirlError
-from ..interrupts import forking
+from ..runtime import forking
 from .execute import _init_worker
 from .plan import RUN, SweepItem
 
@@ -49,7 +50,8 @@ class LocalPool(ProcessPoolExecutor):
     ``interrupt`` sets the shared cancel flag (queued tasks return at once) and sends them
     SIGINT (a terminal's Ctrl-C reaches them directly, ``kill -INT`` on the parent does not).
     The pool's own cancel/terminate paths are not used after an interrupt: in Python 3.11
-    they can leave a worker waiting forever."""
+    they can leave a worker waiting forever. The workers are the child processes that
+    :meth:`start` made (:func:`multiprocessing.active_children`)."""
 
     def __init__(self, jobs: int) -> None:
         context = multiprocessing.get_context()
@@ -57,14 +59,21 @@ class LocalPool(ProcessPoolExecutor):
         super().__init__(max_workers=jobs, mp_context=context, initializer=_init_worker,
                          initargs=(self.cancelled,))
         self.jobs = jobs
+        self._workers: list = []
 
     def workers(self) -> list:
-        return list((getattr(self, "_processes", None) or {}).values())
+        return list(self._workers)
+
+    def broken(self) -> bool:
+        """Whether a worker has died (the pool is then broken: its manager ends the others)."""
+        return any(process.exitcode not in (None, 0) for process in self.workers())
 
     def start(self) -> None:
         """Start every worker now (before a progress display thread exists: fork is safe)."""
+        before = set(multiprocessing.active_children())
         with forking():
             started = [self.submit(os.getpid) for _ in range(self.jobs)]
+        self._workers = [p for p in multiprocessing.active_children() if p not in before]
         for future in started:
             future.result()
 
@@ -72,12 +81,15 @@ class LocalPool(ProcessPoolExecutor):
         """Shut down without risking a hang: workers not gone after ``timeout`` s are killed;
         by then they run no study. If the pool broke (a worker died), its manager has sent
         the others SIGTERM, which ends a study at once but is ignored by an idle worker (see
-        :func:`whirl_cli.sweep.execute._init_worker`): they get ``BROKEN_GRACE`` s."""
+        :func:`whirl_cli.sweep.execute._init_worker`): they get ``BROKEN_GRACE`` s. The
+        shutdown waits in a thread of its own until the pool's manager thread has ended (one
+        left running races Python's exit for the pool's wakeup pipe)."""
         workers = self.workers()
-        manager = getattr(self, "_executor_manager_thread", None)
-        if getattr(self, "_broken", False):
+        if self.broken():
             timeout = min(timeout, BROKEN_GRACE)
-        self.shutdown(wait=False)
+        shutdown = threading.Thread(target=self.shutdown, name="whirl-pool-shutdown",
+                                    daemon=True)
+        shutdown.start()
         deadline = time.monotonic() + timeout
         for process in workers:
             process.join(max(0.0, deadline - time.monotonic()))
@@ -85,8 +97,7 @@ class LocalPool(ProcessPoolExecutor):
             if process.is_alive():
                 process.kill()
                 process.join(5)
-        if manager is not None:
-            manager.join(5)
+        shutdown.join(5)
 
     def interrupt(self) -> None:
         self.cancelled.set()

@@ -1,7 +1,8 @@
 """The exception SIGINT and SIGTERM raise in whirl, and SIGTERM's handler from the first moment.
 
-Only :mod:`signal` is imported here: :func:`whirl_cli.entry.main` installs
-:func:`raise_interrupted` for SIGTERM before it imports anything else, so that a batch system's
+Only :mod:`signal` is imported here (and light modules by the package):
+:func:`whirl_cli.entry.main` installs :func:`raise_interrupted` for SIGTERM before it imports
+anything else, so that a batch system's
 cancel ends whirl as Ctrl-C does (Python's own handler raises KeyboardInterrupt for SIGINT)
 instead of by the signal's default action, however early it lands.
 """
@@ -24,6 +25,19 @@ class Interrupted(KeyboardInterrupt):
         signal's name, which is no signal number): an interrupt raised in a worker process
         must reach the parent intact, or the process pool breaks."""
         return type(self), (self.signum,)
+
+
+def wrapped_interrupt(error: BaseException) -> KeyboardInterrupt | None:
+    """The interrupt that caused ``error`` (its ``__cause__`` or ``__context__``, at any
+    depth), if any: Python turns an interrupt raised inside some of its hooks into another
+    exception (3.11: a RuntimeError for one inside ``__set_name__``)."""
+    seen: set[int] = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, KeyboardInterrupt):
+            return error
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return None
 
 
 def raise_interrupted(signum: int, _frame: object) -> None:
