@@ -11,3 +11,7 @@ PLOT_KINDS = ("bifurcation", "linear", "root_locus", "damping_multiples", "proje
 
 #: The plot kinds drawn from a continuation's ``explore:`` classifications.
 MOTION_KINDS = ("poincare", "spectrum", "orbit_diagram")
+
+#: The kinds of locus (a two-parameter continuation's ``loci``) that bound the unsafe region
+#: by folds: of equilibria and of cycles.
+FOLD_LOCI = ("fold", "fold_of_cycles")

@@ -21,9 +21,18 @@ Either way the results are stored, with each branch's and run's status and messa
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
-from .results import OTHER_END, STEP_LIMIT, Branch, ContinuationResult, StudyResult
+from .kinds import FOLD_LOCI
+from .results import (
+    OTHER_END,
+    STEP_LIMIT,
+    Boundary,
+    Branch,
+    ContinuationResult,
+    StudyResult,
+)
 
 
 @dataclass(frozen=True)
@@ -93,3 +102,30 @@ def verdict(result: StudyResult, plot_error: str = "") -> Verdict:
     problems += [unjudged_seeds(c) for c in result.continuations if seeds_found_nothing(c)]
     problems += [plot_error] if plot_error else []
     return Verdict(tuple(problems), notes)
+
+
+def range_warnings(found: Boundary, tolerance: float = 1e-6) -> tuple[str, ...]:
+    """Where ``found``'s unsafe region may reach past its range: an unsafe interval ending at
+    an edge of the first parameter's range (within ``tolerance`` of its span), and a fold or
+    fold-of-cycles locus ending there (the intervals it bounds are then never formed). None
+    for a boundary whose range is not known (older files)."""
+    low, high = found.first_range
+    if not (math.isfinite(low) and math.isfinite(high)):
+        return ()
+    first, second = found.parameter_names
+    near = tolerance * (high - low)
+
+    def edge(value: float) -> bool:  # on the edge, or past it (a locus's last step may be)
+        return value <= low + near or value >= high - near
+
+    warnings = [f"{found.name}: the unsafe interval {i.lower:.6g} < {first} < {i.upper:.6g} "
+                f"at {second} = {i.slice_value:.6g} ends at the edge of the range of {first} "
+                f"[{low:g}, {high:g}]: the region may extend beyond it"
+                for i in found.intervals if edge(i.lower) or edge(i.upper)]
+    for name, (kind, curve) in found.loci.items():
+        ends = [point for point in (curve[[0, -1]] if len(curve) else ())
+                if kind in FOLD_LOCI and edge(point[0])]
+        warnings += [f"{found.name}: the {kind.replace('_', ' ')} locus {name} leaves the range "
+                     f"of {first} at {first} = {p[0]:.6g}, {second} = {p[1]:.6g}: unsafe "
+                     "intervals it bounds beyond are not formed" for p in ends]
+    return tuple(warnings)

@@ -8,10 +8,10 @@ from __future__ import annotations
 import h5py
 import numpy as np
 
-from whirl_cli.analysis.boundaries import range_warnings
 from whirl_cli.output import store
 from whirl_cli.output.summary import tables
 from whirl_cli.results import Boundary, ContinuationResult, StudyResult, UnsafeInterval
+from whirl_cli.verdict import range_warnings
 
 
 def boundary(intervals, loci, first_range=(-0.3, 0.5)) -> Boundary:

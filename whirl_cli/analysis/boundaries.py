@@ -286,34 +286,3 @@ def boundary(name: str, model: Model, overrides: dict[str, float], pair: tuple[s
     return Boundary(name, pair, tuple(model.parameter(p).unit for p in pair), method, loci,
                     tuple(intervals), tuple(polygons(intervals, rows)), tuple(slices),
                     tuple(map(float, bounds[first])), tuple(map(float, bounds[second])))
-
-
-#: Locus kinds whose leaving the range leaves unsafe intervals unformed (their other end).
-FOLD_KINDS = ("fold", "fold_of_cycles")
-
-
-def range_warnings(found: Boundary, tolerance: float = 1e-6) -> tuple[str, ...]:
-    """Where ``found``'s unsafe region may reach past its range: an unsafe interval ending at
-    an edge of the first parameter's range (within ``tolerance`` of its span), and a fold or
-    fold-of-cycles locus ending there (the intervals it bounds are then never formed). None
-    for a boundary whose range is not known (older files)."""
-    low, high = found.first_range
-    if not np.isfinite([low, high]).all():
-        return ()
-    first, second = found.parameter_names
-    near = tolerance * (high - low)
-
-    def edge(value: float) -> bool:  # on the edge, or past it (a locus's last step may be)
-        return value <= low + near or value >= high - near
-
-    warnings = [f"{found.name}: the unsafe interval {i.lower:.6g} < {first} < {i.upper:.6g} "
-                f"at {second} = {i.slice_value:.6g} ends at the edge of the range of {first} "
-                f"[{low:g}, {high:g}]: the region may extend beyond it"
-                for i in found.intervals if edge(i.lower) or edge(i.upper)]
-    for name, (kind, curve) in found.loci.items():
-        ends = [point for point in (curve[[0, -1]] if len(curve) else ())
-                if kind in FOLD_KINDS and edge(point[0])]
-        warnings += [f"{found.name}: the {kind.replace('_', ' ')} locus {name} leaves the range "
-                     f"of {first} at {first} = {p[0]:.6g}, {second} = {p[1]:.6g}: unsafe "
-                     "intervals it bounds beyond are not formed" for p in ends]
-    return tuple(warnings)

@@ -190,6 +190,8 @@ BOUNDARY = (
     Field("parameter_names", "attribute", "text", key="parameters"),
     Field("parameter_units", "attribute", "text", key="units"),
     Field("method", "attribute", "text"), Field("slices", "attribute", "float"),
+    Field("first_range", "attribute", "float", default=(np.nan, np.nan)),
+    Field("second_range", "attribute", "float", default=(np.nan, np.nan)),
 )
 #: The :class:`UnsafeInterval` table of a boundary (``unsafe_intervals/``).
 UNSAFE_INTERVAL = (

@@ -25,7 +25,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.boundaries import range_warnings
 from ..results import (
     Branch,
     ContinuationResult,
@@ -35,7 +34,7 @@ from ..results import (
     positions,
 )
 from ..units import axis_label, display_unit
-from ..verdict import truncation, unjudged_seeds
+from ..verdict import range_warnings, truncation, unjudged_seeds
 
 FORMATS = ("table", "csv", "json")
 """Formats of ``whirl summary --format``."""
