@@ -213,3 +213,26 @@ def test_only_a_branch_stopped_at_the_step_limit_fails_the_study(end, truncated)
     assert b.truncated is truncated
     assert len(problems) == truncated
     assert all(p.startswith("p stopped at the step limit") for p in problems)
+
+
+def test_point_type_codes_are_named_in_the_file(tmp_path):
+    """A reader with h5py alone can name every point type: the point_type datasets of a
+    branch and of the special points carry flag_values and flag_meanings (CF style) that
+    map each stored code to its name."""
+    import h5py
+
+    main = branch("main_down", "equilibrium", 4)
+    point = results.SpecialPoint("main_down", 3, results.PointType.HB, ("V",),
+                                 np.array([1.0]), np.zeros(2), 0.5, True)
+    result = results.StudyResult("s", "m", (results.ContinuationResult(
+        "c", "one-parameter", (main,), (point,)),), (), ())
+    path = store.write(result, tmp_path / "r.h5")
+    with h5py.File(path) as handle:
+        for key in ("continuations/c/branches/main_down/point_type",
+                    "continuations/c/special_points/point_type"):
+            dataset = handle[key]
+            names = dict(zip(dataset.attrs["flag_values"].tolist(),
+                             dataset.attrs["flag_meanings"].split(), strict=True))
+            assert names[3] == "HB" and names[101] == "HOMOCLINIC" and names[0] == "REGULAR"
+            assert all(names[int(code)] == results.PointType(int(code)).name
+                       for code in dataset[()])

@@ -48,7 +48,10 @@ class Field:
     reading: an int is a fixed size; a name is the size every dataset of the group naming
     it shares or, for a ``columns`` names field, the number of its names. ``derived``:
     written from the object's attribute of that name, never read (e.g. a point type's name
-    beside its code).
+    beside its code). ``codes``: an IntEnum whose members the integer dataset holds, written
+    beside it as the attributes ``flag_values`` and ``flag_meanings`` (the CF conventions'
+    pair: the codes and their names, space-separated), so that a reader of the file alone
+    can name them.
     """
 
     name: str
@@ -62,6 +65,7 @@ class Field:
     default: Any = REQUIRED
     derived: bool = False
     shape: tuple[int | str, ...] | None = None
+    codes: Any = None
 
     def hdf5_key(self, kind: str = "") -> str:
         return _choose(self.key, kind) or self.name
@@ -201,6 +205,14 @@ def _attach(dataset: h5py.Dataset, field: Field, obj, kind: str) -> None:
         dataset.attrs["units"] = getattr(obj, field.unit_field)
     elif field.hdf5_units(kind) is not None:
         dataset.attrs["units"] = field.hdf5_units(kind)
+    _name_codes(dataset, field)
+
+
+def _name_codes(dataset: h5py.Dataset, field: Field) -> None:
+    """The ``flag_values``/``flag_meanings`` of a field with ``codes`` (see :class:`Field`)."""
+    if field.codes is not None:
+        dataset.attrs["flag_values"] = np.array([int(c) for c in field.codes], dtype=np.int64)
+        dataset.attrs["flag_meanings"] = " ".join(c.name for c in field.codes)
 
 
 def _attribute(field: Field, value):
@@ -303,6 +315,7 @@ def write_table(group: h5py.Group, rows: Sequence, fields: Sequence[Field],
                 dataset.attrs["units"] = list(getattr(rows[0], units)) if rows else []
         elif field.hdf5_units() is not None:
             dataset.attrs["units"] = field.hdf5_units()
+        _name_codes(dataset, field)
         dataset.attrs.update(attributes.get(field.name, {}))
 
 

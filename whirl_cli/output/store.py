@@ -44,6 +44,7 @@ from ..results import (
     LinearSweep,
     Orbit,
     ParameterValue,
+    PointType,
     RunRecord,
     SeedOutcome,
     Simulation,
@@ -88,7 +89,7 @@ BRANCH = (
     Field("stable", kind="bool", shape=("points",)),
     Field("stability_known", kind="bool", default=None,  # older files: known everywhere
           shape=("points",)),
-    Field("point_type", kind="int", shape=("points",)),
+    Field("point_type", kind="int", shape=("points",), codes=PointType),
     Field("label", kind="int", shape=("points",)),
     Field("eigenvalues",
           key=lambda kind: "floquet_multipliers" if kind == _PERIODIC else "eigenvalues",
@@ -105,7 +106,8 @@ ORBIT = (
 #: The :class:`SpecialPoint` table of a continuation (``special_points/``), one column each.
 SPECIAL_POINT = (
     Field("branch", kind="text"), Field("index", kind="int"),
-    Field("point_type", kind="int"), Field("type_name", kind="text", derived=True),
+    Field("point_type", kind="int", codes=PointType),
+    Field("type_name", kind="text", derived=True),
     Field("label", kind="int"),
     Field("parameters", width="parameters", columns=("parameter_names", "parameter_units")),
     Field("state", width="states"),  # names and units: the continuation's states
