@@ -100,7 +100,7 @@ def settle(model: Model, params: np.ndarray, seed: np.ndarray, max_periods: int 
         times, points = returns(t, y, dofs, amplitudes)
         judged = judge(times, points, tolerance)
         if judged.lag:
-            orbit = _orbit(t, y, times[-1 - judged.lag], times[-1])
+            orbit = _orbit(t, y, *_one_period(t, y, times[-1] - times[-1 - judged.lag]))
             crossings = f", {judged.lag} returns a period" if judged.lag > 1 else ""
             return Settled("periodic", seed, state, orbit,
                            f"period {orbit.period:.6g} s{crossings}, returns repeat to "
@@ -176,6 +176,21 @@ def judge(times: np.ndarray, points: np.ndarray, tolerance: float) -> Judged:
         lags = np.max(np.abs(points[converging:] - points[:-converging]), axis=1)
         return Judged(0, float(lags[-1]), rate, step)
     return Judged(0, float(distance), np.nan, step)
+
+
+def _one_period(t: np.ndarray, y: np.ndarray, period: float) -> tuple[float, float]:
+    """(begin, end) of the orbit handed to AUTO: the last upward crossing of the first state
+    through its mean over the last half, and the crossing nearest one ``period`` before it
+    (both linearly interpolated): a fixed phase whatever dof the return map watches (AUTO's
+    continuation from the orbit, its first steps, depends on where the orbit starts)."""
+    x = y[:, 0] - y[len(y) // 2:, 0].mean()
+    up = np.flatnonzero((x[:-1] < 0) & (x[1:] >= 0))
+    share = -x[up] / (x[up + 1] - x[up])
+    crossings = t[up] + share * (t[up + 1] - t[up])
+    if len(crossings) < 2:
+        return float(t[-1] - period), float(t[-1])
+    end = float(crossings[-1])
+    return float(crossings[np.argmin(np.abs(crossings - (end - period)))]), end
 
 
 def _orbit(t: np.ndarray, y: np.ndarray, begin: float, end: float) -> Orbit:
