@@ -55,7 +55,8 @@ def test_titles_name_the_study_and_its_fixed_parameters(hardening):
 def test_axis_labels_carry_units(hardening):
     drawn = figures(hardening, ("bifurcation", "period", "phase"))
     ax = drawn["x_k1_bifurcation.png"].axes[0]
-    assert (ax.get_xlabel(), ax.get_ylabel()) == ("$K_{\\theta}$ [N m/rad]", "$\\theta$ (max) [deg]")
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("$K_{\\theta}$ [N m/rad]",
+                                                  "$\\theta$ (max) [deg]")
     ax = drawn["x_k1_period.png"].axes[0]
     assert (ax.get_xlabel(), ax.get_ylabel()) == ("$K_{\\theta}$ [N m/rad]", "period [s]")
     ax = drawn["x_k1_periodic_1_phase.png"].axes[0]

@@ -487,7 +487,8 @@ def test_projections_odd_state_count_in_radians(continuation):
                   special_points=tuple(replace(p, state=p.state[:3])
                                        for p in continuation.special_points))
     axes = projections_figure(cut, which=("max", "min"), degrees=False).axes
-    assert [ax.get_ylabel() for ax in axes] == ["$\\theta$ (max, min) [rad]", "$\\psi$ (max, min) [rad]",
+    assert [ax.get_ylabel() for ax in axes] == ["$\\theta$ (max, min) [rad]",
+                                                "$\\psi$ (max, min) [rad]",
                                                 "dtheta (max, min) [rad/s]"]
     assert [ax.get_xlabel() for ax in axes] == ["", "K1 [N m/rad]", "K1 [N m/rad]"]
     ys = np.concatenate([line.get_ydata() for line in branch_lines(axes[0])])

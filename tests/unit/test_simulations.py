@@ -317,7 +317,8 @@ def test_a_stopped_simulation_says_why_in_the_title(model):
 def test_the_title_names_the_study_its_fixed_and_the_simulation_s_parameters(model):
     captions = Captions("study", (Fixed("K_psi", 0.3, "N m/rad"), Fixed("V", 6.7, "m/s")))
     found = a_simulation(model, {"V": 7.9}, name="pitch")
-    assert captions.simulation_title(found) == "study: $K_{\\psi}$ = 0.3 N m/rad, V = 7.9 m/s\npitch"
+    assert captions.simulation_title(found) == \
+        "study: $K_{\\psi}$ = 0.3 N m/rad, V = 7.9 m/s\npitch"
     plain = a_simulation(model, {}, name="p")
     assert Captions("study").simulation_title(plain) == "study\np"
     assert Captions("study").simulation_title(found) == "study: V = 7.9 m/s\npitch"
