@@ -260,7 +260,7 @@ def test_plots_drawn_with_the_model_states(cli_run):
 
 def test_bifurcation_diagram_of_the_first_dof_by_default(continuation):
     ax = bifurcation_diagram(continuation).axes[0]
-    assert (ax.get_xlabel(), ax.get_ylabel()) == ("alpha [1/s]", "q1 (max) [m]")
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("$\\alpha$ [1/s]", "q1 (max) [m]")
     hopf = next(line for line in ax.lines if line.get_marker() == "s")
     np.testing.assert_allclose(sorted(hopf.get_xdata()), sorted(HOPFS), atol=1e-6 * WIDTH)
     np.testing.assert_array_equal(hopf.get_ydata(), 0.0)

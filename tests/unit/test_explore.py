@@ -219,7 +219,7 @@ def test_poincare_plot_draws_every_value_in_degrees_with_its_class():
     assert len(ax.collections[1].get_offsets()) == 0
     assert [t.get_text() for t in ax.get_legend().get_texts()] == [
         "K_theta = 0.24: periodic", "K_theta = 0.45: equilibrium", "K_theta = 0.3: chaotic"]
-    assert (ax.get_xlabel(), ax.get_ylabel()) == ("theta [deg]", "psi [deg]")
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("$\\theta$ [deg]", "$\\psi$ [deg]")
 
 
 def test_orbit_diagram_draws_section_values_over_the_branches(continuation):  # noqa: F811
@@ -240,7 +240,7 @@ def test_orbit_diagram_draws_section_values_over_the_branches(continuation):  # 
     assert "stable equilibrium" in labels  # the bifurcation diagram under it
     assert {"periodic (simulation)", "equilibrium (simulation)",
             "chaotic (simulation)"} <= set(labels)
-    assert ax.get_xlabel() == "K_theta [N m/rad]"
+    assert ax.get_xlabel() == "$K_{\\theta}$ [N m/rad]"
     alone = orbit_diagram(drawn, branches=False).axes[0]
     assert "stable equilibrium" not in [t.get_text() for t in alone.get_legend().get_texts()]
 

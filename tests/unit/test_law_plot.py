@@ -38,7 +38,7 @@ def test_freeplay_law_smoothed_exact_and_their_largest_difference():
     assert abs(x[np.argmax(error)]) == pytest.approx(DELTA)  # at the corners
     assert x.max() == pytest.approx(4 * DELTA)
     ax = figure.axes[0]
-    assert ax.get_xlabel() == "theta [deg]"
+    assert ax.get_xlabel() == "$\\theta$ [deg]"
     assert ax.get_ylabel() == "restoring force on theta [N m]"
     assert "freeplay law on theta" in ax.get_title()
 

@@ -38,7 +38,7 @@ def figures(result, kinds, **view):
 def test_titles_name_the_study_and_its_fixed_parameters(hardening):
     study = yaml.safe_load(hardening.attributes["study_yaml"])
     assert study["parameters"] == {"K_psi": 0.3}  # what the title must say, in N m/rad
-    want = f"{study['name']}: K_psi = 0.3 N m/rad"
+    want = f"{study['name']}: $K_{{\\psi}}$ = 0.3 N m/rad"
     drawn = figures(hardening, ("bifurcation", "projections", "period", "phase"))
     assert set(drawn) == {"x_k1_bifurcation.png", "x_k1_projections.png", "x_k1_period.png",
                           "x_k1_periodic_1_phase.png", "x_k1_periodic_3_phase.png",
@@ -55,11 +55,12 @@ def test_titles_name_the_study_and_its_fixed_parameters(hardening):
 def test_axis_labels_carry_units(hardening):
     drawn = figures(hardening, ("bifurcation", "period", "phase"))
     ax = drawn["x_k1_bifurcation.png"].axes[0]
-    assert (ax.get_xlabel(), ax.get_ylabel()) == ("K_theta [N m/rad]", "theta (max) [deg]")
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("$K_{\\theta}$ [N m/rad]",
+                                                  "$\\theta$ (max) [deg]")
     ax = drawn["x_k1_period.png"].axes[0]
-    assert (ax.get_xlabel(), ax.get_ylabel()) == ("K_theta [N m/rad]", "period [s]")
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("$K_{\\theta}$ [N m/rad]", "period [s]")
     ax = drawn["x_k1_periodic_1_phase.png"].axes[0]
-    assert (ax.get_xlabel(), ax.get_ylabel()) == ("theta [deg]", "psi [deg]")
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("$\\theta$ [deg]", "$\\psi$ [deg]")
 
 
 def test_a_study_at_datum_is_titled_by_its_name_alone():
@@ -128,9 +129,9 @@ def test_slices_are_labelled_by_the_study():
                                                 "thesis case 2", "case 1"]
     assert ax.get_title() == "boundary-linear"  # K_psi, its only override, is varied here
     overhang = drawn["x_boundary_slice_1_overhang.png"].axes[0]
-    assert overhang.get_title() == "boundary-linear\nthesis case 2: K_psi = 0.3 N m/rad"
+    assert overhang.get_title() == "boundary-linear\nthesis case 2: $K_{\\psi}$ = 0.3 N m/rad"
     assert drawn["x_boundary_slice_0_overhang.png"].axes[0].get_title() == \
-        "boundary-linear\ncase 1: K_psi = 0.4 N m/rad"
+        "boundary-linear\ncase 1: $K_{\\psi}$ = 0.4 N m/rad"
 
 
 def test_without_a_valid_stored_study_titles_are_the_study_name(hardening):

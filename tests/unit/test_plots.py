@@ -261,7 +261,7 @@ def test_y_data_are_degrees(continuation):
     periodic = [line for line in branch_lines(ax) if line_style(line)[0] in ("red", "blue")]
     ys = np.concatenate([line.get_ydata() for line in periodic])
     np.testing.assert_allclose(np.sort(np.unique(ys)), np.degrees([0.0, 0.1, 0.2, 0.3, 0.4]))
-    assert ax.get_ylabel() == "theta (max) [deg]"
+    assert ax.get_ylabel() == "$\\theta$ (max) [deg]"
     assert ax.get_xlabel() == "K1 [N m/rad]"
     assert ax.get_title() == "hopf_K1"
 
@@ -270,7 +270,7 @@ def test_radians_when_degrees_false(continuation):
     ax = bifurcation_diagram(continuation, degrees=False).axes[0]
     ys = np.concatenate([line.get_ydata() for line in branch_lines(ax)])
     assert np.max(ys) == pytest.approx(0.4)
-    assert ax.get_ylabel() == "theta (max) [rad]"
+    assert ax.get_ylabel() == "$\\theta$ (max) [rad]"
 
 
 def test_rate_state_in_deg_per_second(continuation):
@@ -307,7 +307,7 @@ def test_min_drawn_for_periodic_only(continuation):
     assert len(periodic) == 4 and len(equilibrium) == 2
     ys = np.concatenate([line.get_ydata() for line in periodic])
     assert np.min(ys) == pytest.approx(np.degrees(-0.4))
-    assert ax.get_ylabel() == "theta (max, min) [deg]"
+    assert ax.get_ylabel() == "$\\theta$ (max, min) [deg]"
 
 
 def test_special_point_markers(continuation):
@@ -341,7 +341,7 @@ def test_legend_without_periodic_or_points():
     result = ContinuationResult("eq", "one-parameter", (equilibrium,), ())
     ax = bifurcation_diagram(result).axes[0]
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["stable equilibrium"]
-    assert ax.get_ylabel() == "theta [deg]"
+    assert ax.get_ylabel() == "$\\theta$ [deg]"
 
 
 def test_all_markers_of_the_key():
@@ -464,7 +464,7 @@ def test_projections_one_axes_per_state(continuation):
     figure = projections_figure(continuation)
     axes = figure.axes
     assert len(axes) == 4
-    assert [ax.get_ylabel() for ax in axes] == ["theta (max) [deg]", "psi (max) [deg]",
+    assert [ax.get_ylabel() for ax in axes] == ["$\\theta$ (max) [deg]", "$\\psi$ (max) [deg]",
                                                 "dtheta (max) [deg/s]", "dpsi (max) [deg/s]"]
     # theta max reaches 0.4 rad, the other states 0.1 * theta (rad or rad/s)
     for ax, top in zip(axes, [0.4, 0.04, 0.04, 0.04], strict=True):
@@ -487,7 +487,8 @@ def test_projections_odd_state_count_in_radians(continuation):
                   special_points=tuple(replace(p, state=p.state[:3])
                                        for p in continuation.special_points))
     axes = projections_figure(cut, which=("max", "min"), degrees=False).axes
-    assert [ax.get_ylabel() for ax in axes] == ["theta (max, min) [rad]", "psi (max, min) [rad]",
+    assert [ax.get_ylabel() for ax in axes] == ["$\\theta$ (max, min) [rad]",
+                                                "$\\psi$ (max, min) [rad]",
                                                 "dtheta (max, min) [rad/s]"]
     assert [ax.get_xlabel() for ax in axes] == ["", "K1 [N m/rad]", "K1 [N m/rad]"]
     ys = np.concatenate([line.get_ydata() for line in branch_lines(axes[0])])
@@ -620,7 +621,7 @@ def test_phase_plane_closed_curves_in_degrees(orbit_branch):
     assert [line.get_linestyle() for line in ax.lines] == ["-", ":"]
     assert [t.get_text() for t in ax.get_legend().get_texts()] == [
         "K1 = 0.1234 (stable)", "K1 = 0.35 (unstable)"]
-    assert ax.get_xlabel() == "theta [deg]" and ax.get_ylabel() == "psi [deg]"
+    assert ax.get_xlabel() == "$\\theta$ [deg]" and ax.get_ylabel() == "$\\psi$ [deg]"
     assert ax.get_aspect() == 1.0
     assert ax.get_title() == "periodic_1"
 
@@ -785,7 +786,7 @@ def test_boundary_plot_linear_contour_styles():
 
 def test_boundary_plot_grid_only_labels_limits_and_legend():
     ax = boundary_plot(None, make_grid()).axes[0]
-    assert ax.get_xlabel() == "K1 [N m/rad]" and ax.get_ylabel() == "K_psi [N m/rad]"
+    assert ax.get_xlabel() == "K1 [N m/rad]" and ax.get_ylabel() == "$K_{\\psi}$ [N m/rad]"
     assert ax.get_xlim() == (0.0, 1.0) and ax.get_ylim() == (0.0, 0.5)
     assert legend_labels(ax) == ["linearly unstable", "linear boundary (flutter)",
                                  "linear boundary (divergence)"]
@@ -854,7 +855,7 @@ def test_boundary_plot_boundary_only_legend_and_limits():
     # extent of the loci (x 0..0.45, y 0..0.35) with a 2 % margin
     np.testing.assert_allclose(ax.get_xlim(), [-0.009, 0.459])
     np.testing.assert_allclose(ax.get_ylim(), [-0.007, 0.357])
-    assert ax.get_xlabel() == "K1 [N m/rad]" and ax.get_ylabel() == "K_psi [N m/rad]"
+    assert ax.get_xlabel() == "K1 [N m/rad]" and ax.get_ylabel() == "$K_{\\psi}$ [N m/rad]"
 
 
 def test_boundary_plot_transposes_a_swapped_grid():
@@ -922,7 +923,7 @@ def test_overhang_diagram_bands_at_interval_edges(continuation):
         "stable equilibrium", "unstable equilibrium", "stable periodic", "unstable periodic",
         "Hopf (HB)", "branch point (BP, BPC)", "fold (LP, LPC)", "unsafe (overhang)"]
     assert ax.get_title() == "kk: K_psi = 0.2"
-    assert ax.get_xlabel() == "K1 [N m/rad]" and ax.get_ylabel() == "theta (max) [deg]"
+    assert ax.get_xlabel() == "K1 [N m/rad]" and ax.get_ylabel() == "$\\theta$ (max) [deg]"
     # the slice's branches only, as in a plain bifurcation diagram
     plain = bifurcation_diagram(continuation).axes[0]
     assert len(ax.lines) == len(plain.lines)
@@ -943,7 +944,7 @@ def test_overhang_diagram_one_parameter(continuation):
     ax = overhang_diagram(continuation, make_boundary(), 0.2, which=("max", "min"),
                           degrees=False).axes[0]
     assert bands(ax) == [pytest.approx((0.1, 0.25)), pytest.approx((0.32, 0.35))]
-    assert ax.get_ylabel() == "theta (max, min) [rad]"
+    assert ax.get_ylabel() == "$\\theta$ (max, min) [rad]"
     assert legend_labels(ax)[-1] == "unsafe (overhang)"
     ax = overhang_diagram(continuation, None, 0.2).axes[0]
     assert len(ax.patches) == 0 and ax.get_title() == "hopf_K1"

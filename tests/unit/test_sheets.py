@@ -95,7 +95,7 @@ PANEL = "panels:\n  - {kind: bifurcation, study: a.yaml}\n"
      ["f.yaml:4: panels[0].orbits[0]: must be >= 1, got 0"]),
     ("panels:\n  - {kind: bifurcation, study: a.yaml, colour: red}\n",
      ["f.yaml:4: panels[0].colour: unknown key (allowed: kind, study, overlay, continuation, "
-      "branch, state, sweep, slice, orbits, simulation, hz, title)"]),
+      "branch, state, sweep, slice, orbits, simulation, hz, title, cuts)"]),
     ("panels: []\n", ["f.yaml:3: panels: expected 1 to 64 panels, got 0"]),
 ])
 def test_numeric_sheet_keys_are_bounded_and_each_problem_is_said_once(tmp_path, body,
@@ -176,7 +176,7 @@ def test_overlay_one_colour_per_result_labelled_by_what_differs(continuation):  
     assert len(colours) == 3  # one per result; stability by line style
     styles = {line.get_linestyle() for line in branch_lines(ax)}
     assert styles == {"-", ":"}
-    assert ax.get_title() == "K_psi = 0.3 N m/rad"  # the parameter they share, not K2
+    assert ax.get_title() == "$K_{\\psi}$ = 0.3 N m/rad"  # the parameter they share, not K2
     with pytest.raises(WhirlError, match="cannot be overlaid"):
         draw_overlay(results, "period", ax)
 
@@ -259,7 +259,7 @@ def test_simulation_panels_one_axes_per_dof_and_a_hub_path(continuation):  # noq
     result = replace(result_with(continuation, 10.0), simulations=(simulation,))
     history = draw(result, "time_history", _new_figure().add_subplot(),
                    PanelChoice(simulation="kick"))
-    assert [ax.get_ylabel() for ax in history] == ["theta [deg]", "psi [deg]"]
+    assert [ax.get_ylabel() for ax in history] == ["$\\theta$ [deg]", "$\\psi$ [deg]"]
     np.testing.assert_allclose(history[0].lines[0].get_ydata(), np.degrees(states[:, 0]))
     (hub,) = draw(result, "hub_path", _new_figure().add_subplot())
     assert hub.get_xlabel() == "hub y [deg]"

@@ -258,7 +258,7 @@ def test_time_history_draws_one_panel_per_dof_in_degrees(model):
     figure = time_history(found, title="study: V = 7.9 m/s\ns1")
     axes = figure.axes
     assert len(axes) == 2
-    assert [ax.get_ylabel() for ax in axes] == ["theta [deg]", "psi [deg]"]
+    assert [ax.get_ylabel() for ax in axes] == ["$\\theta$ [deg]", "$\\psi$ [deg]"]
     assert axes[-1].get_xlabel() == "t [s]"
     assert axes[0].get_title() == "study: V = 7.9 m/s\ns1"
     for k, ax in enumerate(axes):
@@ -317,7 +317,8 @@ def test_a_stopped_simulation_says_why_in_the_title(model):
 def test_the_title_names_the_study_its_fixed_and_the_simulation_s_parameters(model):
     captions = Captions("study", (Fixed("K_psi", 0.3, "N m/rad"), Fixed("V", 6.7, "m/s")))
     found = a_simulation(model, {"V": 7.9}, name="pitch")
-    assert captions.simulation_title(found) == "study: K_psi = 0.3 N m/rad, V = 7.9 m/s\npitch"
+    assert captions.simulation_title(found) == \
+        "study: $K_{\\psi}$ = 0.3 N m/rad, V = 7.9 m/s\npitch"
     plain = a_simulation(model, {}, name="p")
     assert Captions("study").simulation_title(plain) == "study\np"
     assert Captions("study").simulation_title(found) == "study: V = 7.9 m/s\npitch"

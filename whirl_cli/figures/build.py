@@ -136,10 +136,26 @@ def make_figures(paths: Sequence[str | os.PathLike[str]], out_dir: Path, results
     outcomes = [artist.outcome(sheet) for sheet in sheets]
     outcomes += [FigureOutcome(sheet, None, sheet.problem) for sheet in refused]
     outcomes.sort(key=lambda o: figure_order(o.sheet.figure))
-    page = index_html([_entry(o, out_dir) for o in outcomes], "whirl figures")
+    page = index_html([_entry(o, out_dir) for o in outcomes], "whirl figures",
+                      _about(artist.read.values()))
     publish(page.encode("utf-8"), out_dir / "index.html", overwrite=True, what="the index",
             own=PAGE)
     return outcomes
+
+
+def _about(results) -> dict[str, str]:
+    """whirl's version, commit and AUTO engine as the result files drawn record them (each
+    distinct value once; this whirl's version when no result was read)."""
+    from .. import __version__
+
+    names = {"whirl_version": "whirl", "git_describe": "commit", "auto_version": "engine"}
+    about = {}
+    for key, name in names.items():
+        values = sorted({str(r.attributes[key]) for r in results if r.attributes.get(key)})
+        if values:
+            about[name] = ", ".join(values)
+    about.setdefault("whirl", __version__)
+    return about
 
 
 def _make_folder(out_dir: Path) -> None:

@@ -38,10 +38,57 @@ def draw_sheet(sheet: Sheet, results: Mapping[Path, StudyResult]) -> Figure:
         for ax in figure.axes[1:]:
             if ax.get_legend() is not None:
                 ax.get_legend().remove()
+    elif sheet.legends == "figure":
+        figure_legend(figure)
+    share_limits(figure.axes, sheet.share)
     width = max(40, int(size[0] * 14))
     figure.suptitle(textwrap.fill(f"Figure {sheet.figure}: {sheet.caption}", width),
                     fontsize="medium")
     return figure
+
+
+_CHAR_INCHES = 0.075  # width of a character of a small legend text (an upper bound)
+_ENTRY_INCHES = 0.7  # a legend entry's handle and gaps
+
+
+def figure_legend(figure: Figure) -> None:
+    """The panels' legends as one legend of ``figure`` below its panels: every entry once
+    (by its label, the first panel's artist), the panels' own legends removed."""
+    entries: dict[str, object] = {}
+    for ax in figure.axes:
+        legend = ax.get_legend()
+        if legend is None:
+            continue
+        for handle, text in zip(legend.legend_handles, legend.get_texts(), strict=False):
+            entries.setdefault(text.get_text(), handle)
+        legend.remove()
+    if not entries:
+        return
+    width = figure.get_size_inches()[0]
+    longest = max(len(label) for label in entries)
+    columns = max(1, min(len(entries), int(0.95 * width / (_ENTRY_INCHES + _CHAR_INCHES
+                                                               * longest))))
+    figure.legend(list(entries.values()), list(entries), loc="outside lower center",
+                  ncols=columns, fontsize="small", frameon=False)
+
+
+def share_limits(axes, share: str) -> None:
+    """Give the axes that show the same quantity (the same axis label) the union of their
+    limits on x (``share`` "x" or "both") and on y ("y" or "both")."""
+    for axis in ("x", "y"):
+        if share not in (axis, "both"):
+            continue
+        groups: dict[str, list] = {}
+        for ax in axes:
+            label = getattr(ax, f"get_{axis}label")()
+            if label and ax.has_data():
+                groups.setdefault(label, []).append(ax)
+        for group in groups.values():
+            limits = [getattr(ax, f"get_{axis}lim")() for ax in group]
+            low = min(min(lim) for lim in limits)
+            high = max(max(lim) for lim in limits)
+            for ax in group:
+                getattr(ax, f"set_{axis}lim")(low, high)
 
 
 def _draw_panel(sheet: Sheet, panel: PanelSpec, results: Mapping[Path, StudyResult], ax
@@ -49,7 +96,7 @@ def _draw_panel(sheet: Sheet, panel: PanelSpec, results: Mapping[Path, StudyResu
     choice = PanelChoice(continuation=panel.continuation, branch=panel.branch,
                          state=panel.state, sweep=panel.sweep, slice=panel.slice,
                          orbits=panel.orbits, simulation=panel.simulation, hz=panel.hz,
-                         title=panel.title)
+                         title=panel.title, cuts=panel.cuts)
     if panel.overlay:
         members = [results[sheet.resolve(m.study)] for m in panel.overlay]
         draw_overlay(members, panel.kind, ax, [m.label for m in panel.overlay], choice,

@@ -35,6 +35,7 @@ from ..study.messages import _report, _translate
 from ..study.schema import (
     Boolean,
     Integer,
+    Number,
     Text,
     _as_number,
     _at_most_orbits,
@@ -51,6 +52,15 @@ PANEL_SIZE = (5.2, 4.2)
 """Default width and height of one panel, inches."""
 INCHES = (1.0, 40.0)
 """Smallest and largest width or height of a figure, inches (40 in: 6000 pixels at 150 dpi)."""
+
+
+_MAX_CUTS = 8
+
+
+def _at_most_cuts(value: tuple) -> tuple:
+    if not 1 <= len(value) <= _MAX_CUTS:
+        _fail(f"expected 1 to {_MAX_CUTS} values, got {len(value)}")
+    return value
 
 
 def _as_figure(value: str) -> str:
@@ -111,6 +121,9 @@ class PanelSpec(_Strict):
         None, description="Simulation of a `time_history` or `hub_path` panel; unset: the first.")
     hz: Boolean = Field(False, description="Frequencies in Hz.")
     title: Text | None = Field(None, description="Panel title; unset: the study's.")
+    cuts: Annotated[tuple[Number, ...], AfterValidator(_at_most_cuts)] | None = Field(
+        None, description="Parameter values: a `phase` panel draws every solution at each "
+        f"(a grid of phase planes, at most {_MAX_CUTS}), a `bifurcation` panel a line.")
 
     @model_validator(mode="after")
     def _one_source(self) -> PanelSpec:
@@ -134,8 +147,12 @@ class Sheet(_Strict):
     size: tuple[Inches, Inches] | None = Field(
         None, description=f"[width, height] in inches, each {INCHES[0]:g} to {INCHES[1]:g}; "
         f"unset: {PANEL_SIZE[0]:g} x {PANEL_SIZE[1]:g} per panel.")
-    legends: Literal["all", "first"] = Field(
-        "all", description="Legends on every panel, or on the first panel only (grids).")
+    legends: Literal["all", "first", "figure"] = Field(
+        "figure", description="One legend for the figure with every style drawn on it "
+        "(below the panels), legends on every panel, or on the first panel only.")
+    share: Literal["none", "x", "y", "both"] = Field(
+        "none", description="Panels whose axes show the same quantities get the same "
+        "limits on this axis (a comparison grid).")
     panels: Annotated[tuple[PanelSpec, ...], BeforeValidator(_panel_count)] = Field(
         description="The panels, row by row.")
 

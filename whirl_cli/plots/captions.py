@@ -23,8 +23,10 @@ class Fixed:
     unit: str
 
     def __str__(self) -> str:
+        from .key import symbol
+
         dimensioned = self.unit not in ("", "1")  # "a = 0.3", not "a = 0.3 1"
-        return f"{self.name} = {self.value:g}{' ' + self.unit if dimensioned else ''}"
+        return f"{symbol(self.name)} = {self.value:g}{' ' + self.unit if dimensioned else ''}"
 
 
 @dataclass(frozen=True)

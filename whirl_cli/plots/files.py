@@ -18,7 +18,7 @@ from ..errors import OutputError, WhirlError
 from ..kinds import MOTION_KINDS, PLOT_KINDS
 from ..output.guard import PLOT_CHARACTERS, plot_stem
 from ..results import Branch, ContinuationResult, PointType, StudyResult
-from .captions import Captions, captions
+from .captions import Captions, Fixed, captions
 from .diagrams import bifurcation_diagram, period_plot, phase_plane, projections_figure
 from .freeplay import amplitude_diagram, has_amplitudes
 from .key import _PLOTTED_KINDS
@@ -390,10 +390,9 @@ def _boundary_jobs(result: StudyResult, stem: str, state: str | None,
 
 def _slice_title(caption: Captions, boundary, k: int, value: float) -> str:
     """``"<study title>\n<slice label>: <second parameter> = <value> <unit>"``."""
-    unit = boundary.parameter_units[1]
+    fixed = Fixed(boundary.parameter_names[1], float(value), boundary.parameter_units[1])
     return (f"{caption.title(boundary.parameter_names)}\n"
-            f"{caption.slice_label(boundary.name, k)}: {boundary.parameter_names[1]} = "
-            f"{float(value):g}{' ' + unit if unit else ''}")
+            f"{caption.slice_label(boundary.name, k)}: {fixed}")
 
 
 def phase_labels(branch: Branch, most: int = PHASE_ORBITS) -> list[int]:

@@ -9,6 +9,7 @@ arguments that draw it and its legend label. Stability maps (thesis figures 3.13
 from __future__ import annotations
 
 import itertools
+import re
 from collections.abc import Iterator
 from functools import cache
 from typing import TYPE_CHECKING
@@ -16,7 +17,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..results import BranchKind, PointType
-from ..units import axis_label, display_unit  # noqa: F401  (re-exported: plots use them)
+from ..units import axis_label as _plain_axis_label
+from ..units import display_unit  # noqa: F401  (re-exported: plots use them)
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -230,6 +232,41 @@ def _round_positions(figure) -> None:
         _round_positions(sub)
 
 
+#: Greek letters a quantity's name may spell out, drawn as mathtext symbols.
+_GREEK = ("alpha", "beta", "gamma", "delta", "epsilon", "zeta", "eta", "theta", "lambda", "mu",
+          "nu", "xi", "pi", "rho", "sigma", "tau", "phi", "chi", "psi", "omega", "Omega",
+          "Delta", "Theta", "Lambda", "Phi", "Psi")
+_NAME_RE = re.compile(r"([A-Za-z]+)(?:_([A-Za-z]+|\d+)|(\d+))?")
+
+
+def symbol(name: str) -> str:
+    """A name with a Greek letter as mathtext: ``theta`` -> ``$\\theta$``, ``K_psi`` ->
+    ``$K_{\\psi}$``, ``theta_dot`` -> ``$\\dot{\\theta}$``, ``beta_1`` -> ``$\\beta_{1}$``;
+    any other name unchanged (``K1``, ``V``, ``hub y``)."""
+    stem = name.removesuffix("_dot")
+    dot = stem != name
+    match = _NAME_RE.fullmatch(stem)
+    if match is None:
+        return name
+    base, sub, digits = match.groups()
+    if base not in _GREEK and (len(base) > 1 or sub not in _GREEK):
+        return name
+    text = f"\\{base}" if base in _GREEK else base
+    if dot:
+        text = f"\\dot{{{text}}}"
+    index = sub if sub is not None else digits
+    if index is not None:
+        text += f"_{{\\{index}}}" if index in _GREEK else f"_{{{index}}}"
+    return f"${text}$"
+
+
+def axis_label(name: str, unit: str) -> str:
+    """``"<symbol> [unit]"``: :func:`symbol` of the name (a trailing ``(max)`` or the like
+    kept as text), ``[-]`` for dimensionless quantities."""
+    head, sep, tail = name.partition(" ")
+    return _plain_axis_label(symbol(head) + sep + tail, unit)
+
+
 def _plot_styled(ax: Axes, x: np.ndarray, y: np.ndarray, style: str, first: dict) -> None:
     """Plot with ``PLOT_KEY[style]``; remember the first artist of each style for the legend."""
     kwargs = dict(PLOT_KEY[style])
@@ -245,6 +282,21 @@ def _colours() -> Iterator[str]:
     from matplotlib import rcParams
 
     return itertools.cycle(rcParams["axes.prop_cycle"].by_key().get("color", ["C0"]))
+
+
+#: Colours of the lines a figure draws beyond its key (orbits at cuts, simulations): none is
+#: a colour of :data:`PLOT_KEY`, and their lightness differs (they survive greyscale better
+#: than a hue cycle).
+FIGURE_COLOURS = ("#E69F00", "#6A3D9A", "#17BECF", "#8C564B", "#CC79A7", "#393B79",
+                  "#B8860B", "#56B4E9", "#D55E00", "#0072B2", "#BCBD22", "#7F7F7F")
+
+
+def next_colour(figure) -> str:
+    """The next of :data:`FIGURE_COLOURS` in ``figure``: no colour is taken twice in one
+    figure (they cycle only after all are taken)."""
+    taken = getattr(figure, "_whirl_colours_taken", 0)
+    figure._whirl_colours_taken = taken + 1
+    return FIGURE_COLOURS[taken % len(FIGURE_COLOURS)]
 
 
 def _patch_proxy(style: dict[str, object]):

@@ -48,7 +48,9 @@ class PanelChoice:
     first state); ``sweep``: a linear sweep's parameter; ``slice``: a boundary slice index
     from 0 (``overhang``); ``orbits``: AUTO labels of the orbits a phase plane draws;
     ``simulation``: a simulation's name (``time_history``, ``hub_path``); ``hz``:
-    frequencies in Hz; ``title``: replaces the study's title."""
+    frequencies in Hz; ``title``: replaces the study's title; ``cuts``: parameter values at
+    which a ``phase`` panel draws every solution (:mod:`whirl_cli.plots.cuts`) and a
+    ``bifurcation`` panel draws lines."""
 
     continuation: str | None = None
     branch: str | None = None
@@ -59,6 +61,7 @@ class PanelChoice:
     simulation: str | None = None
     hz: bool = False
     title: str | None = None
+    cuts: tuple[float, ...] | None = None
 
 
 def draw(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice = PanelChoice()
@@ -90,6 +93,10 @@ def _bifurcation_panel(result, ax, choice, caption) -> list[Axes]:
     continuation = pick_continuation(result, choice.continuation, "bifurcation")
     bifurcation_diagram(continuation, choice.state, ax=ax,
                         title=_continuation_title(continuation, choice, caption))
+    if choice.cuts:
+        from .cuts import mark_cuts
+
+        mark_cuts(ax, choice.cuts)
     return [ax]
 
 
@@ -148,6 +155,11 @@ def _orbit_diagram_panel(result, ax, choice, caption) -> list[Axes]:
 
 
 def _phase_panel(result, ax, choice, caption) -> list[Axes]:
+    if choice.cuts:
+        from .cuts import phase_cuts
+
+        continuation = pick_continuation(result, choice.continuation, "period")
+        return _replaced(ax, lambda region: phase_cuts(continuation, choice.cuts, region))
     branch = _pick_branch(result, choice)
     labels = list(choice.orbits) if choice.orbits is not None else None
     if labels is None:
@@ -220,6 +232,9 @@ def _draw_simulation(result: StudyResult, kind: str, ax: Axes, choice: PanelChoi
     title = choice.title or caption.simulation_title(simulation)
     if kind == "hub_path":
         hub_path(simulation, ax=ax, title=title)
+        return [ax]
+    if choice.state is not None:
+        time_history(simulation, states=[choice.state], axes=ax, title=title)
         return [ax]
     dofs = len(simulation.dof_names)
     return _replaced(ax, lambda region: time_history(
@@ -352,8 +367,7 @@ def differing_labels(results: Sequence[StudyResult]) -> list[str]:
              and len({t[n].value for t in tables}) > 1]
     if not names:
         return [r.study_name for r in results]
-    return [", ".join(f"{n} = {t[n].value:g}{' ' + t[n].unit if t[n].unit else ''}"
-                      for n in names) for t in tables]
+    return [", ".join(str(Fixed(n, t[n].value, t[n].unit)) for n in names) for t in tables]
 
 
 def draw_overlay(results: Sequence[StudyResult], kind: str, ax: Axes,

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import WhirlError
 from ..results import Simulation
-from .key import _BLACK, _new_figure, axis_label, display_unit
+from .key import _BLACK, _new_figure, axis_label, display_unit, next_colour
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -52,7 +52,8 @@ def time_history(simulation: Simulation, states: Sequence[str] | None = None,
     for ax, name in zip(axes, names, strict=True):
         factor, unit = display_unit(units[name], degrees)
         column = simulation.state_names.index(name)
-        ax.plot(simulation.time, factor * simulation.states[:, column], color="C0",
+        ax.plot(simulation.time, factor * simulation.states[:, column],
+                color=next_colour(ax.figure),
                 linewidth=0.8, label=name)
         ax.set_ylabel(axis_label(name, unit))
         ax.axhline(0.0, color=_BLACK, linewidth=0.5, zorder=0)
