@@ -123,17 +123,18 @@ def _stages(study: Study, model, parameters: dict[str, float], workroot: Path, j
             continuations.append(continuation)
             found_boundaries.append(boundary)
             continue
-        starts, outcomes = seeded_orbits(model, parameters, spec.parameter, spec.start,
-                                         spec.seeds, jobs)
+        starts, rests, outcomes = seeded_orbits(model, parameters, spec.parameter,
+                                                spec.start, spec.seeds, jobs)
         preload(*later)  # imported while AUTO runs (after the seeds' fork)
 
-        def continued(name: str, values: dict[str, float], spec=spec, starts=starts):
+        def continued(name: str, values: dict[str, float], spec=spec, starts=starts,
+                      rests=rests):
             return one_parameter(
                 engine, name, spec.parameter, spec.start, tuple(spec.range), values,
                 numerics, branch_points=spec.branch_points, periodic=spec.periodic,
                 orbits_at=spec.orbits_at, start_orbits=starts,
                 start_state=None if spec.start_state is None
-                else seeds.seed_state(model, spec.start_state))
+                else seeds.seed_state(model, spec.start_state), resting=rests)
 
         continuation = replace(continued(spec.name, parameters), seeds=outcomes)
         if model.smoothing_parameters:
@@ -309,12 +310,14 @@ def explorations(model, overrides: dict[str, float], spec,
 
 
 def seeded_orbits(model, overrides: dict[str, float], parameter: str, start: float, given,
-                  jobs: int = 1) -> tuple[tuple[OrbitStart, ...], tuple[SeedOutcome, ...]]:
+                  jobs: int = 1) -> tuple[tuple[OrbitStart, ...], tuple[np.ndarray, ...],
+                                          tuple[SeedOutcome, ...]]:
     """A continuation's seeds (``given``: ``auto`` or state mappings) simulated with
     ``parameter`` at ``start``, ``jobs`` at a time (forked processes): one orbit start per
-    distinct limit cycle they settle on, and what became of every seed."""
+    distinct limit cycle they settle on, the states where seeds came to rest (SI), and what
+    became of every seed."""
     if not given:
-        return (), ()
+        return (), (), ()
     values = {**overrides, parameter: float(start)}
     params = model.parameter_vector(values)
     if given == "auto":
@@ -334,7 +337,8 @@ def seeded_orbits(model, overrides: dict[str, float], parameter: str, start: flo
                     families.get(seeds.same_as(settled, k, kept), ""),
                     s.message)
         for k, s in enumerate(settled))
-    return starts, outcomes
+    rests = tuple(s.state for s in settled if s.kind == "equilibrium")
+    return starts, rests, outcomes
 
 
 def slice_seeds(model, overrides: dict[str, float], spec, jobs: int = 1
@@ -347,8 +351,8 @@ def slice_seeds(model, overrides: dict[str, float], spec, jobs: int = 1
         return (), ()
     per_slice, outcomes = [], []
     for k, value in enumerate(spec.slice_values):
-        starts, found = seeded_orbits(model, {**overrides, second: value}, first, spec.start,
-                                      spec.seeds, jobs)
+        starts, _, found = seeded_orbits(model, {**overrides, second: value}, first,
+                                         spec.start, spec.seeds, jobs)
         per_slice.append(starts)
         outcomes += [replace(o, index=len(outcomes) + n + 1,
                              branch=o.branch and f"slice_{k}.{o.branch}")

@@ -193,7 +193,7 @@ def test_the_short_persistence_runs_agree_with_the_repeated_continuation():
     model, parameters, spec = study.variant(), study.parameter_values(), study.continuations[0]
     numerics = Numerics.from_settings(study.auto)
     engine = Engine(model, Path(tempfile.mkdtemp(prefix="whirl-test-")), jobs=2)
-    starts, _ = seeded_orbits(model, parameters, "V", spec.start, spec.seeds, 2)
+    starts, _, _ = seeded_orbits(model, parameters, "V", spec.start, spec.seeds, 2)
     runs = repeated(lambda name, values: one_parameter(
         engine, name, "V", spec.start, tuple(spec.range), values, numerics,
         branch_points=False, start_orbits=starts), "v", parameters, model.smoothing_parameters)

@@ -3,7 +3,11 @@
 1. the main branch from the start value, both directions, to the ends of the range;
 2. at every branch point (BP) found, branch switching (ISW=-1) in both directions to the
    secondary (static-divergence) equilibria, recursively for branch points on those branches
-   (each point once).
+   (each point once);
+3. from every further equilibrium given at the start value (e.g. one a seed settled on) that
+   lies on none of these branches, a branch both ways; of a symmetric model whose right-hand
+   side is odd there, from its mirror image too (offset equilibria no branch point leads to,
+   such as those of freeplay with K_in = 0).
 """
 
 from __future__ import annotations
@@ -54,11 +58,13 @@ def equilibrium_constants(model: Model, numerics: Numerics, parameter: str,
 
 def equilibria(engine: Engine, name: str, parameter: str, start: float,
                bounds: tuple[float, float], parameters: dict[str, float], numerics: Numerics,
-               branch_points: bool = True, guess: np.ndarray | None = None
+               branch_points: bool = True, guess: np.ndarray | None = None,
+               also_from: tuple[np.ndarray, ...] = ()
                ) -> tuple[list[Branch], list[SpecialPoint]]:
-    """Equilibrium branches (main, then secondary from every BP) and their special points;
-    the main branch starts at the equilibrium :func:`starting_equilibrium` finds from
-    ``guess``."""
+    """Equilibrium branches (main, then secondary from every BP, then one from each state of
+    ``also_from`` on no branch yet) and their special points; the main branch starts at the
+    equilibrium :func:`starting_equilibrium` finds from ``guess``, the others at those it
+    finds from each of ``also_from`` (SI states at ``start``)."""
     model = engine.model
     lower, upper = bounds
     width = upper - lower
@@ -68,14 +74,8 @@ def equilibria(engine: Engine, name: str, parameter: str, start: float,
                                  f"{start:g}")
     start_state = None if not state.any() else \
         " ".join(f"{x:.17g}" for x in state / model.state_scale) + "\n"
-    specs = []
-    for direction, label in ((-1, "down"), (1, "up")):
-        if (direction < 0 and start > lower) or (direction > 0 and start < upper):
-            constants = equilibrium_constants(model, numerics, parameter, bounds, direction)
-            constants["PAR"] = start_parameters
-            specs.append(RunSpec(f"{name}/main_{label}", constants, BranchKind.EQUILIBRIUM,
-                                 f"start at {parameter} = {start:g}", (parameter,),
-                                 start_state=start_state))
+    specs = _both_ways(model, numerics, parameter, start, bounds, start_parameters,
+                       f"{name}/main", f"start at {parameter} = {start:g}", start_state)
     branches: list[Branch] = []
     points: list[SpecialPoint] = []
     frontier = _run_branches(engine, specs, branches, points, skip_first=False)
@@ -107,12 +107,77 @@ def equilibria(engine: Engine, name: str, parameter: str, start: float,
         frontier = [p for p in _run_branches(engine, todo, branches, points, skip_first=True)
                     if not any(_same_point(p, q, width, amplitudes) for q in switched)]
 
+    found = 0
+    for rest in _mirrored(model, start_parameters, also_from):
+        state = starting_equilibrium(model, start_parameters, rest, f"{name}: {parameter} = "
+                                     f"{start:g}")
+        if on_branch(branches, start, state, width, amplitudes):
+            continue
+        found += 1
+        text = " ".join(f"{x:.17g}" for x in state / model.state_scale) + "\n"
+        _run_branches(engine, _both_ways(
+            model, numerics, parameter, start, bounds, start_parameters,
+            f"{name}/resting_{found}", f"equilibrium at {parameter} = {start:g} off every "
+            "branch (a seed settled on it, or its mirror image)", text),
+            branches, points, skip_first=False)
+
     unique: list[SpecialPoint] = []
     for point in points:
         if not any(point.point_type == q.point_type and _same_point(point, q, width, amplitudes)
                    for q in unique):
             unique.append(point)
     return branches, unique
+
+
+def _both_ways(model: Model, numerics: Numerics, parameter: str, start: float,
+               bounds: tuple[float, float], values: dict[str, float], name: str, origin: str,
+               start_state: str | None) -> list[RunSpec]:
+    """The runs of an equilibrium branch from ``start`` down and up (``<name>_down``,
+    ``<name>_up``; only those with room in ``bounds``)."""
+    specs = []
+    for direction, label in ((-1, "down"), (1, "up")):
+        if (direction < 0 and start > bounds[0]) or (direction > 0 and start < bounds[1]):
+            constants = equilibrium_constants(model, numerics, parameter, bounds, direction)
+            constants["PAR"] = values
+            specs.append(RunSpec(f"{name}_{label}", constants, BranchKind.EQUILIBRIUM, origin,
+                                 (parameter,), start_state=start_state))
+    return specs
+
+
+def _mirrored(model: Model, values: dict[str, float], states: tuple[np.ndarray, ...]
+              ) -> list[np.ndarray]:
+    """``states``, each followed by its mirror image -y where the model is symmetric and its
+    right-hand side odd there."""
+    from .mirror import is_odd
+
+    params = model.parameter_vector(values)
+    out = []
+    for state in states:
+        state = np.asarray(state, dtype=float)
+        out.append(state)
+        if model.symmetric and state.any() and is_odd(model, params, [state]):
+            out.append(-state)
+    return out
+
+
+def on_branch(branches: list[Branch], value: float, state: np.ndarray, width: float,
+              amplitudes: np.ndarray) -> bool:
+    """True if an equilibrium branch passes through ``state`` (SI) at parameter ``value``:
+    a point of it there, interpolated between its neighbours, within 1e-4 typical
+    ``amplitudes`` (or 1e-3 relatively) of it in every state."""
+    target = state / amplitudes
+    for branch in branches:
+        if branch.is_periodic or len(branch) < 1:
+            continue
+        p = branch.parameters[:, 0]
+        rows = branch.state_max / amplitudes
+        near = [rows[k] for k in np.flatnonzero(np.abs(p - value) <= 1e-9 * width)]
+        for k in np.flatnonzero((p[:-1] - value) * (p[1:] - value) < 0):
+            w = (value - p[k]) / (p[k + 1] - p[k])
+            near.append(rows[k] + w * (rows[k + 1] - rows[k]))
+        if any(np.allclose(row, target, atol=1e-4, rtol=1e-3) for row in near):
+            return True
+    return False
 
 
 def starting_equilibrium(model: Model, parameters: dict[str, float],

@@ -20,15 +20,18 @@ def one_parameter(engine: Engine, name: str, parameter: str, start: float,
                   numerics: Numerics, branch_points: bool = True,
                   periodic: bool = False, orbits_at: tuple[float, ...] = (),
                   start_orbits: tuple[OrbitStart, ...] = (),
-                  start_state: np.ndarray | None = None) -> ContinuationResult:
+                  start_state: np.ndarray | None = None,
+                  resting: tuple[np.ndarray, ...] = ()) -> ContinuationResult:
     """Equilibria of ``parameter`` over ``bounds`` from ``start`` (from the equilibrium found
     by Newton's method from ``start_state``, SI, default zero), with branch switching, and
     (``periodic``) the periodic families of every Hopf point, and those through each of
     ``start_orbits`` (e.g. orbits settled by time simulation). ``orbits_at``: parameter values
-    where every branch stores a labelled solution (orbit profiles)."""
+    where every branch stores a labelled solution (orbit profiles); ``resting``: states (SI)
+    at ``start`` near equilibria (e.g. where seeds came to rest), each starting a branch if
+    it is on none (see :func:`.equilibria.equilibria`)."""
     numerics = replace(numerics, orbits_at=tuple(orbits_at))
     branches, points = equilibria(engine, name, parameter, start, bounds, parameters, numerics,
-                                  branch_points, start_state)
+                                  branch_points, start_state, tuple(resting))
     points = with_lyapunov(engine.model, parameter, parameters, points)
     # a linear model has no limit cycles: at a Hopf point it carries a continuum of neutral
     # orbits of every amplitude, which AUTO reports as folds everywhere
