@@ -29,6 +29,18 @@ def pytest_configure(config):
         signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
+@pytest.fixture(autouse=True)
+def _signal_handlers():
+    """Each test leaves SIGINT's and SIGTERM's handlers as it found them: whirl's console
+    entry (``cli.main``) ends by giving them their default action, which, left in place, would
+    let a later test's own signal end the test session."""
+    saved = {number: signal.getsignal(number) for number in (signal.SIGINT, signal.SIGTERM)}
+    yield
+    for number, handler in saved.items():
+        if handler is not None:
+            signal.signal(number, handler)
+
+
 def pytest_collection_modifyitems(items):
     for item in items:
         if "/tests/auto/" in str(item.fspath) or "/tests/regression/" in str(item.fspath):
