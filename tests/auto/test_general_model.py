@@ -246,11 +246,11 @@ def test_plots_drawn_with_the_model_states(cli_run):
     assert sorted(drawn) == sorted(p.name for p in output.parent.glob("*.png")) == expected
     # titled by the study (it fixes no parameter), not by the continuation (issue 17, item 3)
     title = "oscillators-alpha"
-    assert drawn[f"{stem}_bifurcation.png"] == [(title, "alpha [1/s]", "q2 (max) [m]")]
+    assert drawn[f"{stem}_bifurcation.png"] == [(title, r"$\alpha$ [1/s]", "q2 (max) [m]")]
     panels = drawn[f"{stem}_projections.png"]
     assert [y for _, _, y in panels] == [f"{s} (max) [{'m' if len(s) == 2 else 'm/s'}]"
                                          for s in STATES]
-    assert drawn[f"{stem}_period.png"] == [(title, "alpha [1/s]", "period [s]")]
+    assert drawn[f"{stem}_period.png"] == [(title, r"$\alpha$ [1/s]", "period [s]")]
     for j in (1, 2, 3):
         assert drawn[f"{stem}_periodic_{j}_phase.png"] == [(f"{title}\nperiodic_{j}",
                                                             "q1 [m]", "q2 [m]")]

@@ -38,10 +38,6 @@ def prepare_workers(items: Sequence[SweepItem]) -> None:
             model.rhs_numpy(np.zeros(model.n_states), params)
 
 
-#: Seconds the workers of a broken pool get to end their studies and remove their directories.
-BROKEN_GRACE = 2.0
-
-
 class LocalPool(ProcessPoolExecutor):
     """A process pool of ``jobs`` workers whose studies can be interrupted.
 
@@ -64,10 +60,6 @@ class LocalPool(ProcessPoolExecutor):
     def workers(self) -> list:
         return list(self._workers)
 
-    def broken(self) -> bool:
-        """Whether a worker has died (the pool is then broken: its manager ends the others)."""
-        return any(process.exitcode not in (None, 0) for process in self.workers())
-
     def start(self) -> None:
         """Start every worker now (before a progress display thread exists: fork is safe)."""
         before = set(multiprocessing.active_children())
@@ -79,14 +71,13 @@ class LocalPool(ProcessPoolExecutor):
 
     def close(self, timeout: float) -> None:
         """Shut down without risking a hang: workers not gone after ``timeout`` s are killed;
-        by then they run no study. If the pool broke (a worker died), its manager has sent
-        the others SIGTERM, which ends a study at once but is ignored by an idle worker (see
-        :func:`whirl_cli.sweep.execute._init_worker`): they get ``BROKEN_GRACE`` s. The
-        shutdown waits in a thread of its own until the pool's manager thread has ended (one
+        by then they run no study. Every worker gets the whole ``timeout`` to end its study and
+        remove its work directory, also in a broken pool (a worker died, its manager has sent
+        the others SIGTERM, which ends a study at once but is ignored by an idle worker, see
+        :func:`whirl_cli.sweep.execute._init_worker`, so an idle one then waits to be killed).
+        The shutdown waits in a thread of its own until the pool's manager thread has ended (one
         left running races Python's exit for the pool's wakeup pipe)."""
         workers = self.workers()
-        if self.broken():
-            timeout = min(timeout, BROKEN_GRACE)
         shutdown = threading.Thread(target=self.shutdown, name="whirl-pool-shutdown",
                                     daemon=True)
         shutdown.start()
