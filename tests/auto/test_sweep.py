@@ -26,18 +26,7 @@ from whirl_cli.sweep.executors import dask_pool
 from whirl_cli.sweep.plan import INVALID, RUN, SKIP, find_studies, plan
 
 from ..conftest import ROOT, STUDIES
-
-SMALL = ("linear_case2", "linear_datum_airspeed")  # about a second of AUTO each
-
-
-def copy_studies(directory: Path, names=SMALL) -> list[Path]:
-    directory.mkdir(parents=True, exist_ok=True)
-    paths = []
-    for name in names:
-        path = directory / f"{name}.yaml"
-        path.write_text((STUDIES / f"{name}.yaml").read_text())
-        paths.append(path)
-    return paths
+from .helpers import SMALL, copy_studies
 
 
 def renamed(path: Path, name: str, **replace: str) -> Path:

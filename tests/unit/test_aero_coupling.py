@@ -23,7 +23,7 @@ from scipy.optimize import brentq
 from whirl_cli.analysis import linear
 from whirl_cli.models import get_model
 
-from .test_linear import DAMPING, I_X, I_Y, OMEGA, V, aerodynamic_coefficients
+from .linear_datum import DAMPING, I_X, I_Y, OMEGA, V, aerodynamic_coefficients
 
 CLASSICAL = get_model("classical")
 K = 0.4  # K_theta = K_psi at the datum

@@ -9,11 +9,12 @@ import time
 
 import numpy as np
 
-from tests.unit.test_locus_geometry import _locus
 from whirl_cli.continuation import loci
 from whirl_cli.continuation.engine import _Slots
 from whirl_cli.continuation.numerics import Numerics
 from whirl_cli.results import PointType, SpecialPoint
+
+from .locus_data import make_locus
 
 
 def test_background_holders_wait_while_a_foreground_request_waits():
@@ -89,14 +90,14 @@ def test_a_next_wave_start_on_a_locus_of_the_wave_before_is_set_aside(monkeypatc
         for k, point, _ in starts:
             for tag in "ab":
                 spec = loci.RunSpec(f"c/fold_of_cycles_{k}{tag}2", {}, "", "", ("p", "q"))
-                rows.append((k, PointType.LPC, spec, _locus(np.array(
+                rows.append((k, PointType.LPC, spec, make_locus(np.array(
                     [point.parameters, point.parameters + [0.0, 0.1 if tag == "a" else -0.1]]))))
         return rows[::-1]  # any order: the recipe puts them in its own
 
     def wave(_engine, _pair, _bounds, _numerics, traced, curves, _width):
         grown.append([spec.name for _, spec, _ in traced.values()])
         if len(grown) == 1:  # wave 0's locus runs through (0.5, 0.3), wave 1's first start
-            return [(PointType.LPC, _locus(np.array([[0.5, 0.0], [0.5, 0.5]])))]
+            return [(PointType.LPC, make_locus(np.array([[0.5, 0.0], [0.5, 0.5]])))]
         return [(kind, curve) for kind, _, curve in traced.values()]
 
     monkeypatch.setattr(loci, "_trace", trace)
