@@ -15,7 +15,7 @@ from whirl_cli.figures.build import load_sheets, make_figures
 from whirl_cli.output import store
 
 from ..conftest import ROOT
-from .test_sweep import copy_studies
+from .helpers import copy_studies
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

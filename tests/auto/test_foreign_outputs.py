@@ -13,7 +13,7 @@ from whirl_cli.cli import cli
 from whirl_cli.output import store, study_files
 
 from ..conftest import STUDIES
-from ..unit.test_output_guard import KINDS, fingerprint, make
+from ..foreign_paths import KINDS, fingerprint, make
 
 AIRSPEED = STUDIES / "linear_datum_airspeed.yaml"  # plots: bifurcation, linear
 

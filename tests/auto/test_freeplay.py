@@ -20,6 +20,8 @@ from whirl_cli.pipeline import run_study
 from whirl_cli.results import PointType
 from whirl_cli.study import validate_text
 
+from .helpers import offset_equilibria_at_zero
+
 DELTA = math.radians(1.0)
 K_PSI = 0.3
 
@@ -123,16 +125,6 @@ continuations:
   - {{name: kin, type: one-parameter, parameter: K_in_theta, range: [0.0, 0.1],
       orbits_at: [0.0]}}
 """
-
-
-def offset_equilibria_at_zero(continuation):
-    """(branch, row) of each secondary equilibrium branch of a continuation in K_in at its
-    labelled point K_in = 0 (``orbits_at: [0.0]``)."""
-    for branch in continuation.branches:
-        if branch.name.startswith("secondary"):
-            (row,) = np.flatnonzero(branch.point_type == PointType.UZ)
-            assert abs(branch.parameters[row, 0]) < 1e-9
-            yield branch, row
 
 
 def test_offset_equilibria_of_pitch_freeplay_are_the_closed_form(run):

@@ -5,7 +5,8 @@
   branch points against eigenvalues, +/- pairs of secondary equilibria that are equilibria of
   the model, periodic families with passing cross-checks, HDF5, plots of a gimbal state,
   compare) and the onset against K_beta (the Hopf locus against eigenvalues);
-* 8-state code generation and compilation in a cold cache under 60 s.
+* 8-state code generation and compilation in a cold cache, the code within 4 times the
+  classical model's.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from whirl_cli.analysis import linear
 from whirl_cli.auto import toolchain
 from whirl_cli.auto.codegen import fortran_source
 from whirl_cli.cli import cli
-from whirl_cli.models import FAMILIES, get_model
+from whirl_cli.models import get_model
 from whirl_cli.models.numeric import numeric_source
 from whirl_cli.output import store
 from whirl_cli.pipeline import run_study
@@ -205,17 +206,19 @@ def test_onset_study_hopf_locus_against_eigenvalues(tmp_path):
     assert set(np.unique(sweep.mode_group)) == {"nacelle", "gimbal"}
 
 
-# ------------------------------------------------------------------------------ speed
-def test_eight_state_codegen_and_compile_under_a_minute(tmp_path, monkeypatch):
-    """Cold cache: the numeric module, the Fortran and its compilation for gimballed_poly in
-    under 60 s (measured ~5 s); nothing symbolic is needed at run time afterwards."""
+# ------------------------------------------------------------------------------ size
+def test_eight_state_code_grows_with_the_jacobian_and_compiles(tmp_path, monkeypatch):
+    """Cold cache: the numeric module and the Fortran of gimballed_poly compile, and nothing
+    symbolic is needed at run time afterwards. The generated code is a count of the work: the
+    Jacobian of 8 states has 4 times the entries of the classical model's 4, so each file stays
+    within 4 times the classical one (a mass matrix inverted symbolically, or unsimplified
+    products of it, would grow far faster and take minutes to generate and compile)."""
     monkeypatch.setenv("WHIRL_CACHE_DIR", str(tmp_path))
-    started = time.perf_counter()
     numeric = numeric_source(MODEL)
-    executable = toolchain.compile_equations(fortran_source(MODEL), MODEL.name)
-    seconds = time.perf_counter() - started
-    print(f"\n  gimballed_poly codegen + compile: {seconds:.1f} s")
+    fortran = fortran_source(MODEL)
+    executable = toolchain.compile_equations(fortran, MODEL.name)
     assert executable.compiled and Path(executable.path).exists()
     assert "import sympy" not in numeric and "N_STATES = 8" in numeric
-    assert seconds < 60.0
-    assert FAMILIES["classical"].name == "classical"  # the classical model is untouched by it
+    classical = get_model("classical")
+    assert len(fortran) < 4 * len(fortran_source(classical))
+    assert len(numeric) < 4 * len(numeric_source(classical))

@@ -21,7 +21,7 @@ from whirl_cli.results import PointType
 from whirl_cli.study import load_study, validate_text
 
 from ..gimballed_exact import freeplay_simulation, matrices, maxima
-from .test_freeplay import offset_equilibria_at_zero
+from .helpers import offset_equilibria_at_zero
 
 pytestmark = pytest.mark.auto
 

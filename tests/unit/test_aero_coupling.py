@@ -23,7 +23,7 @@ from scipy.optimize import brentq
 from whirl_cli.analysis import linear
 from whirl_cli.models import get_model
 
-from .test_linear import DAMPING, I_X, I_Y, OMEGA, V, aerodynamic_coefficients
+from .linear_datum import DAMPING, I_X, I_Y, OMEGA, V, aerodynamic_coefficients
 
 CLASSICAL = get_model("classical")
 K = 0.4  # K_theta = K_psi at the datum
@@ -102,7 +102,7 @@ def test_with_coupling_on_the_model_is_unchanged():
 @pytest.mark.parametrize("factor", [0.0, 0.5, 1.0])
 def test_the_switch_scales_k_c_in_the_quartic(factor):
     """The characteristic polynomial of models.md 2.3 with k_c -> factor k_c (the closed-form
-    coefficients of test_linear): its roots are whirl's eigenvalues (1e-9 relative)."""
+    coefficients of linear_datum.py): its roots are whirl's eigenvalues (1e-9 relative)."""
     k_d, k_c, c_a = aerodynamic_coefficients(V)
     axis = [K - k_d, DAMPING + c_a, I_Y]
     coupling = [-factor * k_c, I_X * OMEGA]

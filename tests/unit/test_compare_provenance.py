@@ -14,7 +14,7 @@ from whirl_cli.cli import cli
 from whirl_cli.output.compare import compare, compare_results
 
 from ..conftest import ROOT
-from .test_compare import make_result
+from .compare_data import make_result
 
 REFERENCE = ROOT / "tests" / "regression" / "references" / "hardening_case2.h5"
 

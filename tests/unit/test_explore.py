@@ -15,7 +15,6 @@ import h5py
 import numpy as np
 import pytest
 
-from tests.unit.test_plots import continuation  # noqa: F401  (the fixture)
 from whirl_cli import pipeline
 from whirl_cli.analysis import motion
 from whirl_cli.errors import StudyError, WhirlError

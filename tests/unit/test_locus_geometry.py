@@ -8,6 +8,8 @@ import numpy as np
 
 from whirl_cli.continuation.geometry import _near_polyline
 
+from .locus_data import make_locus
+
 
 def test_point_between_vertices_is_on_the_polyline():
     curve = np.array([[0.0, 0.0], [0.1, 0.0], [0.1, 0.2]])
@@ -31,19 +33,6 @@ def test_degenerate_curves():
     assert _near_polyline(np.zeros(2), np.zeros((1, 2)), width)
 
 
-def _locus(points: np.ndarray, extremes: np.ndarray | None = None):
-    """A two-parameter locus through ``points`` (K, 2) with one state whose orbit extremes are
-    ``extremes`` (K,) (default: 0.1 along the whole locus)."""
-    from whirl_cli.results import Branch, BranchKind
-
-    n = len(points)
-    top = (np.full(n, 0.1) if extremes is None else extremes)[:, None]
-    return Branch("fold_of_cycles_1a", BranchKind.FOLD_OF_CYCLES_LOCUS, "", ("p", "q"),
-                  ("1", "1"), ("x",), ("1",), points.astype(float), top, -top, np.zeros(n),
-                  np.ones(n), np.ones(n, bool), np.zeros(n, int), np.zeros(n, int),
-                  np.zeros((n, 1), complex))
-
-
 def _circle(turns: float, points_per_turn: int = 200, centre=(0.5, 0.5)) -> np.ndarray:
     angle = np.linspace(0, 2 * np.pi * turns, int(points_per_turn * turns) + 1)
     return np.column_stack([centre[0] + 0.2 * np.cos(angle), centre[1] + 0.2 * np.sin(angle)])
@@ -53,7 +42,7 @@ def test_a_locus_is_cut_where_it_returns_to_its_start():
     from whirl_cli.continuation.geometry import _closed
 
     width = np.ones(2)
-    cut = _closed(_locus(_circle(2.5)), width)
+    cut = _closed(make_locus(_circle(2.5)), width)
     assert 200 <= len(cut) <= 202  # one turn and the point that closes it
 
 
@@ -64,7 +53,7 @@ def test_a_locus_that_runs_onto_a_closed_loop_is_cut_after_one_turn_of_it():
 
     lead = np.column_stack([np.linspace(0.9, 0.7, 41), np.full(41, 0.5)])[:-1]
     curve = np.vstack([lead, _circle(3.0, centre=(0.5, 0.5))])
-    cut = _closed(_locus(curve), np.ones(2))
+    cut = _closed(make_locus(curve), np.ones(2))
     assert len(lead) + 200 <= len(cut) <= len(lead) + 210
 
 
@@ -80,7 +69,7 @@ def test_a_locus_round_a_loop_whose_sampled_extremes_jitter_is_cut_after_one_lap
     lead = np.column_stack([np.linspace(0.9, 0.7, 41), np.full(41, 0.5)])[:-1]
     curve = np.vstack([lead, _circle(4.0, centre=(0.5, 0.5))])
     jitter = 0.1 * (1 + 0.03 * np.sin(np.arange(len(curve)) * 2.7))  # 3 %, no lap alike
-    locus = _locus(curve, jitter)
+    locus = make_locus(curve, jitter)
     cut = _closed(replace(locus, period=np.full(len(curve), 0.5)), np.ones(2))
     assert len(lead) + 200 <= len(cut) <= len(lead) + 210
     growing = np.linspace(0.5, 0.9, len(curve))  # 0.1 of its spread per lap
@@ -96,12 +85,12 @@ def test_a_hairpin_or_a_crossing_of_the_projection_is_not_cut():
     width = np.ones(2)
     out = np.column_stack([np.linspace(0.1, 0.6, 101), np.full(101, 0.3)])
     hairpin = np.vstack([out, out[::-1][1:] + [0.0, 0.002], [[0.1, 0.5]]])
-    assert len(_closed(_locus(np.vstack([[0.05, 0.3], hairpin])), width)) == len(hairpin) + 1
+    assert len(_closed(make_locus(np.vstack([[0.05, 0.3], hairpin])), width)) == len(hairpin) + 1
     # down, back up, down again over the same parameters with a larger orbit
     path = np.vstack([[0.05, 0.25], out, out[::-1][1:], out[1:]])
     extremes = np.concatenate([np.full(102, 0.1), np.linspace(0.1, 0.3, 100),
                                np.full(100, 0.3)])
-    assert len(_closed(_locus(path, extremes), width)) == len(path)
+    assert len(_closed(make_locus(path, extremes), width)) == len(path)
 
 
 def test_mirror_image_starts_are_traced_once():
@@ -161,7 +150,7 @@ def test_a_locus_that_passed_the_range_edge_ends_there_and_is_not_continued():
     for last, edge in (((0.5, 0.3), False), ((1.0, 0.3), True), ((0.5, 0.5), True),
                        ((1.003, 0.3), True), ((0.5, 0.52), True), ((0.5, -0.01), True)):
         points = np.array([[0.2, 0.1], [0.3, 0.2], last])
-        curve = _locus(points)
+        curve = make_locus(points)
         curve.point_type[-1] = PointType.EP
         assert _at_range_edge(curve, bounds, width) == edge, last
         assert _chunk_used(curve, width, bounds) == (not edge), last
@@ -175,7 +164,7 @@ def test_a_locus_chunk_that_adds_no_point_ends_the_locus(monkeypatch):
     from whirl_cli.continuation.engine import Numerics, RunSpec
     from whirl_cli.results import PointType
 
-    curve = _locus(np.array([[0.2, 0.1], [0.3, 0.2], [0.4, 0.3]]))
+    curve = make_locus(np.array([[0.2, 0.1], [0.3, 0.2], [0.4, 0.3]]))
     curve.point_type[-1] = PointType.EP
     curve.label[-1] = 7
     curve = dataclasses.replace(curve, run="c.fold_of_cycles_1a2")
@@ -188,7 +177,7 @@ def test_a_locus_chunk_that_adds_no_point_ends_the_locus(monkeypatch):
             assert len(calls) < 3, "the same chunk run again"
             return [None] * len(specs)
 
-    monkeypatch.setattr(loci, "_read", lambda _engine, _spec, _outcome: _locus(
+    monkeypatch.setattr(loci, "_read", lambda _engine, _spec, _outcome: make_locus(
         np.array([[0.4, 0.3]])))
     kept, _ = loci._grown(Engine(), {0: (PointType.LPC, spec, curve)}, [], Numerics(),
                           {"p": (0.0, 1.0), "q": (0.0, 0.5)}, np.array([1.0, 0.5]))
@@ -205,7 +194,7 @@ def test_a_locus_chunk_drawn_over_its_own_path_ends_the_locus(monkeypatch):
     from whirl_cli.results import PointType
 
     def ending(points):
-        curve = _locus(points)
+        curve = make_locus(points)
         curve.point_type[-1] = PointType.EP
         curve.label[-1] = 7
         return curve
@@ -237,9 +226,9 @@ def test_a_locus_wholly_on_others_is_dropped_later_one_first():
 
     width = np.ones(2)
     path = np.column_stack([np.linspace(0.1, 0.9, 161), 0.3 + 0.1 * np.sin(np.linspace(0, 3, 161))])
-    whole = _locus(path)
-    left, right = _locus(path[:90]), _locus(path[80:])
-    offset = _locus(path + [0.0, 0.004])  # drawn beside the others: kept
+    whole = make_locus(path)
+    left, right = make_locus(path[:90]), make_locus(path[80:])
+    offset = make_locus(path + [0.0, 0.004])  # drawn beside the others: kept
     curves = {1: (13, None, left), 2: (13, None, right), 3: (13, None, whole),
               4: (13, None, offset), 5: (2, None, whole)}
     kept, _ = _distinct(curves, [], width)
@@ -259,17 +248,17 @@ def test_a_locus_that_runs_onto_another_stops_where_both_are_kept():
 
     width = np.ones(2)
     path = np.column_stack([np.linspace(0.1, 0.9, 161), np.full(161, 0.3)])
-    first = _locus(path[:100])        # 0.1 .. 0.595
-    second = _locus(path[150:60:-1])  # 0.85 back to 0.4: ends on the first
+    first = make_locus(path[:100])        # 0.1 .. 0.595
+    second = make_locus(path[150:60:-1])  # 0.85 back to 0.4: ends on the first
     kept, merged = _distinct({1: (13, None, first), 2: (13, None, second)}, [], width)
     assert sorted(kept) == [1, 2] and merged == {1, 2}  # head-on: both stop, nothing lost
-    ahead = _locus(path[40:120])      # 0.3 .. 0.695
-    behind = _locus(path[:60])        # 0.1 .. 0.395: its end lies on the one ahead
+    ahead = make_locus(path[40:120])      # 0.3 .. 0.695
+    behind = make_locus(path[:60])        # 0.1 .. 0.395: its end lies on the one ahead
     kept, merged = _distinct({1: (13, None, ahead), 2: (13, None, behind)}, [], width)
     assert merged == {2}
-    twins = {1: (13, None, _locus(path[80:84])), 2: (13, None, _locus(path[80:76:-1]))}
+    twins = {1: (13, None, make_locus(path[80:84])), 2: (13, None, make_locus(path[80:76:-1]))}
     assert _distinct(twins, [], width)[1] == set()
-    other = _locus(path[150:60:-1], extremes=np.full(90, 0.5))  # other orbits, same parameters
+    other = make_locus(path[150:60:-1], extremes=np.full(90, 0.5))  # other orbits, same parameters
     kept, merged = _distinct({1: (13, None, first), 2: (13, None, other)}, [], width)
     assert merged == set()
 
@@ -325,7 +314,7 @@ def test_a_locus_back_at_its_start_with_another_orbit_reached_the_next_fold():
     width = np.array([0.8, 0.5])
     bounds = {"p": (-0.3, 0.5), "q": (0.0, 0.5)}
     loop = np.vstack([_circle(1.0, centre=(0.1, 0.25))[:-1], [[0.3, 0.2501]]])
-    curve = dataclasses.replace(_locus(loop), period=np.linspace(0.525, 0.6136, len(loop)))
+    curve = dataclasses.replace(make_locus(loop), period=np.linspace(0.525, 0.6136, len(loop)))
 
     def fold(k1: float, period: float) -> SpecialPoint:
         return SpecialPoint("slice_2.periodic_2", 3, int(PointType.LPC), ("p", "q"),

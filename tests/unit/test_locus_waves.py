@@ -9,18 +9,35 @@ import time
 
 import numpy as np
 
-from tests.unit.test_locus_geometry import _locus
 from whirl_cli.continuation import loci
 from whirl_cli.continuation.engine import _Slots
 from whirl_cli.continuation.numerics import Numerics
 from whirl_cli.results import PointType, SpecialPoint
 
+from .locus_data import make_locus
+
+
+class _SeenWaiting(threading.Condition):
+    """A condition that records the name of each thread that waits on it."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.waiting: set[str] = set()
+
+    def wait(self, timeout=None):
+        self.waiting.add(threading.current_thread().name)
+        return super().wait(timeout)
+
 
 def test_background_holders_wait_while_a_foreground_request_waits():
+    """Two foreground holders fill both slots; two more foreground requests and a background
+    one wait. When both slots free, the waiting foreground requests get them and the
+    background one only after (each step waits for a state, not for a time)."""
     slots = _Slots(2)
+    slots._changed = seen = _SeenWaiting()
     order, holding = [], []
     lock = threading.Lock()
-    first_in = threading.Event()
+    entered = {tag: threading.Event() for tag in ("f1", "f2", "f3", "f4", "b")}
     release = threading.Event()
 
     def hold(tag: str, background: bool) -> None:
@@ -29,29 +46,25 @@ def test_background_holders_wait_while_a_foreground_request_waits():
                 order.append(tag)
                 holding.append(tag)
                 assert len(holding) <= 2
-            if tag == "f1":
-                first_in.set()
-                release.wait(5)
-            else:
-                time.sleep(0.05)
+            entered[tag].set()
+            release.wait(5)
             with lock:
                 holding.remove(tag)
 
-    f1 = threading.Thread(target=hold, args=("f1", False))
-    f1.start()
-    first_in.wait(5)
-    f2 = threading.Thread(target=hold, args=("f2", False))  # takes the second slot
-    blockers = [threading.Thread(target=hold, args=(f"f{k}", False)) for k in (3, 4)]
-    background = threading.Thread(target=hold, args=("b", True))
-    f2.start()
-    time.sleep(0.01)
-    for thread in blockers:
-        thread.start()
-    time.sleep(0.01)
-    background.start()
-    time.sleep(0.2)
+    threads = {tag: threading.Thread(target=hold, args=(tag, tag == "b"), name=tag)
+               for tag in entered}
+    for tag in ("f1", "f2"):
+        threads[tag].start()
+        assert entered[tag].wait(5)
+    for tag in ("f3", "f4", "b"):
+        threads[tag].start()
+    for _ in range(60_000):  # a guard against a hang: ends once all three wait for a slot
+        if {"f3", "f4", "b"} <= seen.waiting:
+            break
+        time.sleep(0.001)
+    assert {"f3", "f4", "b"} <= seen.waiting and order == ["f1", "f2"]
     release.set()
-    for thread in (f1, f2, *blockers, background):
+    for thread in threads.values():
         thread.join(5)
     assert order[:2] == ["f1", "f2"] and order[-1] == "b" and sorted(order[2:4]) == ["f3", "f4"]
 
@@ -89,14 +102,14 @@ def test_a_next_wave_start_on_a_locus_of_the_wave_before_is_set_aside(monkeypatc
         for k, point, _ in starts:
             for tag in "ab":
                 spec = loci.RunSpec(f"c/fold_of_cycles_{k}{tag}2", {}, "", "", ("p", "q"))
-                rows.append((k, PointType.LPC, spec, _locus(np.array(
+                rows.append((k, PointType.LPC, spec, make_locus(np.array(
                     [point.parameters, point.parameters + [0.0, 0.1 if tag == "a" else -0.1]]))))
         return rows[::-1]  # any order: the recipe puts them in its own
 
     def wave(_engine, _pair, _bounds, _numerics, traced, curves, _width):
         grown.append([spec.name for _, spec, _ in traced.values()])
         if len(grown) == 1:  # wave 0's locus runs through (0.5, 0.3), wave 1's first start
-            return [(PointType.LPC, _locus(np.array([[0.5, 0.0], [0.5, 0.5]])))]
+            return [(PointType.LPC, make_locus(np.array([[0.5, 0.0], [0.5, 0.5]])))]
         return [(kind, curve) for kind, _, curve in traced.values()]
 
     monkeypatch.setattr(loci, "_trace", trace)

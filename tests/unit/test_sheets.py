@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from matplotlib.colors import to_hex
 
-from tests.unit.test_plots import STATES, branch_lines, continuation, make_sweep  # noqa: F401
+from tests.unit.plot_data import STATES, branch_lines, make_sweep
 from whirl_cli.errors import StudyError, WhirlError
 from whirl_cli.figures.draw import draw_sheet
 from whirl_cli.figures.index import Entry, index_html

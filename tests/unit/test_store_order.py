@@ -13,7 +13,7 @@ from whirl_cli.output import store
 from whirl_cli.results import Boundary, LinearGrid, Orbit, RunRecord, UnsafeInterval
 
 from ..conftest import ROOT
-from .test_compare import equilibrium_branch, make_result, periodic_branch
+from .compare_data import equilibrium_branch, make_result, periodic_branch
 
 REFERENCE = ROOT / "tests" / "data" / "legacy_hardening_case2.h5"  # written 2026-11-25
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from matplotlib.colors import to_hex
 
-from tests.unit.test_plots import make_branch, make_point
+from tests.unit.plot_data import make_branch, make_point
 from whirl_cli.plots.blowup import approach, blowup_plot, fit_blowup
 from whirl_cli.plots.key import _new_figure
 from whirl_cli.plots.laws import laws_plot

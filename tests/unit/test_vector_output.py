@@ -11,7 +11,6 @@ import xml.etree.ElementTree as ET
 import pytest
 from click.testing import CliRunner
 
-from tests.unit.test_plots import continuation  # noqa: F401
 from whirl_cli.cli import cli
 from whirl_cli.output import store
 from whirl_cli.plots.diagrams import bifurcation_diagram
