@@ -236,3 +236,34 @@ def test_point_type_codes_are_named_in_the_file(tmp_path):
             assert names[3] == "HB" and names[101] == "HOMOCLINIC" and names[0] == "REGULAR"
             assert all(names[int(code)] == results.PointType(int(code)).name
                        for code in dataset[()])
+
+
+def test_coordinates_are_hdf5_dimension_scales(tmp_path):
+    """Where the declaration gives a coordinate (an axis along which exactly one 1-D dataset
+    lies), the file says so: an orbit's time is the dimension scale of its states' first axis,
+    a linear sweep's values of its eigenvalues, damping ratios, frequencies and whirl senses;
+    a branch's points have no single coordinate and get none. Read back, nothing changes."""
+    import h5py
+
+    values = np.linspace(0.0, 1.0, 5)
+    eigenvalues = np.column_stack([-1 + values + 2j, -1 + values - 2j])
+    sweep = results.LinearSweep("V", "m/s", values, eigenvalues, -eigenvalues.real / 2.2,
+                                np.abs(eigenvalues.imag), np.array([["FW", "BW"]] * 5))
+    main = branch("main_down", "periodic", 6)
+    result = results.StudyResult("s", "m", (results.ContinuationResult(
+        "c", "one-parameter", (main,), ()),), (sweep,), ())
+    path = store.write(result, tmp_path / "r.h5")
+    with h5py.File(path) as handle:
+        sweeps = handle["linear/sweeps/V"]
+        for key in ("eigenvalues", "damping_ratio", "frequency", "whirl"):
+            (scale,) = sweeps[key].dims[0].values()
+            assert scale.name == "/linear/sweeps/V/values"
+        orbit = handle["continuations/c/branches/main_down/orbits/3"]
+        (scale,) = orbit["states"].dims[0].values()
+        assert scale.name.endswith("/orbits/3/time") and not len(orbit["states"].dims[1])
+        points = handle["continuations/c/branches/main_down"]
+        assert all(not len(points[k].dims[0]) for k in ("period", "l2_norm", "stable"))
+    read = store.read(path)
+    np.testing.assert_array_equal(read.linear_sweeps[0].values, values)
+    np.testing.assert_array_equal(read.continuations[0].branches[0].orbits[0].states,
+                                  main.orbits[0].states)

@@ -235,6 +235,32 @@ def write_record(group: h5py.Group, obj, fields: Sequence[Field]) -> None:
                 continue  # an optional dataset, absent (read back as None)
             dataset = group.create_dataset(field.hdf5_key(kind), **_encoded(value, field.kind))
             _attach(dataset, field, obj, kind)
+    _attach_scales(group, fields, kind)
+
+
+def _attach_scales(group: h5py.Group, fields: Sequence[Field], kind: str) -> None:
+    """HDF5 dimension scales where the declaration gives one: an axis (a name in ``shape``,
+    not a names field) along which exactly one one-dimensional dataset lies is that
+    dataset's (a sweep's ``values``, a grid's ``x`` and ``y``, a time history's ``time``),
+    attached to that axis of every other dataset of the group that has it. A tool reading
+    the file alone (h5py's ``dims``, netCDF readers) then knows the coordinates."""
+    names = {f.columns[0] for f in fields if f.columns is not None}
+    stored = [f for f in fields if f.stored == "dataset" and f.shape
+              and f.hdf5_key(kind) in group]
+    lines: dict[str, list[Field]] = {}
+    for field in stored:
+        if len(field.shape) == 1 and isinstance(field.shape[0], str) \
+                and field.shape[0] not in names:
+            lines.setdefault(field.shape[0], []).append(field)
+    scales = {axis: group[found[0].hdf5_key(kind)] for axis, found in lines.items()
+              if len(found) == 1}
+    for axis, scale in scales.items():
+        scale.make_scale(axis)
+    for field in stored:
+        dataset = group[field.hdf5_key(kind)]
+        for position, axis in enumerate(field.shape):
+            if axis in scales and dataset != scales[axis]:
+                dataset.dims[position].attach_scale(scales[axis])
 
 
 def read_record(group: h5py.Group, fields: Sequence[Field]) -> dict[str, Any]:
