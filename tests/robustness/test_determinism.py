@@ -22,12 +22,23 @@ VOLATILE = {("/", "created"), ("runs", "wall_seconds")}
 
 
 def contents(path) -> dict:
-    """name -> ("group" | dataset array, attributes) for every object of an HDF5 file."""
+    """name -> ("group" | dataset array, attributes) for every object of an HDF5 file; the
+    object references of dimension scales (``DIMENSION_LIST``, ``REFERENCE_LIST``) as the
+    names of the objects they refer to (a reference itself is particular to its file)."""
     found: dict = {}
     with h5py.File(path, "r") as handle:
+        def named(value):
+            if isinstance(value, h5py.Reference):
+                return handle[value].name
+            if isinstance(value, np.void):
+                return tuple(named(v) for v in value)
+            if isinstance(value, np.ndarray) and value.dtype.kind in "OV":
+                return str([named(v) for v in value.ravel()])
+            return value
+
         def visit(name: str, item) -> None:
             data = "group" if isinstance(item, h5py.Group) else item[()]
-            found[name] = (data, dict(item.attrs))
+            found[name] = (data, {key: named(value) for key, value in item.attrs.items()})
 
         visit("/", handle)
         handle.visititems(visit)
