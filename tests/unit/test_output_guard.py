@@ -264,17 +264,19 @@ def test_two_overwriting_publishers_leave_one_consistent_set(tmp_path):
 
 
 @pytest.mark.parametrize("kind", ["text", "fifo", "directory"])
-def test_a_sweep_refuses_a_foreign_result_path_before_any_work(tmp_path, kind):
-    """``whirl sweep`` checks every result file it would write before it starts: another
-    program's file (here a text file, a FIFO, a directory) at results/<study>.h5 stops it
-    with a reason, nothing else is written and the path is left as it was."""
+@pytest.mark.parametrize("name", ["linear-case2.h5", "linear-case2_k1_bifurcation.png"])
+def test_a_sweep_refuses_a_foreign_output_path_before_any_work(tmp_path, kind, name):
+    """``whirl sweep`` checks every file it would write before it starts, result files and
+    plots (``<study>_*.png``): another program's file (here a text file, a FIFO, a directory)
+    at one of them stops it with a reason, nothing else is written and the path is left as
+    it was."""
     studies = tmp_path / "studies"
     studies.mkdir()
     (studies / "a.yaml").write_text((ROOT / "studies" / "thesis_ch3" / "linear_case2.yaml")
                                     .read_text())
     results = tmp_path / "results"
     results.mkdir()
-    target = results / "linear-case2.h5"
+    target = results / name
     if kind == "text":
         target.write_text("mine")
     elif kind == "fifo":
@@ -286,36 +288,11 @@ def test_a_sweep_refuses_a_foreign_result_path_before_any_work(tmp_path, kind):
     assert done.returncode == 1, done.stderr
     assert f"{target}: " in done.stderr and "whirl never replaces it" in done.stderr
     assert "Traceback" not in done.stderr and "start" not in done.stderr
-    assert sorted(p.name for p in results.iterdir()) == ["linear-case2.h5"]
+    assert sorted(p.name for p in results.iterdir()) == [name]
     if kind == "text":
         assert target.read_text() == "mine"
     else:
         assert stat.S_ISFIFO(target.lstat().st_mode) if kind == "fifo" else target.is_dir()
-
-
-@pytest.mark.parametrize("kind", ["text", "fifo", "directory"])
-def test_a_sweep_refuses_a_foreign_plot_path_before_any_work(tmp_path, kind):
-    """As for its result files, ``whirl sweep`` checks the plot paths it would write
-    (``<study>_*.png``) before it starts."""
-    studies = tmp_path / "studies"
-    studies.mkdir()
-    (studies / "a.yaml").write_text((ROOT / "studies" / "thesis_ch3" / "linear_case2.yaml")
-                                    .read_text())
-    results = tmp_path / "results"
-    results.mkdir()
-    target = results / "linear-case2_k1_bifurcation.png"
-    if kind == "text":
-        target.write_text("mine")
-    elif kind == "fifo":
-        os.mkfifo(target)
-    else:
-        target.mkdir()
-    done = subprocess.run([str(Path(sys.executable).with_name("whirl")), "sweep", str(studies),
-                           "-o", str(results)], capture_output=True, text=True, timeout=120)
-    assert done.returncode == 1, done.stderr
-    assert f"{target}: " in done.stderr and "whirl never replaces it" in done.stderr
-    assert "Traceback" not in done.stderr and "start" not in done.stderr
-    assert sorted(p.name for p in results.iterdir()) == [target.name]
 
 
 # ------------------------------------------------------------ plots of two results colliding
