@@ -72,10 +72,9 @@ def equilibria(engine: Engine, name: str, parameter: str, start: float,
     start_parameters = {**parameters, parameter: float(start)}
     state = starting_equilibrium(model, start_parameters, guess, f"{name}: {parameter} = "
                                  f"{start:g}")
-    start_state = None if not state.any() else \
-        " ".join(f"{x:.17g}" for x in state / model.state_scale) + "\n"
     specs = _both_ways(model, numerics, parameter, start, bounds, start_parameters,
-                       f"{name}/main", f"start at {parameter} = {start:g}", start_state)
+                       f"{name}/main", f"start at {parameter} = {start:g}",
+                       _start_line(model, state) if state.any() else None)
     branches: list[Branch] = []
     points: list[SpecialPoint] = []
     frontier = _run_branches(engine, specs, branches, points, skip_first=False)
@@ -114,11 +113,10 @@ def equilibria(engine: Engine, name: str, parameter: str, start: float,
         if on_branch(branches, start, state, width, amplitudes):
             continue
         found += 1
-        text = " ".join(f"{x:.17g}" for x in state / model.state_scale) + "\n"
         _run_branches(engine, _both_ways(
             model, numerics, parameter, start, bounds, start_parameters,
             f"{name}/resting_{found}", f"equilibrium at {parameter} = {start:g} off every "
-            "branch (a seed settled on it, or its mirror image)", text),
+            "branch (a seed settled on it, or its mirror image)", _start_line(model, state)),
             branches, points, skip_first=False)
 
     unique: list[SpecialPoint] = []
@@ -142,6 +140,12 @@ def _both_ways(model: Model, numerics: Numerics, parameter: str, start: float,
             specs.append(RunSpec(f"{name}_{label}", constants, BranchKind.EQUILIBRIUM, origin,
                                  (parameter,), start_state=start_state))
     return specs
+
+
+def _start_line(model: Model, state: np.ndarray) -> str:
+    """``state`` (SI) as the line of AUTO's U the generated STPNT reads (RunSpec.start_state),
+    to full double precision."""
+    return " ".join(f"{x:.17g}" for x in state / model.state_scale) + "\n"
 
 
 def _mirrored(model: Model, values: dict[str, float], states: tuple[np.ndarray, ...]
