@@ -615,7 +615,8 @@ def _family(model: ModelFile, text: str) -> Family:
                                    c.reason or f"{c.expression.text} must hold")
                         for c in model.constraints)
     datum = {p.name: p.value for p in model.parameters}
-    probes = _probes(model, datum)
+    # probed only for what the file leaves out (the built-ins state both: start-up)
+    probes = _probes(model, datum) if None in (model.symmetric, model.linear) else (None, None)
     return Family(
         name=model.name,
         description=model.description or f"model file {model.name}",
