@@ -5,9 +5,12 @@ from __future__ import annotations
 
 import os
 import stat
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import h5py
+import pytest
 
 from whirl_cli.output import store
 from whirl_cli.results import StudyResult
@@ -64,3 +67,17 @@ def make(kind: str, path: Path) -> str:
 
 
 KINDS = ["device", "fifo", "directory", "symlink", "dangling", "text", "hdf5"]
+
+
+@contextmanager
+def tmpfs(mount: Path, options: str) -> Iterator[Path]:
+    """A tmpfs mounted at the new folder ``mount`` with ``options`` (e.g. "ro,size=64m" for a
+    read-only file system, "size=1m" for a full one), unmounted afterwards; the test is
+    skipped where it cannot be mounted (not root)."""
+    mount.mkdir()
+    if os.geteuid() != 0 or os.system(f"mount -t tmpfs -o {options} tmpfs {mount}") != 0:
+        pytest.skip("needs root and mount")
+    try:
+        yield mount
+    finally:
+        os.system(f"umount {mount}")

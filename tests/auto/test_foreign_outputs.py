@@ -13,7 +13,7 @@ from whirl_cli.cli import cli
 from whirl_cli.output import store, study_files
 
 from ..conftest import STUDIES
-from ..foreign_paths import KINDS, fingerprint, make
+from ..foreign_paths import KINDS, fingerprint, make, tmpfs
 
 AIRSPEED = STUDIES / "linear_datum_airspeed.yaml"  # plots: bifurcation, linear
 
@@ -105,26 +105,14 @@ def test_an_unknown_engine_leaves_no_output_directory(tmp_path):
 
 def test_a_read_only_output_is_found_before_any_work(tmp_path):
     """Before: a read-only file system was found after every AUTO run."""
-    mount = tmp_path / "ro"
-    mount.mkdir()
-    if os.geteuid() != 0 or os.system(f"mount -t tmpfs -o ro,size=64m tmpfs {mount}") != 0:
-        pytest.skip("needs root and mount")
-    try:
+    with tmpfs(tmp_path / "ro", "ro,size=64m") as mount:
         refused_before_work(run(AIRSPEED, "-o", mount / "r.h5"), "Read-only file system")
-    finally:
-        os.system(f"umount {mount}")
 
 
 def test_a_full_output_is_found_before_any_work(tmp_path):
-    mount = tmp_path / "full"
-    mount.mkdir()
-    if os.geteuid() != 0 or os.system(f"mount -t tmpfs -o size=1m tmpfs {mount}") != 0:
-        pytest.skip("needs root and mount")
-    try:
+    with tmpfs(tmp_path / "full", "size=1m") as mount:
         refused_before_work(run(AIRSPEED, "-o", mount / "r.h5"), "MiB free")
         assert os.listdir(mount) == []
-    finally:
-        os.system(f"umount {mount}")
 
 
 def test_plots_keep_the_output_stem(tmp_path):

@@ -22,7 +22,7 @@ from whirl_cli.output import atomic, guard, store, study_files
 from whirl_cli.plots.files import plot_names, save_study_plots
 
 from ..conftest import ROOT
-from ..foreign_paths import KINDS, fingerprint, make, small_result
+from ..foreign_paths import KINDS, fingerprint, make, small_result, tmpfs
 
 LEGACY = ROOT / "tests" / "data" / "legacy_hardening_case2.h5"
 
@@ -145,16 +145,10 @@ def test_an_unwritable_or_full_directory_is_found_up_front(tmp_path, monkeypatch
 
 
 def test_a_read_only_file_system_is_found_up_front(tmp_path):
-    mount = tmp_path / "ro"
-    mount.mkdir()
-    if os.geteuid() != 0 or os.system(f"mount -t tmpfs -o ro,size=64m tmpfs {mount}") != 0:
-        pytest.skip("needs root and mount")
-    try:
+    with tmpfs(tmp_path / "ro", "ro,size=64m") as mount:
         for path in (mount / "r.h5", mount / "sub" / "r.h5"):
             with pytest.raises(OutputError, match="not writable .Read-only file system"):
                 guard.writable(path)
-    finally:
-        os.system(f"umount {mount}")
 
 
 def test_the_output_directory_is_made_only_when_published(tmp_path, monkeypatch):
