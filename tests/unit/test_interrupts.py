@@ -219,12 +219,27 @@ def test_a_signal_during_interpreter_shutdown_ends_whirl_without_a_traceback(tmp
     assert process.returncode == -signal.SIGINT
 
 
-def slow_module(tmp_path, monkeypatch, name: str, body: str = "") -> str:
-    """A module ``name`` under ``tmp_path`` (on sys.path) that takes 0.3 s to import."""
-    (tmp_path / f"{name}.py").write_text(f"import time\ntime.sleep(0.3)\n{body}\n")
+def probe_module(tmp_path, monkeypatch, name: str, text: str) -> str:
+    """A module ``name`` of ``text`` under ``tmp_path`` (on sys.path), not imported yet."""
+    (tmp_path / f"{name}.py").write_text(text)
     monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.delitem(sys.modules, name, raising=False)
     return name
+
+
+def slow_module(tmp_path, monkeypatch, name: str, body: str = "") -> str:
+    """A module ``name`` under ``tmp_path`` (on sys.path) that takes 0.3 s to import."""
+    return probe_module(tmp_path, monkeypatch, name, f"import time\ntime.sleep(0.3)\n{body}\n")
+
+
+def waiting_module(tmp_path, monkeypatch, name: str, flag, attribute: str) -> str:
+    """A module ``name`` whose import ends only once the file ``flag`` exists (or after
+    20 s); its ``attribute`` says whether the flag was there by then."""
+    present = f"os.path.exists({str(flag)!r})"
+    return probe_module(tmp_path, monkeypatch, name,
+                        "import os, time\ndeadline = time.monotonic() + 20\n"
+                        f"while not {present} and time.monotonic() < deadline:\n"
+                        f"    time.sleep(0.01)\n{attribute} = {present}\n")
 
 
 def test_preload_imports_in_the_background_and_a_fork_waits_for_it(tmp_path, monkeypatch):
@@ -232,14 +247,7 @@ def test_preload_imports_in_the_background_and_a_fork_waits_for_it(tmp_path, mon
     20 s, then without DONE): ``preload`` did not wait for it, and the forked workers see it
     imported whole (a module being imported is in sys.modules already, without DONE)."""
     flag = tmp_path / "went_on"
-    name = "whirl_preload_probe"
-    (tmp_path / f"{name}.py").write_text(
-        "import os, time\ndeadline = time.monotonic() + 20\n"
-        f"while not os.path.exists({str(flag)!r}) and time.monotonic() < deadline:\n"
-        "    time.sleep(0.01)\n"
-        f"DONE = os.path.exists({str(flag)!r})\n")
-    monkeypatch.syspath_prepend(str(tmp_path))
-    monkeypatch.delitem(sys.modules, name, raising=False)
+    name = waiting_module(tmp_path, monkeypatch, "whirl_preload_probe", flag, "DONE")
     preload(name)
     flag.touch()
     seen = forked_map(lambda _k: getattr(sys.modules.get(name), "DONE", False), 2, 2)
@@ -265,14 +273,7 @@ def test_a_standby_worker_imports_first_and_computes_from_what_is_submitted_late
         tmp_path, monkeypatch):
     # a module whose import in the worker ends only once this test has submitted (or 20 s)
     flag = tmp_path / "submitted"
-    name = "whirl_standby_probe"
-    (tmp_path / f"{name}.py").write_text(
-        "import os, time\ndeadline = time.monotonic() + 20\n"
-        f"while not os.path.exists({str(flag)!r}) and time.monotonic() < deadline:\n"
-        "    time.sleep(0.01)\n"
-        f"SUBMITTED_FIRST = os.path.exists({str(flag)!r})\n")
-    monkeypatch.syspath_prepend(str(tmp_path))
-    monkeypatch.delitem(sys.modules, name, raising=False)
+    name = waiting_module(tmp_path, monkeypatch, "whirl_standby_probe", flag, "SUBMITTED_FIRST")
     inherited = {"offset": 10}  # made before the fork: the worker sees it without pickling
 
     def work(values):  # a closure: it does not pickle, it is inherited at the fork
