@@ -70,37 +70,52 @@ def outputs(directory: Path) -> list[str]:
     return sorted(p.name for p in directory.iterdir()) if directory.exists() else []
 
 
-def interrupt(cache: Path, scratch: Path, out: Path, delay: float, after_workers: bool,
-              group: bool, reference: list[str]) -> str:
-    """Run the study, send SIGINT ``delay`` s after the start (``after_workers``: after its
-    first forked worker appears), and check how it ended; returns a word for it."""
-    env = environment(cache, TMPDIR=str(scratch))
-    process = subprocess.Popen([str(WHIRL), "run", str(STUDY), "-o", str(out / "r.h5")],
-                               env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                               text=True, start_new_session=True)
+def signalled(arguments: list[str], env: dict[str, str], delay: float, send,
+              ready=lambda process: True) -> tuple[subprocess.Popen, str, str]:
+    """Start whirl with ``arguments`` in a session of its own, wait until ``ready(process)``
+    (or the process has ended), then ``delay`` s, call ``send(process)`` (the signal), and
+    return (process, stdout, stderr) once it has ended: a test failure naming the processes
+    left if it hangs for HANG_SECONDS; the session killed if anything in between fails."""
+    process = subprocess.Popen([str(WHIRL), *arguments], env=env, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, start_new_session=True)
     try:
-        while after_workers and len(session_processes(process.pid)) < 2 and \
-                process.poll() is None:
+        while not ready(process) and process.poll() is None:
             time.sleep(0.005)
         time.sleep(delay)
-        if group:
-            os.killpg(process.pid, signal.SIGINT)
-        else:
-            process.send_signal(signal.SIGINT)
+        send(process)
         try:
-            _, stderr = process.communicate(timeout=HANG_SECONDS)
+            stdout, stderr = process.communicate(timeout=HANG_SECONDS)
         except subprocess.TimeoutExpired:
-            pytest.fail(f"whirl hung after SIGINT (group={group}); "
+            pytest.fail(f"whirl {arguments[0]} hung after the signal at {delay:.2f} s; "
                         f"alive: {session_processes(process.pid)}")
     finally:
         if process.poll() is None:
             os.killpg(process.pid, signal.SIGKILL)
             process.wait()
-    assert "Traceback" not in stderr, stderr
-    deadline = time.monotonic() + HANG_SECONDS  # a guard: the loop ends once all are gone
+    return process, stdout, stderr
+
+
+def wait_gone(process: subprocess.Popen, cache: Path) -> None:
+    """Until every process of ``process``'s session and every AUTO run of ``cache`` has
+    ended (a guard: at most HANG_SECONDS)."""
+    deadline = time.monotonic() + HANG_SECONDS
     while (session_processes(process.pid) or auto_processes(cache)) and \
             time.monotonic() < deadline:
         time.sleep(0.02)
+
+
+def interrupt(cache: Path, scratch: Path, out: Path, delay: float, after_workers: bool,
+              group: bool, reference: list[str]) -> str:
+    """Run the study, send SIGINT ``delay`` s after the start (``after_workers``: after its
+    first forked worker appears), and check how it ended; returns a word for it."""
+    env = environment(cache, TMPDIR=str(scratch))
+    process, _, stderr = signalled(
+        ["run", str(STUDY), "-o", str(out / "r.h5")], env, delay,
+        (lambda p: os.killpg(p.pid, signal.SIGINT)) if group
+        else (lambda p: p.send_signal(signal.SIGINT)),
+        ready=lambda p: not after_workers or len(session_processes(p.pid)) >= 2)
+    assert "Traceback" not in stderr, stderr
+    wait_gone(process, cache)
     assert session_processes(process.pid) == [], "a forked worker outlived whirl"
     assert auto_processes(cache) == [], "an AUTO process outlived whirl"
     left = sorted(scratch.rglob("*"))[:5]
@@ -168,26 +183,10 @@ def terminate_sweep(cache: Path, scratch: Path, studies: Path, out: Path, delay:
     """A ``whirl sweep -j 2`` (with plots) sent SIGTERM as a process group ``delay`` s after
     its start, as a batch system's cancel does; checks how it ended, returns a word for it."""
     env = environment(cache, TMPDIR=str(scratch))
-    process = subprocess.Popen([str(WHIRL), "sweep", str(studies), "-o", str(out), "-j", "2"],
-                               env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                               text=True, start_new_session=True)
-    try:
-        time.sleep(delay)
-        os.killpg(process.pid, signal.SIGTERM)
-        try:
-            _, stderr = process.communicate(timeout=HANG_SECONDS)
-        except subprocess.TimeoutExpired:
-            pytest.fail(f"whirl sweep hung after SIGTERM at {delay:.2f} s; "
-                        f"alive: {session_processes(process.pid)}")
-    finally:
-        if process.poll() is None:
-            os.killpg(process.pid, signal.SIGKILL)
-            process.wait()
+    process, _, stderr = signalled(["sweep", str(studies), "-o", str(out), "-j", "2"], env,
+                                   delay, lambda p: os.killpg(p.pid, signal.SIGTERM))
     assert "Traceback" not in stderr and "internal error" not in stderr, (delay, stderr)
-    deadline = time.monotonic() + HANG_SECONDS  # a guard: the loop ends once all are gone
-    while (session_processes(process.pid) or auto_processes(cache)) and \
-            time.monotonic() < deadline:
-        time.sleep(0.02)
+    wait_gone(process, cache)
     assert session_processes(process.pid) == [], "a worker outlived the sweep"
     assert auto_processes(cache) == [], "an AUTO process outlived the sweep"
     left = sorted(p.name for p in scratch.iterdir())
@@ -252,16 +251,8 @@ def test_a_sigterm_early_in_a_command_ends_it_as_an_interrupt(tmp_path, command)
                              "--results", str(tmp_path / "results")]}[command]
     for k in range(EARLY_SIGNALS):
         delay = first + k / EARLY_SIGNALS * EARLY_SECONDS
-        process = subprocess.Popen([str(WHIRL), *arguments], env=env, stdout=subprocess.PIPE,
-                                   stderr=subprocess.PIPE, text=True, start_new_session=True)
-        try:
-            time.sleep(delay)
-            os.killpg(process.pid, signal.SIGTERM)
-            stdout, stderr = process.communicate(timeout=HANG_SECONDS)
-        finally:
-            if process.poll() is None:
-                os.killpg(process.pid, signal.SIGKILL)
-                process.wait()
+        process, stdout, stderr = signalled(arguments, env, delay,
+                                            lambda p: os.killpg(p.pid, signal.SIGTERM))
         assert process.returncode == 143, (command, delay, process.returncode, stderr)
         assert stderr.rstrip().endswith("interrupted") and "Traceback" not in stdout + stderr
         assert list(scratch.iterdir()) == [], (command, delay)
