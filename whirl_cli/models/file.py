@@ -362,26 +362,9 @@ class _Checker:
             known.add(name)
         self._mass(known, state_free)
         dofs = [d.name for d in model.dofs]
-        for name, expression in model.forces.items():
-            if name not in dofs:
-                self._add(("forces", name), f"no dof {name!r} (dofs: {', '.join(dofs)})")
-            unknown = sorted(expression.names - known)
-            if unknown:
-                self._add(("forces", name), _unknown(unknown))
-        missing = [d for d in dofs if d not in model.forces]
-        if missing:
-            self._add(("forces",), f"no force for dof {', '.join(missing)} (write 0 if none)")
-        first_order = [x.name for x in model.states]
-        for name, expression in model.rates.items():
-            if name not in first_order:
-                self._add(("rates", name), f"no first-order state {name!r} (states: "
-                          f"{', '.join(first_order) or 'none'})")
-            unknown = sorted(expression.names - known)
-            if unknown:
-                self._add(("rates", name), _unknown(unknown))
-        missing = [x for x in first_order if x not in model.rates]
-        if missing:
-            self._add(("rates",), f"no rate for state {', '.join(missing)} (write 0 if none)")
+        self._one_each("forces", model.forces, dofs, ("dof", "dofs", "force for dof"), known)
+        self._one_each("rates", model.rates, [x.name for x in model.states],
+                       ("first-order state", "states", "rate for state"), known)
         if model.hub is not None:
             self._path(("hub",), model.hub, states)
         for i, group in enumerate(model.mode_groups):
@@ -397,6 +380,23 @@ class _Checker:
             if unknown:
                 self._add(("constraints", i, "expression"),
                           f"{_unknown(unknown)} (a constraint compares parameters)")
+
+    def _one_each(self, key: str, expressions: dict, names: list[str],
+                  words: tuple[str, str, str], known: set[str]) -> None:
+        """One expression under ``key`` per name of ``names`` (forces per dof, rates per
+        first-order state), each of known names only. ``words``: what a name is, what they
+        are, and what one lacks (e.g. "dof", "dofs", "force for dof")."""
+        what, plural, lacking = words
+        for name, expression in expressions.items():
+            if name not in names:
+                self._add((key, name), f"no {what} {name!r} ({plural}: "
+                                       f"{', '.join(names) or 'none'})")
+            unknown = sorted(expression.names - known)
+            if unknown:
+                self._add((key, name), _unknown(unknown))
+        missing = [n for n in names if n not in expressions]
+        if missing:
+            self._add((key,), f"no {lacking} {', '.join(missing)} (write 0 if none)")
 
     def _mass(self, known: set[str], state_free: set[str]) -> None:
         n = len(self.model.dofs)
