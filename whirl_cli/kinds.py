@@ -1,7 +1,12 @@
 """whirl's vocabulary of kinds that several stages name, each declared once here (no imports):
-the study schema, the command line and the drawing code read them from this module."""
+the study schema, the command line and the drawing code read them from this module.
+
+The enums' values are the words result files store and whirl prints: a value never changes.
+"""
 
 from __future__ import annotations
+
+from enum import StrEnum
 
 #: The plot kinds of a study's figures (``plots:`` in a study, ``whirl plot --kind``), in the
 #: order a result's figures are drawn.
@@ -15,3 +20,109 @@ MOTION_KINDS = ("poincare", "spectrum", "orbit_diagram")
 #: The kinds of locus (a two-parameter continuation's ``loci``) that bound the unsafe region
 #: by folds: of equilibria and of cycles.
 FOLD_LOCI = ("fold", "fold_of_cycles")
+
+
+class Word(StrEnum):
+    """A word of whirl's vocabulary: a str equal to its value, shown as that value (in
+    reprs too, so that what whirl prints does not change with the type)."""
+
+    def __repr__(self) -> str:
+        return repr(self.value)
+
+
+class BranchKind(Word):
+    """What a branch (a run's curve) holds: equilibria, periodic orbits, or a locus of one
+    kind of special point over two parameters; ``homoclinic`` is a HomCont run, never a
+    stored branch."""
+
+    EQUILIBRIUM = "equilibrium"
+    PERIODIC = "periodic"
+    HOPF_LOCUS = "hopf_locus"
+    BRANCH_POINT_LOCUS = "branch_point_locus"
+    FOLD_LOCUS = "fold_locus"
+    FOLD_OF_CYCLES_LOCUS = "fold_of_cycles_locus"
+    TORUS_LOCUS = "torus_locus"
+    HOMOCLINIC = "homoclinic"
+
+    @property
+    def is_locus(self) -> bool:
+        return self.value.endswith("_locus")
+
+
+class ContinuationKind(Word):
+    """A study's continuation ``type``, and a result's continuation kind."""
+
+    ONE_PARAMETER = "one-parameter"
+    TWO_PARAMETER = "two-parameter"
+
+
+class RunStatus(Word):
+    """How an AUTO run ended (a branch's and a run record's ``status``)."""
+
+    OK = "ok"
+    MX = "mx"  # no convergence: the branch ends early
+    TIMEOUT = "timeout"
+    CRASHED = "crashed"
+    ERROR = "error"
+
+
+class Criticality(Word):
+    """Of a Hopf point: the periodic family it starts is stable (supercritical) or unstable
+    (subcritical); UNKNOWN (the empty text) for other points or where undecided."""
+
+    SUPERCRITICAL = "supercritical"
+    SUBCRITICAL = "subcritical"
+    UNKNOWN = ""
+
+
+class LocateStatus(Word):
+    """How a special point was found: AUTO converged on it, it was estimated between points
+    (a bracket), or AUTO labelled it but whirl's own check says it is not that point."""
+
+    LOCATED = "located"
+    BRACKETED = "bracketed"
+    REJECTED = "rejected"
+
+
+class MotionKind(Word):
+    """What a simulated motion settled on (an ``explore:`` classification)."""
+
+    EQUILIBRIUM = "equilibrium"
+    PERIODIC = "periodic"
+    QUASI_PERIODIC = "quasi-periodic"
+    CHAOTIC = "chaotic"
+    DIVERGED = "diverged"
+
+
+class SeedKind(Word):
+    """What a continuation's seed settled on."""
+
+    PERIODIC = "periodic"
+    EQUILIBRIUM = "equilibrium"
+    DIVERGED = "diverged"
+    UNSETTLED = "unsettled"
+
+
+class SweepAction(Word):
+    """What a sweep does with a study: run it, skip it (up to date), only plot it, or report
+    it invalid."""
+
+    RUN = "run"
+    SKIP = "skip"
+    PLOT = "plot"
+    INVALID = "invalid"
+
+
+class SweepStatus(Word):
+    """What became of a study in a sweep."""
+
+    OK = "ok"
+    FAILED = "failed"  # stored, with problems
+    SKIPPED = "skipped"
+    PLOTTED = "plotted"
+    INVALID = "invalid"
+    ERROR = "error"  # no result: the task raised
+
+    @property
+    def failed(self) -> bool:
+        return self in (SweepStatus.FAILED, SweepStatus.INVALID, SweepStatus.ERROR)

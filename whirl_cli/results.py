@@ -13,6 +13,19 @@ from enum import IntEnum
 
 import numpy as np
 
+from .kinds import (
+    BranchKind,
+    ContinuationKind,
+    Criticality,
+    LocateStatus,
+    MotionKind,
+    RunStatus,
+    SeedKind,
+)
+
+__all__ = ["BranchKind", "ContinuationKind", "Criticality", "LocateStatus", "MotionKind",
+           "RunStatus", "SeedKind"]  # re-exported: the vocabulary results are written in
+
 
 def _brief(value) -> str:
     """A field's value in a short repr: an array as its shape and type, a collection of
@@ -138,18 +151,6 @@ def _is_special(code) -> bool:
         return True
 
 
-class BranchKind:
-    """Values of :attr:`Branch.kind`."""
-
-    EQUILIBRIUM = "equilibrium"
-    PERIODIC = "periodic"
-    HOPF_LOCUS = "hopf_locus"
-    BRANCH_POINT_LOCUS = "branch_point_locus"
-    FOLD_LOCUS = "fold_locus"
-    FOLD_OF_CYCLES_LOCUS = "fold_of_cycles_locus"
-    TORUS_LOCUS = "torus_locus"
-
-
 @dataclass(frozen=True)
 class Orbit:
     """One stored solution profile (a labelled AUTO solution), states in SI units.
@@ -210,7 +211,7 @@ class Branch:
     """
 
     name: str
-    kind: str
+    kind: BranchKind
     origin: str
     parameter_names: tuple[str, ...]
     parameter_units: tuple[str, ...]
@@ -225,7 +226,7 @@ class Branch:
     point_type: np.ndarray
     label: np.ndarray
     eigenvalues: np.ndarray
-    status: str = "ok"
+    status: RunStatus = RunStatus.OK
     message: str = "ok"
     run: str = ""
     orbits: tuple[Orbit, ...] = field(default=())
@@ -286,20 +287,16 @@ class Branch:
         return dataset(branch_table(self))
 
 
-#: :attr:`SpecialPoint.status` of a point AUTO labelled that its own check says is not of
-#: that type (e.g. a TR point without a pair of Floquet multipliers on the unit circle).
-REJECTED = "rejected"
-
-
 @dataclass(frozen=True)
 class SpecialPoint:
     """A bifurcation or notable end on a branch.
 
-    ``status``: "located" (AUTO converged on it), "bracketed" (estimated between points, e.g.
+    ``status``: located (AUTO converged on it), bracketed (estimated between points, e.g.
     a period blow-up, with ``bracket`` the interval of the principal parameter and ``residual``
-    the relative fit residual) or :data:`REJECTED` (AUTO labelled it, but its own check says it
-    is not that kind of point; ``note`` says why). ``criticality``: "supercritical" |
-    "subcritical" | "" (Hopf points: from the periodic family leaving it, else from
+    the relative fit residual) or rejected (AUTO labelled it, but its own check says it
+    is not that kind of point, e.g. a TR point without a pair of Floquet multipliers on the
+    unit circle; ``note`` says why). ``criticality``: supercritical |
+    subcritical | unknown (Hopf points: from the periodic family leaving it, else from
     ``lyapunov``). ``lyapunov``: first Lyapunov coefficient of a Hopf point of equilibria
     [1/(s unit^2), SI states; < 0 supercritical], NaN otherwise (see
     :mod:`whirl_cli.analysis.normal_form`).
@@ -314,8 +311,8 @@ class SpecialPoint:
     period: float
     stable: bool
     label: int = 0
-    status: str = "located"
-    criticality: str = ""
+    status: LocateStatus = LocateStatus.LOCATED
+    criticality: Criticality = Criticality.UNKNOWN
     note: str = ""
     bracket: np.ndarray = field(default_factory=lambda: np.full(2, np.nan))  # bracketed only
     residual: float = float("nan")  # relative rms fit residual (bracketed global points)
@@ -430,7 +427,7 @@ class RunRecord:
     """Bookkeeping of one AUTO run, stored under /runs."""
 
     name: str
-    status: str
+    status: RunStatus
     message: str
     constants: str
     returncode: int
@@ -502,7 +499,7 @@ class SeedOutcome:
 
     index: int
     seed: np.ndarray
-    kind: str
+    kind: SeedKind
     period: float
     branch: str
     message: str
@@ -533,7 +530,7 @@ class Exploration:
     state_names: tuple[str, ...]
     state_units: tuple[str, ...]
     initial: np.ndarray
-    kind: str
+    kind: MotionKind
     lyapunov: float
     lyapunov_error: float
     frequencies: np.ndarray
@@ -555,7 +552,7 @@ class ContinuationResult:
     ``explorations``: the motion classified by simulation at each ``explore:`` value."""
 
     name: str
-    kind: str  # "one-parameter" | "two-parameter"
+    kind: ContinuationKind
     branches: tuple[Branch, ...]
     special_points: tuple[SpecialPoint, ...]
     cross_checks: tuple[CrossCheck, ...] = ()

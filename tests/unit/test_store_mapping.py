@@ -74,7 +74,7 @@ def branch(name: str, kind: str, n: int) -> results.Branch:
 
 def synthetic_result() -> results.StudyResult:
     point = results.SpecialPoint("b_periodic", 1, 5, ("V",), np.array([0.5]), np.zeros(2), 0.2,
-                                 True, label=3, status="bracketed", criticality="sub",
+                                 True, label=3, status="bracketed", criticality="subcritical",
                                  note="n", bracket=np.array([0.4, 0.6]), residual=0.1,
                                  parameter_units=("m/s",), refined=np.array([0.51, 0.52]),
                                  refined_by="epsilon locus")

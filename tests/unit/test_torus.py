@@ -44,12 +44,12 @@ def test_a_tr_point_without_a_pair_on_the_unit_circle_is_listed_as_rejected():
     product 1): that TR point is listed as rejected, its note says why, and it has no angle;
     one with a complex pair on the circle is located with its angle."""
     from whirl_cli.continuation.branches import special_points
-    from whirl_cli.results import REJECTED
+    from whirl_cli.results import LocateStatus
 
     saddle = np.array([1.0, 4.0, 0.25, 0.1])
     (rejected,) = special_points(_periodic_with_tr(saddle))
-    assert rejected.status == REJECTED and np.isnan(rejected.torus_angle)
+    assert rejected.status == LocateStatus.REJECTED and np.isnan(rejected.torus_angle)
     assert "not a torus bifurcation" in rejected.note
     torus = np.array([1.0, np.exp(0.7j), np.exp(-0.7j), 0.1])
     (located,) = special_points(_periodic_with_tr(torus))
-    assert located.status == "located" and located.torus_angle == pytest.approx(0.7)
+    assert located.status == LocateStatus.LOCATED and located.torus_angle == pytest.approx(0.7)

@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..models import Model
-from ..results import REJECTED, Branch, PointType, SpecialPoint
+from ..results import Branch, LocateStatus, PointType, SpecialPoint
 
 #: The per-point columns of a :class:`Branch` (one row per point); ``torus_angle`` is one
 #: only on torus loci (None elsewhere).
@@ -94,12 +94,12 @@ def neimark_sacker_angle(multipliers: np.ndarray) -> float:
 
 def _torus(branch: Branch, index: int) -> dict:
     """A TR point's ``torus_angle``; if its multipliers (known) have no pair on the unit
-    circle, the status REJECTED and a ``note`` saying why."""
+    circle, the status rejected and a ``note`` saying why."""
     multipliers = branch.eigenvalues[index]
     angle = neimark_sacker_angle(multipliers)
     if not np.isfinite(multipliers).any() or np.isfinite(angle):
         return {"torus_angle": angle}
-    return {"torus_angle": angle, "status": REJECTED,
+    return {"torus_angle": angle, "status": LocateStatus.REJECTED,
             "note": "no complex pair of Floquet multipliers on the unit circle: AUTO's torus "
                     "test function changed sign without a Neimark-Sacker pair (not a torus "
                     "bifurcation)"}

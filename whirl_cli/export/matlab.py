@@ -74,7 +74,7 @@ def _named(members: dict[str, dict]) -> dict[str, dict]:
 def _continuation(continuation: ContinuationResult) -> dict[str, object]:
     points = special_point_table(continuation)
     found: dict[str, object] = {
-        "name": continuation.name, "kind": continuation.kind,
+        "name": continuation.name, "kind": str(continuation.kind),
         "branches": _named({b.name: _record(branch_table(b)) for b in continuation.branches}),
         "special_points": _columns(points),
         "special_point_units": _units(points),

@@ -30,7 +30,7 @@ def groups(result: StudyResult) -> dict[str, object]:
     for continuation in result.continuations:
         where = f"/continuations/{continuation.name}"
         found[where] = xarray.Dataset(attrs={"name": continuation.name,
-                                             "kind": continuation.kind})
+                                             "kind": str(continuation.kind)})
         found[f"{where}/special_points"] = dataset(special_point_table(continuation))
         for branch in continuation.branches:
             found[f"{where}/branches/{branch.name}"] = dataset(branch_table(branch))

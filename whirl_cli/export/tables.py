@@ -109,10 +109,16 @@ def branch_table(branch: Branch) -> Table:
     axes = {"parameter": Axis(branch.parameter_names, branch.parameter_units),
             "state": Axis(branch.state_names, branch.state_units),
             "mode": _modes(np.shape(branch.eigenvalues)[1])}
-    attributes = {"name": branch.name, "kind": branch.kind, "origin": branch.origin,
-                  "status": branch.status, "message": branch.message, "run": branch.run,
+    attributes = {"name": branch.name, "kind": str(branch.kind), "origin": str(branch.origin),
+                  "status": str(branch.status), "message": branch.message, "run": branch.run,
                   "end": branch.end}
     return Table(branch.name, tuple(columns), axes, attributes)
+
+
+def plain(value):
+    """``value``, a word of whirl's vocabulary as a plain str (export formats take no
+    subclass of str)."""
+    return str(value) if isinstance(value, str) else value
 
 
 def special_point_table(continuation: ContinuationResult) -> Table:
@@ -128,7 +134,7 @@ def special_point_table(continuation: ContinuationResult) -> Table:
     rows = ("special_point",)
 
     def column(name: str, dtype, dims=rows, unit="", long_name="", flat="{label}") -> Column:
-        values = np.array([getattr(p, name) for p in points], dtype=dtype)
+        values = np.array([plain(getattr(p, name)) for p in points], dtype=dtype)
         if len(dims) == 2:
             width = {"parameter": len(names), "state": len(states.names)}.get(dims[1], 2)
             values = values.reshape(len(points), width)
@@ -165,7 +171,7 @@ def special_point_table(continuation: ContinuationResult) -> Table:
     axes = {"parameter": Axis(names, units), "state": states,
             "bound": Axis(("lower", "upper")), "refinement": Axis(("half", "quarter"))}
     return Table("special_points", columns, axes, {"name": continuation.name,
-                                                   "kind": continuation.kind})
+                                                   "kind": str(continuation.kind)})
 
 
 def _units_of(names: Sequence[str], branches: Sequence[Branch]) -> tuple[str, ...]:

@@ -51,7 +51,9 @@ class Field:
     beside its code). ``codes``: an IntEnum whose members the integer dataset holds, written
     beside it as the attributes ``flag_values`` and ``flag_meanings`` (the CF conventions'
     pair: the codes and their names, space-separated), so that a reader of the file alone
-    can name them.
+    can name them. ``vocabulary``: for a text field, the type its words are read as (an enum,
+    or any type built from its text form; written as ``str`` of the value); a word outside
+    it is :class:`Damaged`.
     """
 
     name: str
@@ -66,6 +68,7 @@ class Field:
     derived: bool = False
     shape: tuple[int | str, ...] | None = None
     codes: Any = None
+    vocabulary: Callable[[str], Any] | None = None
 
     def hdf5_key(self, kind: str = "") -> str:
         return _choose(self.key, kind) or self.name
@@ -216,7 +219,10 @@ def _name_codes(dataset: h5py.Dataset, field: Field) -> None:
 
 
 def _attribute(field: Field, value):
-    """An attribute value as h5py takes it: tuples as lists of names or arrays of numbers."""
+    """An attribute value as h5py takes it: tuples as lists of names or arrays of numbers,
+    words of a vocabulary as their text."""
+    if field.vocabulary is not None:
+        return str(value)
     if isinstance(value, tuple):
         return np.array(value, dtype=float) if field.kind == "float" else list(value)
     return value
@@ -308,7 +314,18 @@ def _read_attribute(group: h5py.Group, field: Field):
         return value
     if isinstance(value, np.ndarray):  # a list of names, or of numbers
         return tuple(_CONVERT[field.kind](v) for v in value)
-    return _CONVERT[field.kind](value)
+    return _word(field, _CONVERT[field.kind](value), f"{group.name}: attribute {key!r}")
+
+
+def _word(field: Field, value, where: str):
+    """``value`` read as its field's vocabulary (as it is without one); :class:`Damaged`
+    naming ``where`` if it is not a word of it."""
+    if field.vocabulary is None:
+        return value
+    try:
+        return field.vocabulary(value)
+    except ValueError:
+        raise Damaged(where, f"unknown {field.name} {value!r}") from None
 
 
 def _missing(field: Field, where: str, attribute_key: str = ""):
@@ -330,6 +347,8 @@ def write_table(group: h5py.Group, rows: Sequence, fields: Sequence[Field],
     attributes = attributes or {}
     for field in fields:
         values = [getattr(row, field.name) for row in rows]
+        if field.vocabulary is not None:
+            values = [str(v) for v in values]
         if field.width is not None:
             width = field.width if isinstance(field.width, int) else context[field.width]
             values = np.array(values, dtype=float).reshape(len(rows), width)
@@ -371,7 +390,8 @@ def read_table(group: h5py.Group, cls: type, fields: Sequence[Field]) -> tuple:
         values = dict(shared)
         for field in (f for f in fields if not f.derived):
             if field.name in columns:
-                values[field.name] = _CONVERT[field.kind](columns[field.name][k])
+                values[field.name] = _word(field, _CONVERT[field.kind](columns[field.name][k]),
+                                           _path(group, field.hdf5_key()))
             else:
                 values[field.name] = _missing(field, _path(group, field.hdf5_key()))
         rows.append(cls(**values))

@@ -36,16 +36,22 @@ from ..results import (
     Boundary,
     Branch,
     BranchKind,
+    ContinuationKind,
     ContinuationResult,
+    Criticality,
     CrossCheck,
     Exploration,
     FreeplayAmplitudes,
     LinearGrid,
     LinearSweep,
+    LocateStatus,
+    MotionKind,
     Orbit,
     ParameterValue,
     PointType,
     RunRecord,
+    RunStatus,
+    SeedKind,
     SeedOutcome,
     Simulation,
     SpecialPoint,
@@ -77,8 +83,10 @@ _PERIODIC = BranchKind.PERIODIC
 
 #: A :class:`Branch` in ``branches/<name>`` (its name is the group's).
 BRANCH = (
-    Field("kind", "attribute", "text"), Field("origin", "attribute", "text"),
-    Field("status", "attribute", "text"), Field("message", "attribute", "text"),
+    Field("kind", "attribute", "text", vocabulary=BranchKind),
+    Field("origin", "attribute", "text"),
+    Field("status", "attribute", "text", vocabulary=RunStatus),
+    Field("message", "attribute", "text"),
     Field("run", "attribute", "text"), Field("end", "attribute", "text"),
     Field("parameters", columns=("parameter_names", "parameter_units"),
           shape=("points", "parameter_names")),
@@ -112,7 +120,8 @@ SPECIAL_POINT = (
     Field("parameters", width="parameters", columns=("parameter_names", "parameter_units")),
     Field("state", width="states"),  # names and units: the continuation's states
     Field("period", kind="float", units="s"), Field("stable", kind="bool"),
-    Field("status", kind="text"), Field("criticality", kind="text"), Field("note", kind="text"),
+    Field("status", kind="text", vocabulary=LocateStatus),
+    Field("criticality", kind="text", vocabulary=Criticality), Field("note", kind="text"),
     Field("bracket", width=2),  # units: the principal parameter's
     Field("residual", kind="float", units="1"),
     Field("lyapunov", kind="float", default=float("nan")),  # units: see _lyapunov_unit
@@ -136,14 +145,16 @@ CROSS_CHECK = (
 )
 #: The :class:`SeedOutcome` table of a continuation (``seeds/``).
 SEED = (
-    Field("index", kind="int"), Field("seed", width="states"), Field("kind", kind="text"),
+    Field("index", kind="int"), Field("seed", width="states"),
+    Field("kind", kind="text", vocabulary=SeedKind),
     Field("period", kind="float", units="s"), Field("branch", kind="text"),
     Field("message", kind="text"),
 )
 #: An :class:`Exploration` of a continuation, in ``explorations/<k>`` (k from 0, in the
 #: order of the study's ``explore``).
 EXPLORATION = (
-    Field("parameter", "attribute", "text"), Field("kind", "attribute", "text"),
+    Field("parameter", "attribute", "text"),
+    Field("kind", "attribute", "text", vocabulary=MotionKind),
     Field("multiplicity", "attribute", "int"), Field("evidence", "attribute", "text"),
     Field("value", kind="float", unit_field="unit", shape=()),
     Field("initial", columns=("state_names", "state_units"), shape=("state_names",)),
@@ -211,9 +222,12 @@ SIMULATION = (
     Field("states", columns=("state_names", "state_units"), shape=("samples", "state_names")),
     Field("hub", unit_field="hub_unit", shape=("samples", 2)),
 )
+#: A :class:`ContinuationResult`'s own attributes in ``continuations/<name>``.
+CONTINUATION = (Field("kind", "attribute", "text", vocabulary=ContinuationKind),)
 #: A :class:`RunRecord` in ``runs/<name>``.
 RUN = (
-    Field("status", "attribute", "text"), Field("message", "attribute", "text"),
+    Field("status", "attribute", "text", vocabulary=RunStatus),
+    Field("message", "attribute", "text"),
     Field("constants", "attribute", "text"), Field("returncode", "attribute", "int"),
     Field("wall_seconds", "attribute", "float"), Field("n_points", "attribute", "int"),
 )
@@ -240,7 +254,7 @@ def _write_branch(group: h5py.Group, branch: Branch) -> None:
 
 
 def _write_continuation(group: h5py.Group, continuation: ContinuationResult) -> None:
-    group.attrs["kind"] = continuation.kind
+    write_record(group, continuation, CONTINUATION)
     branches = _collection(group, "branches")  # also where there are none: it is required
     for branch in continuation.branches:
         _write_branch(branches.create_group(branch.name), branch)
@@ -445,7 +459,7 @@ def _read_branch(name: str, group: h5py.Group) -> Branch:
 def _read_continuation(name: str, group: h5py.Group) -> ContinuationResult:
     branches = member(group, "branches")
     found = ContinuationResult(
-        name, text(attribute(group, "kind")),
+        name, read_record(group, CONTINUATION)["kind"],
         tuple(_read_branch(b, g) for b, g in branches.items()),
         read_table(member(group, "special_points"), SpecialPoint, SPECIAL_POINT),
         read_table(group["cross_checks"], CrossCheck, CROSS_CHECK)
