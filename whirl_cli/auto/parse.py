@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..models import Model
-from ..results import Branch, BranchKind, Orbit, PointType
+from ..results import Branch, BranchKind, Orbit, PointType, RunStatus
 from .constants import PERIOD_INDEX, TORUS_ANGLE_INDEX, auto_name, par_layout
 from .runner import RunOutcome
 
@@ -227,7 +227,7 @@ def _attach(segment: BSegment, diagnostics: list[Diagnostics], n: int) -> np.nda
     return table
 
 
-def read_branch(outcome: RunOutcome, model: Model, *, name: str, kind: str, origin: str,
+def read_branch(outcome: RunOutcome, model: Model, *, name: str, kind: BranchKind, origin: str,
                 parameter_names: tuple[str, ...]) -> Branch:
     """The branch one AUTO run wrote, in SI units (see :mod:`whirl_cli.results`)."""
     segments = parse_b(outcome.file("b").read_text(errors="replace"))
@@ -298,9 +298,10 @@ def _principal_angle(theta: np.ndarray) -> np.ndarray:
     return np.abs(np.angle(np.exp(1j * np.asarray(theta, dtype=float))))
 
 
-def _unreadable_branch(outcome: RunOutcome, model: Model, name: str, kind: str, origin: str,
+def _unreadable_branch(outcome: RunOutcome, model: Model, name: str, kind: BranchKind,
+                       origin: str,
                        parameter_names: tuple[str, ...], message: str) -> Branch:
-    """An empty branch with status "error": AUTO's output lacks what whirl reads."""
+    """An empty branch with status error: AUTO's output lacks what whirl reads."""
     n, p = model.n_states, len(parameter_names)
     return Branch(
         name=name, kind=kind, origin=origin, parameter_names=tuple(parameter_names),
@@ -309,7 +310,7 @@ def _unreadable_branch(outcome: RunOutcome, model: Model, name: str, kind: str, 
         parameters=np.empty((0, p)), state_max=np.empty((0, n)), state_min=np.empty((0, n)),
         l2_norm=np.empty(0), period=np.empty(0), stable=np.empty(0, dtype=bool),
         point_type=np.empty(0, dtype=np.int64), label=np.empty(0, dtype=np.int64),
-        eigenvalues=np.empty((0, n), dtype=complex), status="error", message=message,
+        eigenvalues=np.empty((0, n), dtype=complex), status=RunStatus.ERROR, message=message,
         run=outcome.name, torus_angle=np.empty(0) if kind == BranchKind.TORUS_LOCUS else None)
 
 

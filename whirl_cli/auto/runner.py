@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
 
+from ..kinds import RunStatus
 from ..runtime import Interrupted, catching
 from .constants import START_FILE, constants_text
 
@@ -99,10 +100,10 @@ def _pdeathsig_prefix() -> tuple[str, ...]:
 
 @dataclass(frozen=True)
 class RunOutcome:
-    """What one AUTO run did. ``status``: ok | mx | error | timeout | crashed."""
+    """What one AUTO run did, and how it ended (``status``)."""
 
     name: str
-    status: str
+    status: RunStatus
     message: str
     workdir: Path
     constants: str
@@ -113,12 +114,12 @@ class RunOutcome:
 
     @property
     def success(self) -> bool:
-        return self.status == "ok"
+        return self.status == RunStatus.OK
 
     @property
     def has_output(self) -> bool:
         """True if AUTO wrote solution points that can be parsed (also after MX)."""
-        return self.n_points > 0 and self.status in ("ok", "mx", "timeout")
+        return self.n_points > 0 and self.status in (RunStatus.OK, RunStatus.MX, RunStatus.TIMEOUT)
 
     def file(self, kind: str) -> Path:
         """Path of AUTO's ``b``, ``s`` or ``d`` output file of this run."""
@@ -244,22 +245,23 @@ def _wait(process: subprocess.Popen, timeout: float, name: str,
 
 
 def _classify(returncode: int | None, timed_out: bool, stdout: str, n_points: int,
-              labels: tuple[tuple[str, int], ...], timeout: float) -> tuple[str, str]:
+              labels: tuple[tuple[str, int], ...], timeout: float) -> tuple[RunStatus, str]:
     if timed_out:
-        return "timeout", f"AUTO did not finish within {timeout:g} s ({n_points} points kept)"
+        return RunStatus.TIMEOUT, (f"AUTO did not finish within {timeout:g} s ({n_points} "
+                                   "points kept)")
     assert returncode is not None
     if returncode < 0 or returncode > 128:
-        return "crashed", f"AUTO crashed with {_describe_signal(returncode)}"
+        return RunStatus.CRASHED, f"AUTO crashed with {_describe_signal(returncode)}"
     for pattern, meaning in FATAL_PATTERNS:  # before the status: bifpy's AUTO exits 1 here
         found = re.search(pattern, stdout)
         if found:
-            return "error", f"{meaning}: AUTO said '{found.group(0).strip()}'"
+            return RunStatus.ERROR, f"{meaning}: AUTO said '{found.group(0).strip()}'"
     if returncode != 0:
-        return "error", f"AUTO exited with status {returncode}"
+        return RunStatus.ERROR, f"AUTO exited with status {returncode}"
     if n_points == 0:
-        return "error", "AUTO wrote no solution points"
+        return RunStatus.ERROR, "AUTO wrote no solution points"
     if any(kind == "MX" for kind, _ in labels):
-        return "mx", ("no convergence with the minimum step size (MX): the branch ends early; "
-                      "try a smaller auto.step_min or more auto.mesh_intervals")
-    return "ok", "ok"
+        return RunStatus.MX, ("no convergence with the minimum step size (MX): the branch ends "
+                              "early; try a smaller auto.step_min or more auto.mesh_intervals")
+    return RunStatus.OK, "ok"
 

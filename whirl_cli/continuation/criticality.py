@@ -11,7 +11,7 @@ import numpy as np
 
 from ..analysis.normal_form import criticality_of, hopf_lyapunov_coefficient
 from ..models import Model
-from ..results import Branch, PointType, SpecialPoint
+from ..results import Branch, Criticality, PointType, SpecialPoint
 from .branches import _joined
 from .periodic import _hopf_at
 
@@ -40,7 +40,8 @@ def _with_criticality(points: list[SpecialPoint], families: list[Branch],
             growth = _hopf_growth_direction(equilibria[point.branch], point)
             side = sides.get(k, 0.0)
             if side and growth:
-                from_family = "supercritical" if side == growth else "subcritical"
+                from_family = (Criticality.SUPERCRITICAL if side == growth
+                               else Criticality.SUBCRITICAL)
                 if point.criticality and point.criticality != from_family:
                     point = replace(point, note=_joined(
                         point.note, f"first Lyapunov coefficient says {point.criticality}"))

@@ -20,7 +20,15 @@ from ..auto import runner, toolchain
 from ..auto.codegen import fortran_source, source_key
 from ..auto.parse import parse_s, read_branch
 from ..models import Model
-from ..results import STEP_LIMIT, Branch, BranchKind, PointType, RunRecord, SpecialPoint
+from ..results import (
+    STEP_LIMIT,
+    Branch,
+    BranchKind,
+    PointType,
+    RunRecord,
+    RunStatus,
+    SpecialPoint,
+)
 from ..runtime import thread_map
 from .branches import special_points
 from .numerics import Numerics as Numerics  # re-exported: the recipes take it from here
@@ -40,7 +48,7 @@ class RunSpec:
 
     name: str
     constants: dict
-    kind: str
+    kind: BranchKind
     origin: str
     parameter_names: tuple[str, ...]
     restart: tuple[str, int] | None = None
@@ -195,9 +203,9 @@ def run_end(branch: Branch, constants: dict, model: Model) -> str:
     end point" (another stop, e.g. a locus meeting a degenerate point)."""
     if not len(branch):
         return f"failed: {branch.message}"
-    if branch.status == "mx" or branch.point_type[-1] == PointType.MX:
+    if branch.status == RunStatus.MX or branch.point_type[-1] == PointType.MX:
         return "no convergence (MX)"
-    if branch.status != "ok":
+    if branch.status != RunStatus.OK:
         return f"{branch.status}: {branch.message}"
     dofs = {model.state_names[k]: k for k in model.positions}
     amplitudes = model.typical_amplitudes

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..results import Branch, PointType
+from ..results import Branch, PointType, RunStatus
 from .branches import head
 
 
@@ -14,7 +14,7 @@ def _chunk_used(curve: Branch, width: np.ndarray, bounds: dict[str, tuple[float,
                 ) -> bool:
     """True if a locus run stopped only because its chunk of steps was used up: it ended
     with status ok on a plain end point, not closed, not at the range edge."""
-    if curve.status != "ok" or len(curve) < 2 or curve.point_type[-1] != PointType.EP:
+    if curve.status != RunStatus.OK or len(curve) < 2 or curve.point_type[-1] != PointType.EP:
         return False
     return len(_closed(curve, width)) == len(curve) and not _at_range_edge(curve, bounds, width)
 

@@ -12,7 +12,7 @@ from ..auto import runner
 from ..auto.constants import base_constants
 from ..auto.parse import parse_b
 from ..models import Model
-from ..results import Branch, SpecialPoint
+from ..results import Branch, BranchKind, LocateStatus, SpecialPoint
 from .branches import _joined, typical_amplitudes
 from .engine import Engine, RunSpec
 
@@ -91,7 +91,7 @@ def _homoclinic_run(engine: Engine, name: str, family: Branch, point: SpecialPoi
     period_tau = float(family.period[row]) * model.time_scale
     return RunSpec(f"{name}/{family.name}.homoclinic",
                    homoclinic_constants(model, parameter, bounds, period_tau, n_unstable),
-                   "homoclinic", point.note, (parameter,),
+                   BranchKind.HOMOCLINIC, point.note, (parameter,),
                    restart=(engine.run_with_label(family.run, label), label))
 
 
@@ -117,7 +117,7 @@ def _homoclinic_verdict(outcome: runner.RunOutcome, point: SpecialPoint, paramet
             f"over {len(tail)} points)"))
     value = float(values[-1])
     span = periods[len(values) // 2:] / time_scale
-    return replace(point, parameters=np.array([value]), status="located", note=_joined(
+    return replace(point, parameters=np.array([value]), status=LocateStatus.LOCATED, note=_joined(
         point.note, f"located by HomCont (IPS=9): {parameter} = {value:.10g}, spread "
         f"{spread:.2g} while the truncation period runs {span.min():.4g}-{span.max():.4g} s"))
 

@@ -12,7 +12,17 @@ import numpy as np
 from ..auto import runner
 from ..auto.constants import TORUS_ANGLE_INDEX, par_layout
 from ..models import Model
-from ..results import STEP_LIMIT, Branch, BranchKind, ContinuationResult, PointType, SpecialPoint
+from ..results import (
+    STEP_LIMIT,
+    Branch,
+    BranchKind,
+    ContinuationKind,
+    ContinuationResult,
+    LocateStatus,
+    PointType,
+    RunStatus,
+    SpecialPoint,
+)
 from ..runtime import thread_map
 from .branches import _same_point, head, join, special_points, typical_amplitudes
 from .engine import Engine, Numerics, RunSpec, _read
@@ -113,8 +123,8 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
                    outermost=snaking_folds == "outermost")
     for curve in curves:
         points += special_points(curve, skip_first=True)
-    return (ContinuationResult(name, "two-parameter", tuple(branches + curves), tuple(points)),
-            curves)
+    return (ContinuationResult(name, ContinuationKind.TWO_PARAMETER, tuple(branches + curves),
+                               tuple(points)), curves)
 
 
 def _starts_locus(point: SpecialPoint) -> bool:
@@ -122,7 +132,7 @@ def _starts_locus(point: SpecialPoint) -> bool:
     pair of Floquet multipliers on the unit circle (a finite ``torus_angle``; AUTO's test
     function also changes sign at a neutral saddle, a real pair with product 1, which is no
     torus bifurcation, and a TR point without multipliers cannot be told apart)."""
-    if point.status != "located":
+    if point.status != LocateStatus.LOCATED:
         return False
     return point.point_type != PointType.TR or bool(np.isfinite(point.torus_angle))
 
@@ -408,7 +418,7 @@ def _retried(engine: Engine, loci: dict[int, tuple[int, RunSpec, Branch]], numer
     again, where = [], []
     for k, (_, spec, curve) in loci.items():
         labelled = [r for r in np.flatnonzero(curve.label) if curve.point_type[r] != PointType.MX]
-        if curve.status != "mx" or not labelled or labelled[-1] == 0:
+        if curve.status != RunStatus.MX or not labelled or labelled[-1] == 0:
             continue
         row = int(labelled[-1])
         constants = dict(spec.constants, NTST=spec.constants["NTST"] * 2,
@@ -484,11 +494,11 @@ def _locus_end(curve: Branch, codim2: list[SpecialPoint], bounds: dict[str, tupl
     point = _ending_at(last, codim2, width)
     if point is not None:
         where = ", ".join(f"{v:.5g}" for v in point.parameters[:2])
-        message = "ok" if curve.status == "ok" else \
+        message = "ok" if curve.status == RunStatus.OK else \
             "AUTO stopped with MX at the codimension-2 point (the locus ends there)"
         return replace(curve, end=f"{point.type_name} at ({where})", status="ok",
                        message=message)
-    if curve.status == "mx":
+    if curve.status == RunStatus.MX:
         return replace(curve, end="no convergence (MX)")
     return replace(curve, end=STEP_LIMIT if len(curve) >= max_steps else "not continued after "
                    "its last chunk of steps")

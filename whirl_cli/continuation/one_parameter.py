@@ -8,7 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..results import ContinuationResult
+from ..results import ContinuationKind, ContinuationResult
 from .criticality import _with_criticality, with_lyapunov
 from .engine import Engine, Numerics
 from .equilibria import equilibria, is_linear
@@ -48,5 +48,5 @@ def one_parameter(engine: Engine, name: str, parameter: str, start: float,
                                                  list(start_orbits), steady, points, parameters)
         branches += families
         points += family_points
-    return ContinuationResult(name, "one-parameter", tuple(branches), tuple(points))
+    return ContinuationResult(name, ContinuationKind.ONE_PARAMETER, tuple(branches), tuple(points))
 

@@ -16,7 +16,16 @@ import numpy as np
 from ..analysis import global_bifurcations
 from ..auto.constants import AMPLITUDE, par_layout
 from ..models import Model
-from ..results import OTHER_END, STEP_LIMIT, Branch, BranchKind, Orbit, PointType, SpecialPoint
+from ..results import (
+    OTHER_END,
+    STEP_LIMIT,
+    Branch,
+    BranchKind,
+    Orbit,
+    PointType,
+    RunStatus,
+    SpecialPoint,
+)
 from ..runtime import thread_map
 from .branches import amplitude, head, join, reverse, special_points
 from .engine import Engine, Numerics, RunSpec, _read
@@ -250,7 +259,7 @@ def _end(family: _Family, model: Model, hopfs: list[SpecialPoint], bounds: tuple
         whole, model, parameters, equilibria, family.period, width)
     if global_point is not None:
         end = f"period blow-up: {PointType(global_point.point_type).name.lower()} approach"
-        if whole.status == "mx":  # AUTO's expected failure right at the blow-up
+        if whole.status == RunStatus.MX:  # AUTO's expected failure right at the blow-up
             whole = replace(whole, status="ok", message="ended with MX at the period "
                             "blow-up (expected near a global bifurcation)")
     return _Ended(replace(whole, end=end), global_point, returned_to)
@@ -388,9 +397,9 @@ def _next_segment(family: _Family, model: Model, hopfs: list[SpecialPoint],
     """The run continuing ``family`` after its last piece, or None if the family has ended."""
     piece = family.pieces[-1]
     scale = np.asarray(model.state_scale, dtype=float)
-    if piece.status == "mx" and family.retries < MAX_RETRIES:
+    if piece.status == RunStatus.MX and family.retries < MAX_RETRIES:
         return _retry(family, piece)
-    if not len(piece) or piece.status != "ok" or len(family.pieces) >= MAX_SEGMENTS:
+    if not len(piece) or piece.status != RunStatus.OK or len(family.pieces) >= MAX_SEGMENTS:
         return None
     last = PointType(int(piece.point_type[-1]))
     if family.grows and len(family.pieces) == 1:
