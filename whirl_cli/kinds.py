@@ -17,10 +17,6 @@ PLOT_KINDS = ("bifurcation", "linear", "root_locus", "damping_multiples", "proje
 #: The plot kinds drawn from a continuation's ``explore:`` classifications.
 MOTION_KINDS = ("poincare", "spectrum", "orbit_diagram")
 
-#: The kinds of locus (a two-parameter continuation's ``loci``) that bound the unsafe region
-#: by folds: of equilibria and of cycles.
-FOLD_LOCI = ("fold", "fold_of_cycles")
-
 
 class Word(StrEnum):
     """A word of whirl's vocabulary: a str equal to its value, shown as that value (in
@@ -47,6 +43,22 @@ class BranchKind(Word):
     @property
     def is_locus(self) -> bool:
         return self.value.endswith("_locus")
+
+
+class LocusKind(Word):
+    """The kind of special point a locus (a two-parameter curve) follows, as a boundary's
+    ``loci`` name them; also the kind of a linear critical point (hopf, branch_point)."""
+
+    HOPF = "hopf"
+    BRANCH_POINT = "branch_point"
+    FOLD = "fold"
+    FOLD_OF_CYCLES = "fold_of_cycles"
+    TORUS = "torus"
+
+
+#: The kinds of locus (a two-parameter continuation's ``loci``) that bound the unsafe region
+#: by folds: of equilibria and of cycles.
+FOLD_LOCI = (LocusKind.FOLD, LocusKind.FOLD_OF_CYCLES)
 
 
 class ContinuationKind(Word):
@@ -101,6 +113,14 @@ class SeedKind(Word):
     EQUILIBRIUM = "equilibrium"
     DIVERGED = "diverged"
     UNSETTLED = "unsettled"
+
+
+class CheckKind(Word):
+    """What a cross-check simulates: an orbit of a periodic branch, or a perturbed
+    equilibrium."""
+
+    ORBIT = "orbit"
+    EQUILIBRIUM = "equilibrium"
 
 
 class SweepAction(Word):

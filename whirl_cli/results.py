@@ -15,6 +15,7 @@ import numpy as np
 
 from .kinds import (
     BranchKind,
+    CheckKind,
     ContinuationKind,
     Criticality,
     LocateStatus,
@@ -23,8 +24,9 @@ from .kinds import (
     SeedKind,
 )
 
-__all__ = ["BranchKind", "ContinuationKind", "Criticality", "LocateStatus", "MotionKind",
-           "RunStatus", "SeedKind"]  # re-exported: the vocabulary results are written in
+#: re-exported: the vocabulary results are written in
+__all__ = ["BranchKind", "CheckKind", "ContinuationKind", "Criticality", "LocateStatus",
+           "MotionKind", "RunStatus", "SeedKind"]
 
 
 def _brief(value) -> str:
@@ -451,7 +453,7 @@ class CrossCheck:
 
     branch: str
     index: int
-    kind: str
+    kind: CheckKind
     parameter: float
     expected: float
     simulated: float

@@ -21,7 +21,7 @@ from whirl_cli.errors import StudyError, WhirlError
 from whirl_cli.output import compare, store
 from whirl_cli.plots.files import PLOT_KINDS, missing_data, plot_names, study_figures
 from whirl_cli.plots.motion import KIND_COLOURS, orbit_diagram, poincare_plot, spectrum_plot
-from whirl_cli.results import ContinuationResult, Exploration, StudyResult
+from whirl_cli.results import ContinuationResult, Exploration, MotionKind, StudyResult
 from whirl_cli.study import validate_text
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -151,10 +151,10 @@ def exploration(value: float, kind: str, section: np.ndarray, frequencies=(4.4,)
 
 def sample_explorations() -> tuple[Exploration, ...]:
     cycle = np.tile([[-0.1, 0.02, 0.0, 0.5]], (5, 1))
-    return (exploration(0.24, "periodic", cycle),
-            exploration(0.45, "equilibrium", np.zeros((0, 4)), ()),
-            exploration(0.3, "chaotic", np.random.default_rng(1).normal(size=(30, 4)) * 0.05,
-                        (4.0, 2.1, 6.0)))
+    return (exploration(0.24, MotionKind.PERIODIC, cycle),
+            exploration(0.45, MotionKind.EQUILIBRIUM, np.zeros((0, 4)), ()),
+            exploration(0.3, MotionKind.CHAOTIC,
+                        np.random.default_rng(1).normal(size=(30, 4)) * 0.05, (4.0, 2.1, 6.0)))
 
 
 def result_of(explorations, branches=()) -> StudyResult:

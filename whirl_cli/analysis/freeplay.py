@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..kinds import LocusKind
 from ..models import Model, get_model
 from ..models.laws.freeplay import FREEPLAY, equivalent_stiffness
 from ..results import Branch, ContinuationResult, FreeplayAmplitudes
@@ -54,7 +55,7 @@ def linear_onsets(model: Model, overrides: dict[str, float], dof: str, parameter
     stiffness = model.family.dof(dof).stiffness
     return np.array([p.value for p in critical_points(
         linear, {**fixed, stiffness: law["K_out"]}, parameter, *bounds, points=401)
-        if p.kind == "hopf"], dtype=float)
+        if p.kind == LocusKind.HOPF], dtype=float)
 
 
 def describing_estimate(model: Model, overrides: dict[str, float], dof: str, parameter: str,
@@ -74,7 +75,7 @@ def describing_estimate(model: Model, overrides: dict[str, float], dof: str, par
                                           law["K_out"]))
         for point in critical_points(linear, {**fixed, stiffness: k_eq}, parameter, *bounds,
                                      points=201):
-            if point.kind == "hopf":
+            if point.kind == LocusKind.HOPF:
                 rows.append((float(ratio), k_eq, point.value))
     table = np.array(rows, dtype=float).reshape(-1, 3)
     return table[:, 0], table[:, 1], table[:, 2]

@@ -29,7 +29,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..models import Model
-from ..results import Branch, BranchKind, Orbit, PointType, SpecialPoint
+from ..results import (
+    Branch,
+    BranchKind,
+    LocateStatus,
+    Orbit,
+    PointType,
+    RunStatus,
+    SpecialPoint,
+)
 
 #: A family is in blow-up when its period exceeds this multiple of the reference period.
 BLOWUP_FACTOR = 3.0
@@ -71,7 +79,7 @@ def in_blowup(family: Branch, reference_period: float, factor: float = BLOWUP_FA
 def stalled(family: Branch, reference_period: float) -> bool:
     """True if AUTO could not continue the family (MX) after its period had grown beyond
     STALL_FACTOR times the reference period: a blow-up if its orbit lingers near a saddle."""
-    return family.status == "mx" and in_blowup(family, reference_period, STALL_FACTOR)
+    return family.status == RunStatus.MX and in_blowup(family, reference_period, STALL_FACTOR)
 
 
 #: A family in blow-up is continued (fold by fold) until its parameter has turned this often
@@ -290,5 +298,5 @@ def analyse(family: Branch, model: Model, parameters: dict[str, float],
         parameter_names=family.parameter_names, parameters=np.array([estimate]),
         parameter_units=family.parameter_units,
         state=np.asarray(saddles[0][0], dtype=float), period=float(family.period[last]),
-        stable=False, status="bracketed", note=note, bracket=bracket,
+        stable=False, status=LocateStatus.BRACKETED, note=note, bracket=bracket,
         residual=fit.residual if fit else float("nan"))

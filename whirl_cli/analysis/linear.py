@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..kinds import LocusKind
 from ..models import Model
 from ..results import LinearGrid, LinearSweep
 from ..runtime import thread_map
@@ -38,7 +39,7 @@ class CriticalPoint:
     or "branch_point" (a real eigenvalue crosses zero: det J = 0; ``frequency`` 0).
     """
 
-    kind: str
+    kind: LocusKind
     parameter: str
     value: float
     frequency: float
@@ -174,7 +175,7 @@ def critical_points(model: Model, overrides: dict[str, float], parameter: str,
         return parameter_matrix(model, overrides, name, np.array([value]))
 
     found: list[CriticalPoint] = []
-    scans = (("hopf", _oscillatory_growth), ("branch_point", _determinant))
+    scans = ((LocusKind.HOPF, _oscillatory_growth), (LocusKind.BRANCH_POINT, _determinant))
     for kind, function in scans:
         samples = function(model, parameter_matrix(model, overrides, name, grid))
         finite = np.isfinite(samples)
@@ -183,7 +184,7 @@ def critical_points(model: Model, overrides: dict[str, float], parameter: str,
             value = brentq(lambda v, f=function: float(f(model, at(v))[0]), grid[k], grid[k + 1],
                            xtol=xtol)
             frequency = 0.0
-            if kind == "hopf":
+            if kind == LocusKind.HOPF:
                 eigenvalues = np.linalg.eigvals(jacobians(model, at(value)))[0]
                 critical = eigenvalues[np.argmin(np.abs(eigenvalues.real))]
                 frequency = float(abs(critical.imag))

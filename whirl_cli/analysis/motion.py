@@ -70,9 +70,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..kinds import MotionKind
 from .lyapunov import TangentRun, exponent_between, tangent_run
-
-KINDS = ("equilibrium", "periodic", "quasi-periodic", "chaotic", "diverged")
 
 #: Largest lag k tried for a period-k orbit on the section.
 MAX_MULTIPLICITY = 8
@@ -90,14 +89,14 @@ WEAKLY_CHAOTIC = "weakly chaotic"
 class MotionClass:
     """The settled motion at one parameter point.
 
-    ``kind``: one of :data:`KINDS`; ``lyapunov``, ``lyapunov_error``: the largest exponent and
+    ``kind``: what it settled on; ``lyapunov``, ``lyapunov_error``: the largest exponent and
     its standard error (1/s; NaN if diverged); ``frequencies`` (Hz): see the module doc;
     ``section`` (m, n): the Poincaré section points (SI states); ``section_dimension``: D2 of
     the section (NaN with fewer than 10 points); ``multiplicity``: k of a period-k orbit (0
     otherwise); ``peaks`` (Hz): the spectral peaks, strongest first; ``broadband``: the
     fraction of spectral power away from the peaks; ``evidence``: the three readings, text."""
 
-    kind: str
+    kind: MotionKind
     lyapunov: float
     lyapunov_error: float
     frequencies: tuple[float, ...]
@@ -316,7 +315,7 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
 def _undecided(motion: MotionClass) -> bool:
     """The section did not repeat while the spectrum says periodic, or lambda is not resolved
     from zero and the section is a cloud: what a longer window may settle."""
-    return motion.kind != "diverged" and (SPECTRUM_ONLY in motion.evidence
+    return motion.kind != MotionKind.DIVERGED and (SPECTRUM_ONLY in motion.evidence
                                           or WEAKLY_CHAOTIC in motion.evidence)
 
 
@@ -327,14 +326,15 @@ def _classified(run: TangentRun, scale: np.ndarray, amplitude_tolerance: float,
     n = run.states.shape[1]
     empty = np.zeros((0, n))
     if run.diverged:
-        return MotionClass("diverged", np.nan, np.nan, (), empty, np.nan, 0, (), np.nan,
+        return MotionClass(MotionKind.DIVERGED, np.nan, np.nan, (), empty, np.nan, 0, (), np.nan,
                            f"diverged: the trajectory {run.message}")
     time, states = run.time, run.states
     span = np.ptp(states, axis=0) / scale
     spread = np.std(states, axis=0)
     if span.max() < amplitude_tolerance or len(time) < 8:
         exponent, error = exponent_between(time, run.growth)
-        return MotionClass("equilibrium", exponent, error, (), empty, np.nan, 0, (), np.nan,
+        return MotionClass(MotionKind.EQUILIBRIUM, exponent, error, (), empty, np.nan, 0, (),
+                           np.nan,
                            f"equilibrium: the settled motion spans {span.max():.2g} scales "
                            f"(< {amplitude_tolerance:g}); lambda = {exponent:.3g} 1/s")
     index = int(np.argmax(spread / scale)) if section_state is None else int(section_state)
@@ -367,28 +367,28 @@ def _classified(run: TangentRun, scale: np.ndarray, amplitude_tolerance: float,
            else "no one or two bases") + f", {100 * broadband:.2g} % broadband"]
     strongest = tuple(float(p) for p in peaks[:3])
     if exponent < -(threshold + 3 * error) or len(section) < 3:
-        kind, found = "equilibrium", ()
+        kind, found = MotionKind.EQUILIBRIUM, ()
         if len(section) < 3 and exponent >= -(threshold + 3 * error):
             evidence.append("fewer than 3 section crossings: no oscillation left")
     elif exponent > threshold + 3 * error:
-        kind, found = "chaotic", strongest
+        kind, found = MotionKind.CHAOTIC, strongest
     elif multiplicity:
-        kind, found = "periodic", (1.0 / (multiplicity * returns),)
+        kind, found = MotionKind.PERIODIC, (1.0 / (multiplicity * returns),)
     elif converging:
         multiplicity = converging
-        kind, found = "periodic", (1.0 / (multiplicity * returns),)
+        kind, found = MotionKind.PERIODIC, (1.0 / (multiplicity * returns),)
         evidence.append(f"not settled: the section's lag-{converging} distances shrink by "
                         f"{rate:.3g} per return, towards a period-{converging} orbit")
     elif len(bases) == 1 and broadband < 0.01:
-        kind, found = "periodic", bases
+        kind, found = MotionKind.PERIODIC, bases
         evidence.append(f"{SPECTRUM_ONLY} within {section_tolerance:g}")
     elif (np.isfinite(dimension) and dimension < CURVE_DIMENSION) or len(bases) == 2:
         others = [p for p in peaks if abs(p * returns - round(p * returns)) > 1.5 * bins
                   * returns]
-        kind, found = "quasi-periodic", (1.0 / returns,) + ((float(others[0]),) if others
+        kind, found = MotionKind.QUASI_PERIODIC, (1.0 / returns,) + ((float(others[0]),) if others
                                                              else ())
     else:
-        kind, found = "chaotic", strongest
+        kind, found = MotionKind.CHAOTIC, strongest
         evidence.append(f"{WEAKLY_CHAOTIC}: lambda not resolved from zero, the section a cloud")
     return MotionClass(kind, exponent, error, tuple(found), section, dimension, multiplicity,
                        tuple(float(p) for p in peaks), broadband,

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..kinds import Criticality
 from ..models import Model
 
 
@@ -64,9 +65,9 @@ def hopf_lyapunov_coefficient(model: Model, state: np.ndarray, params: np.ndarra
     return first_lyapunov_coefficient(jacobian, second, third)
 
 
-def criticality_of(l1: float, scale: float) -> str:
-    """"supercritical" (l1 < 0), "subcritical" (l1 > 0), or "" when |l1| <= 1e-9 ``scale``
+def criticality_of(l1: float, scale: float) -> Criticality:
+    """Supercritical (l1 < 0), subcritical (l1 > 0), or unknown when |l1| <= 1e-9 ``scale``
     (degenerate to round-off, e.g. a linear model; ``scale``: a typical magnitude of l1)."""
     if not np.isfinite(l1) or abs(l1) <= 1e-9 * scale:
-        return ""
-    return "supercritical" if l1 < 0 else "subcritical"
+        return Criticality.UNKNOWN
+    return Criticality.SUPERCRITICAL if l1 < 0 else Criticality.SUBCRITICAL

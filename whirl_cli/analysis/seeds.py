@@ -34,6 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..kinds import SeedKind
 from ..models import Model
 from ..results import Orbit
 from ..units import display_unit
@@ -55,7 +56,7 @@ class Settled:
     ``orbit`` (one period, periodic only), ``state`` (the last simulated state) and
     ``message`` (what was seen, e.g. the period and the return mismatch)."""
 
-    kind: str
+    kind: SeedKind
     seed: np.ndarray
     state: np.ndarray
     orbit: Orbit | None
@@ -89,26 +90,26 @@ def settle(model: Model, params: np.ndarray, seed: np.ndarray, max_periods: int 
                          samples=CHUNK_PERIODS * SAMPLES_PER_PERIOD + 1)
         elapsed += t[-1]
         if not np.isfinite(y).all() or (np.abs(y[:, dofs]) > limit * amplitudes).any():
-            return Settled("diverged", seed, y[-1], None,
+            return Settled(SeedKind.DIVERGED, seed, y[-1], None,
                            f"a dof beyond {limit:g} typical amplitudes after {elapsed:.3g} s")
         state = y[-1]
         recent = y[-10 * SAMPLES_PER_PERIOD:]
         size = np.ptp(recent[:, dofs], axis=0) / amplitudes
         if size.max() < tolerance * max(np.abs(seed[dofs] / amplitudes).max(), 1e-12):
-            return Settled("equilibrium", seed, state, None,
+            return Settled(SeedKind.EQUILIBRIUM, seed, state, None,
                            f"at rest after {elapsed:.3g} s")
         times, points = returns(t, y, dofs, amplitudes)
         judged = judge(times, points, tolerance)
         if judged.lag:
             orbit = _orbit(t, y, *_one_period(t, y, times[-1] - times[-1 - judged.lag]))
             crossings = f", {judged.lag} returns a period" if judged.lag > 1 else ""
-            return Settled("periodic", seed, state, orbit,
+            return Settled(SeedKind.PERIODIC, seed, state, orbit,
                            f"period {orbit.period:.6g} s{crossings}, returns repeat to "
                            f"{judged.distance:.1e} of the motion's size after {elapsed:.3g} s")
         if elapsed >= budget and elapsed + judged.needed(tolerance) <= \
                 OVERRUN * max_periods * period:
             budget = elapsed + judged.needed(tolerance)
-    return Settled("unsettled", seed, state, None, judged.why(tolerance, elapsed, period))
+    return Settled(SeedKind.UNSETTLED, seed, state, None, judged.why(tolerance, elapsed, period))
 
 
 @dataclass(frozen=True)
@@ -241,7 +242,7 @@ def distinct(found: list[Settled], tolerance: float = 1e-2) -> list[int]:
     approach a weakly attracting cycle slowly: 1e-3 apart after hundreds of periods)."""
     kept: list[int] = []
     for k, settled in enumerate(found):
-        if settled.kind == "periodic" and same_as(found, k, kept, tolerance) is None:
+        if settled.kind == SeedKind.PERIODIC and same_as(found, k, kept, tolerance) is None:
             kept.append(k)
     return kept
 
@@ -249,7 +250,7 @@ def distinct(found: list[Settled], tolerance: float = 1e-2) -> list[int]:
 def same_as(found: list[Settled], k: int, kept: list[int], tolerance: float = 1e-2) -> int | None:
     """The first of ``kept`` whose orbit outcome ``k`` settled on too, as :func:`distinct`
     tells orbits apart (``k`` itself if kept; None if none, or not periodic)."""
-    if found[k].kind != "periodic":
+    if found[k].kind != SeedKind.PERIODIC:
         return None
     mine = _signature(found[k].orbit)
     return next((j for j in kept if np.allclose(mine, _signature(found[j].orbit),

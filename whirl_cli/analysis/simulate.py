@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..models import Model
-from ..results import Branch, BranchKind, CrossCheck, Orbit, PointType, Simulation
+from ..results import Branch, BranchKind, CheckKind, CrossCheck, Orbit, PointType, Simulation
 from ..runtime import forked_map, preloaded
 from .global_bifurcations import BLOWUP_FACTOR
 
@@ -268,8 +268,8 @@ def check_orbit(model: Model, overrides: dict[str, float], branch: Branch, orbit
                               samples=periods * 400)
         exact = float(run.states[run.time >= (periods - 2) * orbit.period, dof].max())
         passed = passed and abs(exact - expected) / half_span <= tolerance
-    return CrossCheck(branch.name, orbit.index, "orbit", float(orbit.parameters[0]), expected,
-                      simulated, bool(passed), model.state_names[dof], exact)
+    return CrossCheck(branch.name, orbit.index, CheckKind.ORBIT, float(orbit.parameters[0]),
+                      expected, simulated, bool(passed), model.state_names[dof], exact)
 
 
 def check_equilibrium(model: Model, overrides: dict[str, float], branch: Branch, index: int,
@@ -307,7 +307,7 @@ def check_equilibrium(model: Model, overrides: dict[str, float], branch: Branch,
     transient = 2.0 * float(np.linalg.cond(vectors)) * np.sqrt(angles.sum())
     floor = 1e-8  # rad: AUTO's Newton tolerance EPSU (whirl's default); LSODA adds far less
     allowed = min(transient * np.exp(-max(slowest, 0.0) * duration), 0.1) * perturbation + floor
-    return CrossCheck(branch.name, index, "equilibrium", float(branch.parameters[index, 0]),
+    return CrossCheck(branch.name, index, CheckKind.EQUILIBRIUM, float(branch.parameters[index, 0]),
                       perturbation, final, bool(slowest > 0 and final < allowed))
 
 
@@ -339,14 +339,14 @@ def _check(model: Model, overrides: dict[str, float], branches: tuple[Branch, ..
            task: tuple[int, str, int]) -> CrossCheck:
     number, kind, item = task
     branch = branches[number]
-    if kind == "orbit":
+    if kind == CheckKind.ORBIT:
         return check_orbit(model, overrides, branch, branch.orbits[item])
     return check_equilibrium(model, overrides, branch, item)
 
 
 def planned_checks(branches: tuple[Branch, ...], per_branch: int = 2
                    ) -> list[tuple[int, str, int]]:
-    """What :func:`cross_check` simulates: (branch index, "orbit" | "equilibrium", orbit index
+    """What :func:`cross_check` simulates: (branch index, check kind, orbit index
     in ``branch.orbits`` or row of the equilibrium branch)."""
     tasks: list[tuple[int, str, int]] = []
     for number, branch in enumerate(branches):
@@ -358,11 +358,11 @@ def planned_checks(branches: tuple[Branch, ...], per_branch: int = 2
                           if 0 < o.index < len(branch) - 1
                           and _interior_stable(branch, o.index) and o.states.shape[0] > 1
                           and o.period < BLOWUP_FACTOR * hopf_period]
-            tasks += [(number, "orbit", k) for k in _spread(candidates, per_branch)]
+            tasks += [(number, CheckKind.ORBIT, k) for k in _spread(candidates, per_branch)]
         elif branch.kind == BranchKind.EQUILIBRIUM:
             rows = [k for k in range(1, len(branch) - 1)
                     if _interior_stable(branch, k) and _checkable(branch.eigenvalues[k])]
-            tasks += [(number, "equilibrium", row) for row in _spread(rows, per_branch)]
+            tasks += [(number, CheckKind.EQUILIBRIUM, row) for row in _spread(rows, per_branch)]
     return tasks
 
 

@@ -36,6 +36,7 @@ from ..results import (
     Boundary,
     Branch,
     BranchKind,
+    CheckKind,
     ContinuationKind,
     ContinuationResult,
     Criticality,
@@ -137,7 +138,8 @@ PARAMETER = (
 )
 #: The :class:`CrossCheck` table of a continuation (``cross_checks/``).
 CROSS_CHECK = (
-    Field("branch", kind="text"), Field("index", kind="int"), Field("kind", kind="text"),
+    Field("branch", kind="text"), Field("index", kind="int"),
+    Field("kind", kind="text", vocabulary=CheckKind),
     Field("parameter", kind="float"), Field("expected", kind="float"),
     Field("simulated", kind="float"), Field("passed", kind="bool"),
     Field("state", kind="text", default=""),  # older files: not recorded
@@ -287,7 +289,7 @@ def _cross_check_units(checks, branch: Branch) -> dict[str, dict]:
     and per row those of expected and simulated: the compared state's unit for an orbit, the
     dofs' typical amplitudes for an equilibrium."""
     units = dict(zip(branch.state_names, branch.state_units, strict=True))
-    rows = [units.get(c.state, "") if c.kind == "orbit" else "typical amplitudes"
+    rows = [units.get(c.state, "") if c.kind == CheckKind.ORBIT else "typical amplitudes"
             for c in checks]
     return {"parameter": {"names": [branch.parameter_names[0]],
                           "units": [branch.parameter_units[0]]},
