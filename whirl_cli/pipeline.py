@@ -27,9 +27,12 @@ from .continuation.periodic import OrbitStart
 from .output.provenance import provenance
 from .results import (
     Boundary,
+    ContinuationKind,
     ContinuationResult,
     Exploration,
+    MotionKind,
     ParameterValue,
+    SeedKind,
     SeedOutcome,
     Simulation,
     StudyResult,
@@ -116,7 +119,7 @@ def _stages(study: Study, model, parameters: dict[str, float], workroot: Path, j
     found_boundaries = []
     for spec in study.continuations:
         assert engine is not None
-        if spec.type == "two-parameter":
+        if spec.type == ContinuationKind.TWO_PARAMETER:
             preload(*later)  # imported while AUTO runs
             continuation, boundary = _two_parameter(engine, study, spec, parameters,
                                                     numerics)
@@ -293,7 +296,7 @@ def explorations(model, overrides: dict[str, float], spec,
                 transient_periods=spec.explore_transient, section_state=section)
         except Exception as error:  # noqa: BLE001 - reported in the result, never raised
             motion_class = motion.MotionClass(
-                "diverged", np.nan, np.nan, (), np.zeros((0, len(names))), np.nan, 0, (),
+                MotionKind.DIVERGED, np.nan, np.nan, (), np.zeros((0, len(names))), np.nan, 0, (),
                 np.nan, f"diverged: the classification failed ({type(error).__name__}: "
                 f"{error})")
         return Exploration(
@@ -337,7 +340,7 @@ def seeded_orbits(model, overrides: dict[str, float], parameter: str, start: flo
                     families.get(seeds.same_as(settled, k, kept), ""),
                     s.message)
         for k, s in enumerate(settled))
-    rests = tuple(s.state for s in settled if s.kind == "equilibrium")
+    rests = tuple(s.state for s in settled if s.kind == SeedKind.EQUILIBRIUM)
     return starts, rests, outcomes
 
 

@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .kinds import FOLD_LOCI
+from .kinds import FOLD_LOCI, BranchKind, RunStatus, SeedKind
 from .results import (
     OTHER_END,
     STEP_LIMIT,
@@ -43,14 +43,14 @@ class Verdict:
     notes: tuple[str, ...]
 
 
-def is_problem(kind: str, status: str) -> bool:
+def is_problem(kind: BranchKind, status: RunStatus) -> bool:
     """True if a branch of ``kind`` that ended with run ``status`` makes the study fail."""
-    return status != "ok" and not is_locus_mx(kind, status)
+    return status != RunStatus.OK and not is_locus_mx(kind, status)
 
 
-def is_locus_mx(kind: str, status: str) -> bool:
+def is_locus_mx(kind: BranchKind, status: RunStatus) -> bool:
     """A locus ending in MX: a note, not a problem (see the module doc)."""
-    return status == "mx" and kind.endswith("_locus")
+    return status == RunStatus.MX and kind.is_locus
 
 
 def truncation(branch: Branch) -> str:
@@ -68,10 +68,10 @@ def truncation(branch: Branch) -> str:
 def unjudged_seeds(continuation: ContinuationResult) -> str:
     """What a continuation's unsettled seeds leave open ("" if none): how many, why the
     first could not be judged, and whether any other seed led to a limit cycle."""
-    unsettled = [s for s in continuation.seeds if s.kind == "unsettled"]
+    unsettled = [s for s in continuation.seeds if s.kind == SeedKind.UNSETTLED]
     if not unsettled:
         return ""
-    found = any(s.kind == "periodic" for s in continuation.seeds)
+    found = any(s.kind == SeedKind.PERIODIC for s in continuation.seeds)
     return (f"{continuation.name}: {len(unsettled)} of {len(continuation.seeds)} seeds could "
             f"not be judged (seed {unsettled[0].index}: {unsettled[0].message}); "
             + ("the limit cycles found from the others may not be all" if found else
@@ -80,8 +80,8 @@ def unjudged_seeds(continuation: ContinuationResult) -> str:
 
 def seeds_found_nothing(continuation: ContinuationResult) -> bool:
     """True if some seeds could not be judged and none led to a limit cycle."""
-    return any(s.kind == "unsettled" for s in continuation.seeds) and not any(
-        s.kind == "periodic" for s in continuation.seeds)
+    return any(s.kind == SeedKind.UNSETTLED for s in continuation.seeds) and not any(
+        s.kind == SeedKind.PERIODIC for s in continuation.seeds)
 
 
 def verdict(result: StudyResult, plot_error: str = "") -> Verdict:

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import StudyError, WhirlError
+from ..kinds import SweepStatus
 from ..results import StudyResult
 from .index import Entry, figure_order, index_html
 from .sheet import Sheet, find_sheets, load_sheet
@@ -180,9 +181,10 @@ class _Artist:
 
     def record(self, outcome) -> None:
         source = Path(os.path.normpath(outcome.item.source))
-        if outcome.status in ("ok", "failed", "skipped") and outcome.item.output is not None:
+        if outcome.status in (SweepStatus.OK, SweepStatus.FAILED, SweepStatus.SKIPPED) \
+                and outcome.item.output is not None:
             self.outputs[source] = outcome.item.output
-        elif outcome.status == "invalid":  # its problems name the study file
+        elif outcome.status == SweepStatus.INVALID:  # its problems name the study file
             self.failed[source] = "; ".join(outcome.problems)
         else:
             self.failed[source] = f"{source}: " + ("; ".join(outcome.problems)

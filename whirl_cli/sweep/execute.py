@@ -26,6 +26,7 @@ from functools import partial
 from pathlib import Path
 
 from ..errors import WhirlError
+from ..kinds import ContinuationKind, LocusKind, SweepStatus
 from ..output.study_files import publish_plots, publish_study
 from ..results import StudyResult
 from ..runtime import catching, held_signals, quiet_worker
@@ -102,14 +103,13 @@ def portable(error: BaseException) -> BaseException:
 
 @dataclass(frozen=True)
 class Outcome:
-    """What became of one study. ``status``: "ok" | "failed" (stored, with problems) |
-    "skipped" | "invalid" | "error" (no result: the task raised).
+    """What became of one study (``status``).
 
     ``auto_seconds``: summed wall time of its AUTO runs (s); ``written``: files written.
     """
 
     item: SweepItem
-    status: str
+    status: SweepStatus
     problems: tuple[str, ...] = ()
     auto_seconds: float = 0.0
     runs: int = 0
@@ -117,7 +117,7 @@ class Outcome:
 
     @property
     def failed(self) -> bool:
-        return self.status in ("failed", "invalid", "error") or bool(self.problems)
+        return self.status.failed or bool(self.problems)
 
 
 def execute(items: Sequence[SweepItem], executor: Executor, plots: bool = True,
@@ -146,9 +146,9 @@ def execute(items: Sequence[SweepItem], executor: Executor, plots: bool = True,
     try:
         for item in items:  # while the workers compute
             if item.action == SKIP:
-                done(Outcome(item, "skipped", item.stored_problems))
+                done(Outcome(item, SweepStatus.SKIPPED, item.stored_problems))
             elif item.action == INVALID:
-                done(Outcome(item, "invalid", (item.reason,)))
+                done(Outcome(item, SweepStatus.INVALID, (item.reason,)))
         for item in items:
             if item.action == PLOT:
                 done(_complete_plots(item))
@@ -185,9 +185,9 @@ def expected_cost(item: SweepItem) -> int:
         return 0
     cost = 1 + 3 * len(study.simulations)
     for spec in study.continuations:
-        if spec.type == "two-parameter":
+        if spec.type == ContinuationKind.TWO_PARAMETER:
             cost += len(spec.slices) * (3 + 2 * len(spec.loci)
-                                        + 6 * ("fold_of_cycles" in spec.loci))
+                                        + 6 * (LocusKind.FOLD_OF_CYCLES in spec.loci))
         else:
             periodic = bool(getattr(spec, "periodic", False))
             cost += 1 + 2 * periodic + 2 * periodic * bool(study.cross_check)
@@ -199,20 +199,20 @@ def _store(item: SweepItem, future: Future, plots: bool) -> Outcome:
     try:
         result: StudyResult = future.result()
     except WhirlError as error:
-        return Outcome(item, "error", (error.message,))
+        return Outcome(item, SweepStatus.ERROR, (error.message,))
     except Exception as error:  # a bug or a lost worker: report it, go on with the others
-        return Outcome(item, "error", (f"{type(error).__name__}: {error}",))
+        return Outcome(item, SweepStatus.ERROR, (f"{type(error).__name__}: {error}",))
     assert item.output is not None and item.study is not None
     auto_seconds = sum(r.wall_seconds for r in result.runs)
     try:
         published = publish_study(result, item.output, item.study.plots if plots else (),
                                   overwrite=True, state=item.study.plot_state)
     except Exception as error:  # e.g. a result the store cannot represent: go on
-        return Outcome(item, "error", (f"writing {item.output}: {type(error).__name__}: "
+        return Outcome(item, SweepStatus.ERROR, (f"writing {item.output}: {type(error).__name__}: "
                                        f"{error}", *verdict(result).problems), auto_seconds,
                        len(result.runs))
     problems = verdict(result, published.plot_error).problems
-    return Outcome(item, "failed" if problems else "ok", problems, auto_seconds,
+    return Outcome(item, SweepStatus.FAILED if problems else SweepStatus.OK, problems, auto_seconds,
                    len(result.runs), published.paths)
 
 
@@ -222,7 +222,7 @@ def _complete_plots(item: SweepItem) -> Outcome:
     try:
         written = publish_plots(item.output, item.study.plots, item.study.plot_state)
     except Exception as error:  # the result file stands; say what went wrong with plots
-        return Outcome(item, "error", (f"plots: {type(error).__name__}: {error}",
+        return Outcome(item, SweepStatus.ERROR, (f"plots: {type(error).__name__}: {error}",
                                        *item.stored_problems))
-    return Outcome(item, "plotted", item.stored_problems, written=written)
+    return Outcome(item, SweepStatus.PLOTTED, item.stored_problems, written=written)
 

@@ -21,28 +21,31 @@ import h5py
 from .. import __version__
 from ..auto.toolchain import auto_version
 from ..errors import StudyError, WhirlError
+from ..kinds import BranchKind, RunStatus, SweepAction
 from ..models import MODEL_SUFFIX, file_key
+from ..output.mapping import word
 from ..output.provenance import code_sha256
 from ..output.store import check_contents
 from ..output.study_files import missing_plots
 from ..study import Study, load_study
 from ..verdict import is_problem
 
-RUN, SKIP, PLOT, INVALID = "run", "skip", "plot", "invalid"
+RUN, SKIP, PLOT, INVALID = (SweepAction.RUN, SweepAction.SKIP, SweepAction.PLOT,
+                             SweepAction.INVALID)
 
 
 @dataclass(frozen=True)
 class SweepItem:
     """One study file of a sweep and what to do with it.
 
-    ``action``: "run" | "skip" | "plot" | "invalid"; ``reason`` says why (e.g. "new", "study
+    ``action``: what to do with it; ``reason`` says why (e.g. "new", "study
     changed", "up to date", "up to date, plots missing", or the validation errors).
     ``stored_problems``: problems recorded in an up-to-date output that is skipped (failed
     branches or cross-checks), so that a resumed sweep still reports them.
     """
 
     source: Path
-    action: str
+    action: SweepAction
     reason: str
     study: Study | None = None
     output: Path | None = None
@@ -115,7 +118,7 @@ def plan(paths: Iterable[str | os.PathLike[str]], out_dir: str | os.PathLike[str
     return items
 
 
-def _decide(study: Study, output: Path, force: bool) -> tuple[str, str, tuple[str, ...]]:
+def _decide(study: Study, output: Path, force: bool) -> tuple[SweepAction, str, tuple[str, ...]]:
     """(action, reason, stored problems) for one valid study and its output path."""
     if force:
         return RUN, "forced", ()
@@ -165,8 +168,9 @@ def stored_state(output: Path) -> StoredState:
         attrs = handle.attrs
         for name, group in handle.get("continuations", {}).items():
             for branch, sub in group.get("branches", {}).items():
-                if is_problem(text(sub.attrs.get("kind", "")),
-                              text(sub.attrs.get("status", "ok"))):
+                if is_problem(word(BranchKind, text(sub.attrs.get("kind", "")), sub.name, "kind"),
+                              word(RunStatus, text(sub.attrs.get("status", "ok")), sub.name,
+                                   "status")):
                     problems.append(f"{branch} ({text(sub.attrs.get('run', ''))}): "
                                     f"{text(sub.attrs.get('message', ''))}")
             if "cross_checks" in group:

@@ -7,6 +7,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
+from ..kinds import SweepStatus
 from .execute import Outcome
 
 
@@ -26,24 +27,24 @@ class Tally:
     def failures(self) -> list[Outcome]:
         return [o for o in self.outcomes if o.failed]
 
-    def count(self, status: str) -> int:
+    def count(self, status: SweepStatus) -> int:
         return sum(o.status == status for o in self.outcomes)
 
     def line(self, outcome: Outcome) -> str:
         """One log line per study: counter, status, name, AUTO time, output or first problem."""
         width = len(str(self.total))
-        mark = {"ok": "ok", "skipped": "skip", "plotted": "plot"}.get(outcome.status,
-                                                                       outcome.status.upper())
+        mark = {SweepStatus.OK: "ok", SweepStatus.SKIPPED: "skip",
+                SweepStatus.PLOTTED: "plot"}.get(outcome.status, outcome.status.upper())
         head = f"[{self.done:>{width}}/{self.total}] {mark:<8} {outcome.item.name:<28}"
-        if outcome.status == "skipped":
+        if outcome.status == SweepStatus.SKIPPED:
             detail = outcome.item.reason
-        elif outcome.status == "plotted":
+        elif outcome.status == SweepStatus.PLOTTED:
             detail = f"{outcome.item.reason}: {len(outcome.written)} drawn"
-        elif outcome.status in ("ok", "failed"):
+        elif outcome.status in (SweepStatus.OK, SweepStatus.FAILED):
             detail = (f"{outcome.runs:>3} AUTO runs {outcome.auto_seconds:6.2f} s -> "
                       f"{outcome.item.output}")
         else:  # an invalid study's problems name its file
-            detail = "" if outcome.status == "invalid" else str(outcome.item.source)
+            detail = "" if outcome.status == SweepStatus.INVALID else str(outcome.item.source)
         if outcome.problems:
             more = len(outcome.problems) - 1
             detail += f"  {outcome.problems[0]}" + (f" (+{more} more)" if more else "")
@@ -52,14 +53,16 @@ class Tally:
     def summary(self, interrupted: bool = False) -> str:
         """Counts and elapsed time, then one line per failed study."""
         seconds = time.perf_counter() - self.started
-        parts = [f"{self.count('ok')} ok", f"{self.count('skipped')} up to date"]
-        parts += [f"{n} plots completed" for n in [self.count("plotted")] if n]
-        parts += [f"{n} {s}" for s in ("failed", "error", "invalid") if (n := self.count(s))]
+        parts = [f"{self.count(SweepStatus.OK)} ok",
+                 f"{self.count(SweepStatus.SKIPPED)} up to date"]
+        parts += [f"{n} plots completed" for n in [self.count(SweepStatus.PLOTTED)] if n]
+        parts += [f"{n} {s}" for s in (SweepStatus.FAILED, SweepStatus.ERROR,
+                                       SweepStatus.INVALID) if (n := self.count(s))]
         if interrupted:
             parts.append(f"{self.total - self.done} not finished (interrupted)")
         text = f"sweep: {', '.join(parts)} of {self.total} studies in {seconds:.1f} s"
         for outcome in self.failures:
-            named = "" if outcome.status == "invalid" else f"{outcome.item.source}: "
+            named = "" if outcome.status == SweepStatus.INVALID else f"{outcome.item.source}: "
             text += f"\n  {named}" + "; ".join(outcome.problems)
         return text
 
