@@ -16,7 +16,7 @@ import click
 
 from .errors import OutputError, WhirlError
 from .jobs import MAX_JOBS, default_jobs
-from .kinds import PLOT_KINDS
+from .kinds import PLOT_KINDS, CheckKind
 
 
 def _version() -> str:
@@ -340,7 +340,7 @@ def check(result_file: Path) -> None:
     model, parameters, names = study.variant(), study.parameter_values(), study.names()
 
     def compared(x) -> str:  # what expected and simulated are (results.CrossCheck)
-        if x.kind == "equilibrium":
+        if x.kind == CheckKind.EQUILIBRIUM:
             return (f"perturbation {x.expected:.6g}, final deviation {x.simulated:.6g} "
                     "(typical amplitudes)")
         unit = model.states[model.state_names.index(x.state)].unit

@@ -320,12 +320,17 @@ def _read_attribute(group: h5py.Group, field: Field):
 def _word(field: Field, value, where: str):
     """``value`` read as its field's vocabulary (as it is without one); :class:`Damaged`
     naming ``where`` if it is not a word of it."""
-    if field.vocabulary is None:
-        return value
+    return value if field.vocabulary is None else word(field.vocabulary, value, where,
+                                                       field.name)
+
+
+def word(vocabulary: Callable[[str], Any], value: str, where: str, what: str):
+    """``value`` read as a word of ``vocabulary`` (e.g. an enum); :class:`Damaged` naming
+    ``where`` and ``what`` it is if it is none."""
     try:
-        return field.vocabulary(value)
+        return vocabulary(value)
     except ValueError:
-        raise Damaged(where, f"unknown {field.name} {value!r}") from None
+        raise Damaged(where, f"unknown {what} {value!r}") from None
 
 
 def _missing(field: Field, where: str, attribute_key: str = ""):

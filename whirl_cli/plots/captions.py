@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
-from ..results import Boundary, Simulation, StudyResult
+from ..results import Boundary, ContinuationKind, Simulation, StudyResult
 
 
 @dataclass(frozen=True)
@@ -92,5 +92,5 @@ def captions(result: StudyResult) -> Captions:
     fixed = tuple(Fixed(names.canonical(key), float(value), names.parameter(key).unit)
                   for key, value in study.parameters.items())
     labels = {c.name: tuple(c.slice_labels) for c in study.continuations
-              if c.type == "two-parameter"}
+              if c.type == ContinuationKind.TWO_PARAMETER}
     return Captions(study.name, fixed, labels, dict(names.defaults()))

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import WhirlError
-from ..results import Branch, ContinuationResult, PointType
+from ..results import Branch, ContinuationResult, Criticality, LocateStatus, PointType
 from .key import (
     _BLACK,
     _PLOTTED_KINDS,
@@ -90,7 +90,7 @@ def overhangs(continuation: ContinuationResult) -> list[tuple[float, float]]:
     by_name = {b.name: b for b in continuation.branches}
     bands = set()
     for hopf in continuation.special_points:
-        if hopf.point_type != PointType.HB or hopf.criticality != "subcritical":
+        if hopf.point_type != PointType.HB or hopf.criticality != Criticality.SUBCRITICAL:
             continue
         at = float(hopf.parameters[0])
         side = _stable_side(by_name.get(hopf.branch), hopf.index, at)
@@ -286,7 +286,7 @@ def _period_points(continuation: ContinuationResult, periodic: list[Branch]
             finite = branch.period[np.isfinite(branch.period)]
             period = float(finite[-1]) if finite.size else np.nan
             bracket = np.asarray(point.bracket, dtype=float)
-            if point.status == "bracketed" and bracket.shape == (2,) and np.isfinite(
+            if point.status == LocateStatus.BRACKETED and bracket.shape == (2,) and np.isfinite(
                     bracket).all():
                 brackets.append((float(bracket.min()), float(bracket.max())))
         else:

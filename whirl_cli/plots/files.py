@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import OutputError, WhirlError
 from ..kinds import MOTION_KINDS, PLOT_KINDS
 from ..output.guard import PLOT_CHARACTERS, plot_stem
-from ..results import Branch, ContinuationResult, PointType, StudyResult
+from ..results import Branch, ContinuationKind, ContinuationResult, PointType, StudyResult
 from .captions import Captions, Fixed, captions
 from .diagrams import bifurcation_diagram, period_plot, phase_plane, projections_figure
 from .freeplay import amplitude_diagram, has_amplitudes
@@ -51,7 +51,7 @@ class View:
 
 def missing_data(result: StudyResult, kind: str) -> str:
     """What ``result`` lacks to draw plot ``kind`` (a sentence), or "" if it can draw it."""
-    one_parameter = [c for c in result.continuations if c.kind == "one-parameter"]
+    one_parameter = [c for c in result.continuations if c.kind == ContinuationKind.ONE_PARAMETER]
     if kind in ("bifurcation", "projections") and not one_parameter:
         return "no one-parameter continuation"
     if kind == "period" and not any(b.is_periodic for c in result.continuations
@@ -272,14 +272,14 @@ def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str,
     jobs = []
     if "bifurcation" in kinds:
         for continuation in result.continuations:
-            if continuation.kind == "one-parameter":
+            if continuation.kind == ContinuationKind.ONE_PARAMETER:
                 chosen = _state_for(continuation, state)
                 jobs.append((f"{stem}_{continuation.name}_bifurcation.png",
                              lambda c=continuation, s=chosen: bifurcation_diagram(
                                  c, s, title=_title(caption, c))))
     if "projections" in kinds:
         for continuation in result.continuations:
-            if continuation.kind == "one-parameter":
+            if continuation.kind == ContinuationKind.ONE_PARAMETER:
                 jobs.append((f"{stem}_{continuation.name}_projections.png",
                              lambda c=continuation: projections_figure(
                                  c, title=_title(caption, c))))
@@ -376,11 +376,12 @@ def _boundary_jobs(result: StudyResult, stem: str, state: str | None,
                          title=caption().title(b.parameter_names),
                          xlim=view.xlim, ylim=view.ylim)))
         continuation = next((c for c in result.continuations if c.name == boundary.name
-                             and c.kind == "two-parameter"),
-                            ContinuationResult(boundary.name, "one-parameter", (), ()))
+                             and c.kind == ContinuationKind.TWO_PARAMETER),
+                            ContinuationResult(boundary.name, ContinuationKind.ONE_PARAMETER,
+                                               (), ()))
         for k, value in enumerate(boundary.slices):
             chosen = (_state_for(slice_continuation(continuation, k), state)
-                      if continuation.kind == "two-parameter" else state)
+                      if continuation.kind == ContinuationKind.TWO_PARAMETER else state)
             jobs.append((f"{stem}_{boundary.name}_slice_{k}_overhang.png",
                          lambda c=continuation, b=boundary, v=value, s=chosen, k=k:
                          overhang_diagram(c, b, v, state=s,

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import WhirlError
-from ..results import Boundary, ContinuationResult, LinearGrid
+from ..results import Boundary, ContinuationKind, ContinuationResult, LinearGrid
 from .diagrams import _checked_branches, _draw_bifurcation
 from .key import _BLACK, _UNSAFE_LABEL, BOUNDARY_KEY, _new_figure, _patch_proxy, axis_label
 
@@ -199,7 +199,8 @@ def slice_continuation(continuation: ContinuationResult, index: int) -> Continua
                      if b.name.startswith(prefix))
     points = tuple(replace(p, branch=p.branch[len(prefix):]) for p in continuation.special_points
                    if p.branch.startswith(prefix))
-    return ContinuationResult(f"{continuation.name}.slice_{index}", "one-parameter", branches,
+    return ContinuationResult(f"{continuation.name}.slice_{index}",
+                              ContinuationKind.ONE_PARAMETER, branches,
                               points)
 
 
@@ -229,7 +230,7 @@ def overhang_diagram(continuation: ContinuationResult, boundary: Boundary | None
     (just the continuation's name without a boundary), unless ``title`` is given. Returns the
     figure.
     """
-    if continuation.kind == "two-parameter":
+    if continuation.kind == ContinuationKind.TWO_PARAMETER:
         if boundary is None:
             raise WhirlError(f"continuation {continuation.name!r} is two-parameter: an "
                              "overhang diagram needs its boundary to find the slice")

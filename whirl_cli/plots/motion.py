@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import WhirlError
-from ..results import ContinuationResult, Exploration
+from ..results import ContinuationResult, Exploration, MotionKind
 from .key import _PLOTTED_KINDS, _new_figure, axis_label, display_unit
 
 if TYPE_CHECKING:
@@ -21,8 +21,9 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 #: Colour of each class of motion (orbit diagram, spectrum).
-KIND_COLOURS = {"equilibrium": "tab:green", "periodic": "tab:blue",
-                "quasi-periodic": "tab:orange", "chaotic": "tab:red", "diverged": "tab:gray"}
+KIND_COLOURS = {MotionKind.EQUILIBRIUM: "tab:green", MotionKind.PERIODIC: "tab:blue",
+                MotionKind.QUASI_PERIODIC: "tab:orange", MotionKind.CHAOTIC: "tab:red",
+                MotionKind.DIVERGED: "tab:gray"}
 
 
 def exploration_label(found: Exploration) -> str:
@@ -50,7 +51,7 @@ def _settled(found: Exploration) -> np.ndarray:
     """The section points the orbit diagram draws (m, n): all of them, but only the last of
     an equilibrium (the transient spirals in towards it)."""
     points = np.asarray(found.section, dtype=float).reshape(-1, len(found.state_names))
-    return points[-1:] if found.kind == "equilibrium" else points
+    return points[-1:] if found.kind == MotionKind.EQUILIBRIUM else points
 
 
 def poincare_plot(continuation: ContinuationResult, x: str | None = None,

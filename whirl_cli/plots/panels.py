@@ -17,7 +17,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import WhirlError
-from ..results import Branch, ContinuationResult, LinearSweep, PointType, StudyResult
+from ..results import (
+    Branch,
+    ContinuationKind,
+    ContinuationResult,
+    LinearSweep,
+    PointType,
+    StudyResult,
+)
 from .captions import Fixed, captions
 from .diagrams import (
     _checked_branches,
@@ -310,7 +317,7 @@ def pick_continuation(result: StudyResult, name: str | None, kind: str = "bifurc
                       ) -> ContinuationResult:
     """The one-parameter continuation named ``name`` (None: the first one that has what
     ``kind`` draws: periodic branches for ``period``, freeplay amplitudes for ``amplitude``)."""
-    one = [c for c in result.continuations if c.kind == "one-parameter"]
+    one = [c for c in result.continuations if c.kind == ContinuationKind.ONE_PARAMETER]
     if name is not None:
         found = [c for c in one if c.name == name]
         if not found:
