@@ -31,6 +31,7 @@ from .results import (
     ContinuationResult,
     Exploration,
     MotionKind,
+    Origin,
     ParameterValue,
     SeedKind,
     SeedOutcome,
@@ -333,7 +334,7 @@ def seeded_orbits(model, overrides: dict[str, float], parameter: str, start: flo
     kept = seeds.distinct(settled)
     families = {k: f"periodic_o{n}" for n, k in enumerate(kept, 1)}
     starts = tuple(OrbitStart(replace(settled[k].orbit, parameters=np.array([start])),
-                              float(start), f"seed {k + 1} settled by time simulation")
+                              float(start), Origin(f"seed {k + 1} settled by time simulation"))
                    for k in kept)
     outcomes = tuple(
         SeedOutcome(k + 1, s.seed, s.kind, s.orbit.period if s.orbit else float("nan"),

@@ -8,6 +8,7 @@ SI units with physical time: angles in rad, rates in rad/s, periods in s, eigenv
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field, fields, is_dataclass
 from enum import IntEnum
 
@@ -171,6 +172,51 @@ class Orbit:
     __repr__ = _brief_repr
 
 
+#: The text form of an :class:`Origin` at a special point (its optional note after ", ").
+_AT_POINT = re.compile(r"(?P<point>[A-Z0-9]+) at (?P<parameter>\S+) = (?P<value>\S+) "
+                       r"on (?P<branch>[^\s,]+)(?:, (?P<note>.*))?", re.DOTALL)
+
+
+@dataclass(frozen=True)
+class Origin:
+    """Where a branch starts: at the special point ``point`` of branch ``branch``, where the
+    principal parameter ``parameter`` = ``value``, with ``note`` saying more (e.g. the
+    smoothing of a short run); or, without a point, as ``note`` says (e.g. "start at K1 =
+    0.5"). ``str()`` is the text a result file stores (:meth:`parse` reads it back)."""
+
+    note: str = ""
+    point: PointType | None = None
+    parameter: str = ""
+    value: float | None = None
+    branch: str = ""
+
+    @classmethod
+    def at(cls, point: SpecialPoint, note: str = "") -> Origin:
+        """The origin of a branch started at ``point`` (in its principal parameter)."""
+        return cls(note, PointType(point.point_type), point.parameter_names[0],
+                   float(point.parameters[0]), point.branch)
+
+    @classmethod
+    def parse(cls, text: str) -> Origin:
+        """The origin whose text form is ``text`` (only the note if it names no point)."""
+        found = _AT_POINT.fullmatch(text)
+        if found and found["point"] in PointType.__members__:
+            try:
+                origin = cls(found["note"] or "", PointType[found["point"]],
+                             found["parameter"], float(found["value"]), found["branch"])
+            except ValueError:
+                return cls(text)
+            if str(origin) == text:
+                return origin
+        return cls(text)
+
+    def __str__(self) -> str:
+        if self.point is None:
+            return self.note
+        text = f"{self.point.name} at {self.parameter} = {self.value:.6g} on {self.branch}"
+        return f"{text}, {self.note}" if self.note else text
+
+
 #: :attr:`Branch.end` of a branch that used up its study's ``max_steps`` (AUTO's NMX) before
 #: reaching any other end: a truncated branch, which makes the study fail
 #: (:mod:`whirl_cli.verdict`).
@@ -187,7 +233,8 @@ class Branch:
     ----------
     name : unique id within its continuation, e.g. "main_down", "secondary_1_up", "periodic_2".
     kind : one of :class:`BranchKind`.
-    origin : where it started, e.g. "start at K1 = 0.5", "BP 4 of main_down".
+    origin : where it started (:class:`Origin`), e.g. "start at K1 = 0.5",
+        "BP at K1 = 0.0359815 on main_down".
     parameter_names : continuation parameters, principal first; ``parameters``: (N, P) values.
     state_names, state_units : the model's states and their SI units.
     state_max, state_min : (N, n) max and min of each state over the orbit (equilibria: equal).
@@ -214,7 +261,7 @@ class Branch:
 
     name: str
     kind: BranchKind
-    origin: str
+    origin: Origin
     parameter_names: tuple[str, ...]
     parameter_units: tuple[str, ...]
     state_names: tuple[str, ...]
@@ -230,7 +277,7 @@ class Branch:
     eigenvalues: np.ndarray
     status: RunStatus = RunStatus.OK
     message: str = "ok"
-    run: str = ""
+    runs: tuple[str, ...] = ()  # the AUTO runs that made it (several for a joined branch)
     orbits: tuple[Orbit, ...] = field(default=())
     end: str = ""  # how the branch ends, e.g. "range", "returns to HB at K1 = 0.0807"
     stability_known: np.ndarray | None = None

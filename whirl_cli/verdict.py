@@ -92,7 +92,7 @@ def verdict(result: StudyResult, plot_error: str = "") -> Verdict:
     notes = tuple(f"locus {b.name} ends with MX (no convergence) "
                   + (f"at {', '.join(f'{v:.5g}' for v in b.parameters[-1])}" if len(b)
                      else "at its start") for b in loci_mx)
-    problems = [f"{b.name} ({b.run}): {b.message}" for b in branches
+    problems = [f"{b.name} ({'+'.join(b.runs)}): {b.message}" for b in branches
                 if is_problem(b.kind, b.status)]
     problems += [truncation(b) for b in branches if b.truncated]
     problems += [f"cross-check failed on {x.branch} at {x.parameter:.6g}"

@@ -9,6 +9,7 @@ from whirl_cli.results import (
     BranchKind,
     ContinuationResult,
     LinearSweep,
+    Origin,
     PointType,
     SpecialPoint,
 )
@@ -28,7 +29,7 @@ def make_branch(name: str, kind: str, k1, theta_max, stable, theta_min=None,
     state_min = np.column_stack([theta_min] + [0.1 * theta_min] * 3)
     periodic = kind == BranchKind.PERIODIC
     return Branch(
-        name=name, kind=kind, origin="test",
+        name=name, kind=kind, origin=Origin("test"),
         parameter_names=("K1", "V"), parameter_units=("N m/rad", "m/s"),
         state_names=STATES, state_units=UNITS,
         parameters=np.column_stack([k1, np.full(n, 6.7)]),

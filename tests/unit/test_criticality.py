@@ -7,14 +7,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from whirl_cli.continuation.criticality import _origin, _with_criticality
-from whirl_cli.results import Branch, BranchKind, PointType, SpecialPoint
+from whirl_cli.continuation.criticality import _with_criticality
+from whirl_cli.results import Branch, BranchKind, Origin, PointType, SpecialPoint
 
 OMEGA = 30.0  # rad/s, the Hopf pair
 
+#: The origin of a branch these tests do not start anywhere in particular.
+ANYWHERE = Origin("")
+
 
 def branch(name: str, kind: str, k1: np.ndarray, eigenvalues: np.ndarray, size: np.ndarray,
-           origin: str = "") -> Branch:
+           origin: Origin = ANYWHERE) -> Branch:
     n = len(k1)
     state = np.zeros((n, 4))
     state[:, 0] = size
@@ -44,7 +47,7 @@ def hopf_and_family(printed: bool, lyapunov_says: str):
                         "supercritical" else 1.0)
     family = branch("periodic_1", BranchKind.PERIODIC, np.array([0.2, 0.19, 0.18, 0.17]),
                     np.full((4, 4), np.nan + 0j), np.array([0.0, 0.01, 0.02, 0.03]),
-                    origin=_origin(hopf))
+                    origin=Origin.at(hopf))
     return equilibria, hopf, family
 
 

@@ -12,13 +12,24 @@ from whirl_cli.figures.draw import figure_legend, share_limits
 from whirl_cli.plots.cuts import mark_cuts, phase_cuts, solutions_at
 from whirl_cli.plots.diagrams import bifurcation_diagram
 from whirl_cli.plots.key import _new_figure, symbol
-from whirl_cli.results import Branch, BranchKind, ContinuationResult, Orbit, PointType, SpecialPoint
+from whirl_cli.results import (
+    Branch,
+    BranchKind,
+    ContinuationResult,
+    Orbit,
+    Origin,
+    PointType,
+    SpecialPoint,
+)
 
 STATES = ("theta", "psi", "theta_dot", "psi_dot")
 UNITS = ("rad", "rad", "rad/s", "rad/s")
 
 
-def branch(name, kind, k1, theta, stable, orbits=(), period=None, origin="test") -> Branch:
+TEST = Origin("test")
+
+
+def branch(name, kind, k1, theta, stable, orbits=(), period=None, origin=TEST) -> Branch:
     """A branch on K1 whose theta is given (rad) and psi is half of it."""
     k1 = np.asarray(k1, dtype=float)
     n = len(k1)
@@ -62,10 +73,13 @@ def cut_continuation() -> ContinuationResult:
     fold = np.array([0.1, 0.2, 0.3, 0.2, 0.15])
     lco = branch("periodic_1", BranchKind.PERIODIC, fold, [0.01, 0.05, 0.1, 0.15, 0.2],
                  [0, 0, 1, 1, 1], orbits=(circle(7, 1, 0.2, 0.05), circle(8, 3, 0.2, 0.15)),
-                 origin="HB at K1 = 0.1 on main_down")
+                 origin=Origin(point=PointType.HB, parameter="K1", value=0.1,
+                               branch="main_down"))
     tail = np.array([-0.05, -0.09, -0.0999, -0.09999])
     secondary = branch("periodic_2", BranchKind.PERIODIC, tail, [0.12] * 4, [1] * 4,
-                       period=[0.2, 0.5, 2.0, 9.0], origin="HB at K1 = -0.05 on secondary_1a",
+                       period=[0.2, 0.5, 2.0, 9.0],
+                       origin=Origin(point=PointType.HB, parameter="K1", value=-0.05,
+                                     branch="secondary_1a"),
                        orbits=(circle(3, 1, -0.09, 0.03, 0.1, 0.5),
                                circle(4, 3, -0.09999, 0.08, 0.1, 9.0)))
     return ContinuationResult(

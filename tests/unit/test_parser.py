@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from whirl_cli.auto.parse import fortran_float, parse_b, parse_d, parse_s
-from whirl_cli.results import PointType
+from whirl_cli.results import Origin, PointType
 
 
 @pytest.mark.parametrize(("text", "value"), [
@@ -134,7 +134,7 @@ def read_fragment(tmp_path, text: str):
     (tmp_path / "b.k1.main").write_text(text)
     outcome = RunOutcome("k1.main", "ok", "ok", tmp_path, "", 0, 0.1, text.count("\n"))
     return read_branch(outcome, get_model("classical"), name="main", kind="equilibrium",
-                       origin="start", parameter_names=("K_theta",))
+                       origin=Origin("start"), parameter_names=("K_theta",))
 
 
 def test_segments_with_different_columns_keep_every_row(tmp_path):

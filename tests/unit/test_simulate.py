@@ -10,7 +10,7 @@ import pytest
 
 from whirl_cli.analysis import simulate
 from whirl_cli.models import get_model
-from whirl_cli.results import Branch, BranchKind, PointType
+from whirl_cli.results import Branch, BranchKind, Origin, PointType
 
 HARDENING_CASE2 = {"K2_theta": 10.0, "K3_theta": 0.0, "K_psi": 0.3}
 
@@ -24,7 +24,8 @@ def one_point_branch(model, k1: float, state: np.ndarray) -> Branch:
     """A stable equilibrium branch of one row at ``k1`` with the stored ``state``."""
     nan = np.full((1, model.n_states), np.nan + 0j)
     return Branch(
-        name="hand", kind=BranchKind.EQUILIBRIUM, origin="by hand", parameter_names=("K_theta",),
+        name="hand", kind=BranchKind.EQUILIBRIUM, origin=Origin("by hand"),
+        parameter_names=("K_theta",),
         parameter_units=("N m/rad",), state_names=model.state_names,
         state_units=tuple(s.unit for s in model.states), parameters=np.array([[k1]]),
         state_max=state[None, :].copy(), state_min=state[None, :].copy(),

@@ -61,7 +61,8 @@ def test_every_field_is_declared_exactly_once(cls):
 def branch(name: str, kind: str, n: int) -> results.Branch:
     rng = np.random.default_rng(1)
     return results.Branch(
-        name=name, kind=kind, origin="o", parameter_names=("V",), parameter_units=("m/s",),
+        name=name, kind=kind, origin=results.Origin("o"), parameter_names=("V",),
+        parameter_units=("m/s",),
         state_names=("q1", "q2"), state_units=("m", "m/s"), parameters=rng.normal(size=(n, 1)),
         state_max=rng.normal(size=(n, 2)), state_min=rng.normal(size=(n, 2)),
         l2_norm=rng.normal(size=n), period=rng.normal(size=n), stable=rng.random(n) > 0.5,

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from whirl_cli import results
-from whirl_cli.results import BranchKind, PointType
+from whirl_cli.results import BranchKind, Origin, PointType
 
 
 def test_a_torus_locus_frees_the_period_and_the_torus_angle():
@@ -73,7 +73,8 @@ def _read(tmp_path, text: str) -> results.Branch:
     model = get_model("gimballed")
     assert model.state_names == STATES
     return read_branch(outcome, model, name="torus_1a",
-                       kind=BranchKind.TORUS_LOCUS, origin="TR", parameter_names=("V", "K_beta"))
+                       kind=BranchKind.TORUS_LOCUS, origin=Origin("TR"),
+                       parameter_names=("V", "K_beta"))
 
 
 def test_the_torus_angle_is_read_from_par_12_in_zero_to_pi(tmp_path):
@@ -96,7 +97,8 @@ def test_a_torus_locus_without_its_angle_column_fails_with_a_message(tmp_path):
 def _locus(n: int, start: float = 0.0) -> results.Branch:
     rows = np.arange(n, dtype=float) + start
     return results.Branch(
-        name="torus_1a", kind=BranchKind.TORUS_LOCUS, origin="TR", parameter_names=("V", "K"),
+        name="torus_1a", kind=BranchKind.TORUS_LOCUS, origin=Origin("TR"),
+        parameter_names=("V", "K"),
         parameter_units=("m/s", "N m/rad"), state_names=("q", "dq"), state_units=("m", "m/s"),
         parameters=np.column_stack([rows, rows]), state_max=np.zeros((n, 2)),
         state_min=np.zeros((n, 2)), l2_norm=rows, period=rows, stable=np.zeros(n, bool),

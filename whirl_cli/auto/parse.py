@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..models import Model
-from ..results import Branch, BranchKind, Orbit, PointType, RunStatus
+from ..results import Branch, BranchKind, Orbit, Origin, PointType, RunStatus
 from .constants import PERIOD_INDEX, TORUS_ANGLE_INDEX, auto_name, par_layout
 from .runner import RunOutcome
 
@@ -227,7 +227,8 @@ def _attach(segment: BSegment, diagnostics: list[Diagnostics], n: int) -> np.nda
     return table
 
 
-def read_branch(outcome: RunOutcome, model: Model, *, name: str, kind: BranchKind, origin: str,
+def read_branch(outcome: RunOutcome, model: Model, *, name: str, kind: BranchKind,
+                origin: Origin,
                 parameter_names: tuple[str, ...]) -> Branch:
     """The branch one AUTO run wrote, in SI units (see :mod:`whirl_cli.results`)."""
     segments = parse_b(outcome.file("b").read_text(errors="replace"))
@@ -284,7 +285,7 @@ def read_branch(outcome: RunOutcome, model: Model, *, name: str, kind: BranchKin
         eigenvalues=eigen,
         status=outcome.status,
         message=outcome.message,
-        run=outcome.name,
+        runs=(outcome.name,),
         orbits=read_orbits(outcome, model, segment, parameter_names) if periodic or torus
         else (),
         stability_known=known,
@@ -299,7 +300,7 @@ def _principal_angle(theta: np.ndarray) -> np.ndarray:
 
 
 def _unreadable_branch(outcome: RunOutcome, model: Model, name: str, kind: BranchKind,
-                       origin: str,
+                       origin: Origin,
                        parameter_names: tuple[str, ...], message: str) -> Branch:
     """An empty branch with status error: AUTO's output lacks what whirl reads."""
     n, p = model.n_states, len(parameter_names)
@@ -311,7 +312,7 @@ def _unreadable_branch(outcome: RunOutcome, model: Model, name: str, kind: Branc
         l2_norm=np.empty(0), period=np.empty(0), stable=np.empty(0, dtype=bool),
         point_type=np.empty(0, dtype=np.int64), label=np.empty(0, dtype=np.int64),
         eigenvalues=np.empty((0, n), dtype=complex), status=RunStatus.ERROR, message=message,
-        run=outcome.name, torus_angle=np.empty(0) if kind == BranchKind.TORUS_LOCUS else None)
+        runs=(outcome.name,), torus_angle=np.empty(0) if kind == BranchKind.TORUS_LOCUS else None)
 
 
 def _hopf_periods(outcome: RunOutcome, segment: BSegment) -> np.ndarray:

@@ -45,7 +45,7 @@ def join(first: Branch, second: Branch, name: str) -> Branch:
     stacked.update({key: None for key in ("torus_angle",) if key not in stacked})
     moved = tuple(replace(o, index=o.index + shift - 1) for o in second.orbits if o.index > 0)
     return replace(first, name=name, status=second.status, message=second.message,
-                   end=second.end, run=f"{first.run}+{second.run}",
+                   end=second.end, runs=first.runs + second.runs,
                    orbits=first.orbits + moved, **stacked)
 
 

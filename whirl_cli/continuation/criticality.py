@@ -11,7 +11,7 @@ import numpy as np
 
 from ..analysis.normal_form import criticality_of, hopf_lyapunov_coefficient
 from ..models import Model
-from ..results import Branch, Criticality, PointType, SpecialPoint
+from ..results import Branch, Criticality, Origin, PointType, SpecialPoint
 from .branches import _joined
 from .periodic import _hopf_at
 
@@ -29,7 +29,7 @@ def _with_criticality(points: list[SpecialPoint], families: list[Branch],
             continue
         for row, neighbour in ((0, 1), (len(family) - 1, len(family) - 2)):
             k = _hopf_at(family, row, hopfs, width, scale) if row else next(
-                (i for i, h in enumerate(hopfs) if family.origin == _origin(h)), None)
+                (i for i, h in enumerate(hopfs) if family.origin == Origin.at(h)), None)
             if k is not None and k not in sides:
                 sides[k] = float(np.sign(family.parameters[neighbour, 0]
                                          - hopfs[k].parameters[0]))
@@ -67,10 +67,6 @@ def with_lyapunov(model: Model, parameter: str, parameters: dict[str, float],
                             criticality=criticality_of(l1, 2 * np.pi / point.period))
         labelled.append(point)
     return labelled
-
-
-def _origin(hopf: SpecialPoint) -> str:
-    return f"HB at {hopf.parameter_names[0]} = {hopf.parameters[0]:.6g} on {hopf.branch}"
 
 
 def _hopf_growth_direction(branch: Branch, hopf: SpecialPoint) -> float:

@@ -24,6 +24,7 @@ from ..results import (
     STEP_LIMIT,
     Branch,
     BranchKind,
+    Origin,
     PointType,
     RunRecord,
     RunStatus,
@@ -49,7 +50,7 @@ class RunSpec:
     name: str
     constants: dict
     kind: BranchKind
-    origin: str
+    origin: Origin
     parameter_names: tuple[str, ...]
     restart: tuple[str, int] | None = None
     data: str | None = None
@@ -134,18 +135,18 @@ class Engine:
             self.on_run(outcome)
         return outcome
 
-    def run_with_label(self, runs: str, label: int) -> str:
-        """Which of the AUTO runs ``runs`` ("a+b+..." for a branch joined from several runs)
-        wrote the solution labelled ``label``."""
-        for name in reversed(runs.split("+")):  # the latest run of a chain of restarts
+    def run_with_label(self, runs: tuple[str, ...], label: int) -> str:
+        """Which of the AUTO runs ``runs`` (a branch's, several for one joined from several
+        runs) wrote the solution labelled ``label``."""
+        for name in reversed(runs):  # the latest run of a chain of restarts
             if any(found == label for _, found in self.outcomes[name].labels):
                 return name
-        for name in reversed(runs.split("+")):  # a regular (NPR) point: no type on stdout
+        for name in reversed(runs):  # a regular (NPR) point: no type on stdout
             outcome = self.outcomes[name]
             if outcome.has_output and any(solution.lab == label for solution in parse_s(
                     outcome.file("s").read_text(errors="replace"))):
                 return name
-        raise KeyError(f"label {label} not found in runs {runs}")
+        raise KeyError(f"label {label} not found in runs {'+'.join(runs)}")
 
     def records(self) -> tuple[RunRecord, ...]:
         return tuple(
@@ -179,7 +180,7 @@ def _failed_branch(model: Model, spec: RunSpec, outcome: runner.RunOutcome) -> B
         l2_norm=np.empty(0), period=np.empty(0), stable=np.empty(0, dtype=bool),
         point_type=np.empty(0, dtype=np.int64), label=np.empty(0, dtype=np.int64),
         eigenvalues=np.empty((0, n), dtype=complex), status=outcome.status,
-        message=outcome.message, run=outcome.name,
+        message=outcome.message, runs=(outcome.name,),
         torus_angle=np.empty(0) if spec.kind == BranchKind.TORUS_LOCUS else None)
 
 

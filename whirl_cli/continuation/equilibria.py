@@ -17,7 +17,7 @@ import numpy as np
 from ..auto.constants import base_constants, par_layout
 from ..errors import WhirlError
 from ..models import Model
-from ..results import Branch, BranchKind, PointType, SpecialPoint
+from ..results import Branch, BranchKind, Origin, PointType, SpecialPoint
 from .branches import _same_point, typical_amplitudes
 from .engine import Engine, Numerics, RunSpec, _run_branches
 
@@ -101,7 +101,7 @@ def equilibria(engine: Engine, name: str, parameter: str, start: float,
                 todo.append(RunSpec(
                     f"{name}/secondary_{len(switched)}{label}", constants,
                     BranchKind.EQUILIBRIUM,
-                    f"BP at {parameter} = {point.parameters[0]:.6g} on {point.branch}",
+                    Origin.at(point),
                     (parameter,), restart=(source, point.label)))
         frontier = [p for p in _run_branches(engine, todo, branches, points, skip_first=True)
                     if not any(_same_point(p, q, width, amplitudes) for q in switched)]
@@ -137,8 +137,8 @@ def _both_ways(model: Model, numerics: Numerics, parameter: str, start: float,
         if (direction < 0 and start > bounds[0]) or (direction > 0 and start < bounds[1]):
             constants = equilibrium_constants(model, numerics, parameter, bounds, direction)
             constants["PAR"] = values
-            specs.append(RunSpec(f"{name}_{label}", constants, BranchKind.EQUILIBRIUM, origin,
-                                 (parameter,), start_state=start_state))
+            specs.append(RunSpec(f"{name}_{label}", constants, BranchKind.EQUILIBRIUM,
+                                 Origin(origin), (parameter,), start_state=start_state))
     return specs
 
 
@@ -233,5 +233,5 @@ def is_linear(model: Model, parameters: dict[str, float]) -> bool:
 
 
 def _run_of(branches: list[Branch], branch_name: str) -> str:
-    return next(b.run for b in branches if b.name == branch_name)
+    return next(b.runs[-1] for b in branches if b.name == branch_name)
 

@@ -12,7 +12,7 @@ from ..auto import runner
 from ..auto.constants import base_constants
 from ..auto.parse import parse_b
 from ..models import Model
-from ..results import Branch, BranchKind, LocateStatus, SpecialPoint
+from ..results import Branch, BranchKind, LocateStatus, Origin, SpecialPoint
 from .branches import _joined, typical_amplitudes
 from .engine import Engine, RunSpec
 
@@ -91,8 +91,8 @@ def _homoclinic_run(engine: Engine, name: str, family: Branch, point: SpecialPoi
     period_tau = float(family.period[row]) * model.time_scale
     return RunSpec(f"{name}/{family.name}.homoclinic",
                    homoclinic_constants(model, parameter, bounds, period_tau, n_unstable),
-                   BranchKind.HOMOCLINIC, point.note, (parameter,),
-                   restart=(engine.run_with_label(family.run, label), label))
+                   BranchKind.HOMOCLINIC, Origin(point.note), (parameter,),
+                   restart=(engine.run_with_label(family.runs, label), label))
 
 
 def _homoclinic_verdict(outcome: runner.RunOutcome, point: SpecialPoint, parameter: str,

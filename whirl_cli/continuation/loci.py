@@ -19,6 +19,7 @@ from ..results import (
     ContinuationKind,
     ContinuationResult,
     LocateStatus,
+    Origin,
     PointType,
     RunStatus,
     SpecialPoint,
@@ -106,7 +107,7 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
     # the slices are independent: side by side (the engine runs at most its jobs of AUTO)
     results = thread_map(run_slice, range(len(slices)), len(slices))
     for k, (value, result) in enumerate(zip(slices, results, strict=True)):
-        runs = {b.name: b.run for b in result.branches}
+        runs = {b.name: b.runs for b in result.branches}
         for branch in result.branches:
             branches.append(replace(branch, name=f"slice_{k}.{branch.name}"))
         for point in result.special_points:
@@ -318,7 +319,7 @@ def _distinct(curves: dict[int, tuple[int, RunSpec | None, Branch]],
 
 def _trace(engine: Engine, name: str, pair: tuple[str, str],
            bounds: dict[str, tuple[float, float]], numerics: Numerics,
-           starts: list[tuple[int, SpecialPoint, str]], background: bool = False
+           starts: list[tuple[int, SpecialPoint, tuple[str, ...]]], background: bool = False
            ) -> list[tuple[int, int, RunSpec, Branch]]:
     """(start number, point type, last run, locus branch) of every start, both directions,
     run in parallel (``background``: see :meth:`Engine.run_many`): the first chunk of steps
@@ -330,7 +331,7 @@ def _trace(engine: Engine, name: str, pair: tuple[str, str],
         kind = PointType(point.point_type)
         locus, branch_kind = LOCI[kind]
         source = engine.run_with_label(runs, point.label)
-        origin = f"{kind.name} at {pair[0]} = {point.parameters[0]:.6g} on {point.branch}"
+        origin = Origin.at(point)
         for direction, tag in ((1, "a"), (-1, "b")):
             constants = locus_constants(model, numerics, pair, bounds, direction, kind)
             if kind in CYCLE_LOCI:  # stage 1: AUTO builds the extended system (NMX 5)
@@ -385,7 +386,7 @@ def _grown(engine: Engine, traced: dict[int, tuple[int, RunSpec, Branch]],
         again = {k: replace(spec, name=f"{spec.name}c{chunk}",
                             constants=dict(spec.constants, NMX=min(
                                 LOCUS_CHUNK, numerics.max_steps - len(curve) + 1)),
-                            restart=(curve.run.rsplit("+", 1)[-1], int(curve.label[-1])))
+                            restart=(curve.runs[-1], int(curve.label[-1])))
                  for k, (_, spec, curve) in kept.items()
                  if k not in cut | stalled and spec.kind in CHUNKED
                  and _chunk_used(curve, width, bounds) and len(curve) < numerics.max_steps
@@ -426,7 +427,7 @@ def _retried(engine: Engine, loci: dict[int, tuple[int, RunSpec, Branch]], numer
         if spec.kind in CHUNKED:
             constants["NMX"] = min(LOCUS_CHUNK, numerics.max_steps - row)
         again.append(replace(spec, name=spec.name + "r", constants=constants,
-                             restart=(engine.run_with_label(curve.run, int(curve.label[row])),
+                             restart=(engine.run_with_label(curve.runs, int(curve.label[row])),
                                       int(curve.label[row]))))
         where.append((k, row))
     done: dict[int, tuple[int, RunSpec, Branch]] = {}

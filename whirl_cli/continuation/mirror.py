@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..models import Model
-from ..results import Branch, PointType, SpecialPoint
+from ..results import Branch, Origin, PointType, SpecialPoint
 from .branches import _joined, typical_amplitudes
 
 #: Mirror Hopf points agree to this fraction of the range in the parameter, this many typical
@@ -62,7 +62,7 @@ def _mirrors(a: SpecialPoint, b: SpecialPoint, width: float, amplitudes: np.ndar
             and np.allclose(sa, -sb, rtol=MIRROR_TOLERANCE, atol=MIRROR_TOLERANCE))
 
 
-def mirrored_branch(branch: Branch, name: str, origin: str, end: str) -> Branch:
+def mirrored_branch(branch: Branch, name: str, origin: Origin, end: str) -> Branch:
     """The mirror image of a periodic ``branch``: states negated (the maxima are the negated
     minima), everything else the same; named ``name``, from ``origin``, ending as ``end``
     says."""

@@ -22,6 +22,7 @@ from ..results import (
     Branch,
     BranchKind,
     Orbit,
+    Origin,
     PointType,
     RunStatus,
     SpecialPoint,
@@ -76,7 +77,7 @@ class OrbitStart:
 
     orbit: Orbit
     value: float
-    origin: str
+    origin: Origin
 
 
 @dataclass
@@ -115,7 +116,7 @@ def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
     scale = np.asarray(model.state_scale, dtype=float)
     hopfs = [p for p in points if p.point_type == PointType.HB]
     sources = mirror_sources(model, hopfs, width, parameters)
-    runs = {b.name: b.run for b in equilibria}
+    runs = {b.name: b.runs[-1] for b in equilibria}
     families: dict[int, _Family] = {}
     for k, hopf in enumerate(hopfs):
         if k in sources:
@@ -164,9 +165,9 @@ def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
     return kept, sorted(found, key=lambda p: order[p.branch])
 
 
-def _hopf_origin(hopf: SpecialPoint) -> str:
+def _hopf_origin(hopf: SpecialPoint) -> Origin:
     """The origin of the family of ``hopf``."""
-    return f"HB at {hopf.parameter_names[0]} = {hopf.parameters[0]:.6g} on {hopf.branch}"
+    return Origin.at(hopf)
 
 
 def _mirrored(side: _Ended, k: int, hopfs: list[SpecialPoint], image: dict[int, int]
@@ -417,7 +418,7 @@ def _next_segment(family: _Family, model: Model, hopfs: list[SpecialPoint],
         return None
     return replace(family.spec, name=f"{family.spec.name.rsplit('.', 1)[0]}."
                    f"{len(family.pieces)}", constants=_segment_constants(family),
-                   restart=(piece.run, int(piece.label[-1])), data=None)
+                   restart=(piece.runs[-1], int(piece.label[-1])), data=None)
 
 
 def _segment_constants(family: _Family, **changes) -> dict:
@@ -454,7 +455,7 @@ def _retry(family: _Family, piece: Branch) -> RunSpec | None:
                                    DSMAX=family.spec.constants["DSMAX"] / refine)
     return replace(family.spec, name=f"{family.spec.name.rsplit('.', 1)[0]}."
                    f"{len(family.pieces)}r{family.retries}", constants=constants,
-                   restart=(piece.run.rsplit("+", 1)[-1], int(piece.label[row])), data=None)
+                   restart=(piece.runs[-1], int(piece.label[row])), data=None)
 
 
 def _periodic_end(family: Branch, model: Model, hopfs: list[SpecialPoint],

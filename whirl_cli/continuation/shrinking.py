@@ -32,7 +32,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..results import BranchKind, ContinuationResult, PointType, SpecialPoint
+from ..results import BranchKind, ContinuationResult, Origin, PointType, SpecialPoint
 from .engine import Engine, Numerics, RunSpec, _read
 from .loci import locus_constants
 
@@ -78,7 +78,7 @@ def recompute(engine: Engine, name: str, continuation: ContinuationResult,
     ``<name>/shrink_<k>_eps<j>`` (point ``k``, ``j``-th factor) and
     ``<name>/shrink_<k>_locus<side>`` (``a``, ``b``; ``...2`` after the first 5 steps)."""
     widths = _widths(engine, parameters, smoothing)
-    runs = {b.name: b.run for b in continuation.branches}
+    runs = {b.name: b.runs for b in continuation.branches}
     todo = {k: p for k, p in enumerate(continuation.special_points)
             if p.point_type in checked and p.label and p.branch in runs}
     found = _close(_restarted(engine, name, todo, runs, widths, factors), todo, reach)
@@ -105,7 +105,7 @@ def _widths(engine: Engine, parameters: dict[str, float],
     return {width: float(values[names.index(width)]) for width in smoothing}
 
 
-def _source(engine: Engine, runs: dict[str, str], point: SpecialPoint) -> str | None:
+def _source(engine: Engine, runs: dict[str, tuple[str, ...]], point: SpecialPoint) -> str | None:
     """The AUTO run that wrote ``point``'s label, or None."""
     try:
         return engine.run_with_label(runs[point.branch], point.label)
@@ -129,8 +129,7 @@ def _restart_spec(engine: Engine, name: str, k: int, j: int, point: SpecialPoint
                      STOP=[f"{STOP_CODES[PointType(point.point_type)]}1"],
                      NMX=2 * steps + SPARE_STEPS)
     return RunSpec(f"{name}/shrink_{k}_eps{j}", constants, spec.kind,
-                   f"{point.type_name} at {point.parameter_names[0]} = "
-                   f"{point.parameters[0]:.6g} on {point.branch}, smoothing x {factor:g}",
+                   Origin.at(point, f"smoothing x {factor:g}"),
                    spec.parameter_names, restart=(source, start), data=None)
 
 
@@ -158,7 +157,8 @@ def _restarted(engine: Engine, name: str, points: dict[int, SpecialPoint],
             if np.all(np.isfinite(v))}
 
 
-def _by_locus(engine: Engine, name: str, folds: dict[int, SpecialPoint], runs: dict[str, str],
+def _by_locus(engine: Engine, name: str, folds: dict[int, SpecialPoint],
+              runs: dict[str, tuple[str, ...]],
               widths: dict[str, float], factors: tuple[float, ...],
               bounds: tuple[float, float], numerics: Numerics) -> dict[int, Recomputed]:
     """Path 2 (module docstring) for every fold of cycles, both ways side by side: AUTO
@@ -182,7 +182,8 @@ def _by_locus(engine: Engine, name: str, folds: dict[int, SpecialPoint], runs: d
                              EPSS=1e-3 * value * min(factors))
             first.append((k, RunSpec(
                 f"{name}/shrink_{k}_locus{side}", constants, BranchKind.FOLD_OF_CYCLES_LOCUS,
-                f"LPC at {pair[0]} = {point.parameters[0]:.6g} on {point.branch}", pair,
+                Origin(point=PointType.LPC, parameter=pair[0], value=float(point.parameters[0]),
+                       branch=point.branch), pair,
                 restart=(source, point.label))))
     second = [(k, replace(spec, name=spec.name + "2", restart=(outcome.name,
                                                                outcome.labels[-1][1]),

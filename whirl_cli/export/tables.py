@@ -110,7 +110,8 @@ def branch_table(branch: Branch) -> Table:
             "state": Axis(branch.state_names, branch.state_units),
             "mode": _modes(np.shape(branch.eigenvalues)[1])}
     attributes = {"name": branch.name, "kind": str(branch.kind), "origin": str(branch.origin),
-                  "status": str(branch.status), "message": branch.message, "run": branch.run,
+                  "status": str(branch.status), "message": branch.message,
+                  "run": "+".join(branch.runs),
                   "end": branch.end}
     return Table(branch.name, tuple(columns), axes, attributes)
 

@@ -51,9 +51,9 @@ class Field:
     beside its code). ``codes``: an IntEnum whose members the integer dataset holds, written
     beside it as the attributes ``flag_values`` and ``flag_meanings`` (the CF conventions'
     pair: the codes and their names, space-separated), so that a reader of the file alone
-    can name them. ``vocabulary``: for a text field, the type its words are read as (an enum,
-    or any type built from its text form; written as ``str`` of the value); a word outside
-    it is :class:`Damaged`.
+    can name them. ``vocabulary``: for a text field, what reads its text into the value (an
+    enum, or a parser such as ``Origin.parse``; ValueError: the file is :class:`Damaged`);
+    ``spelled``: what writes the value as that text (``str``).
     """
 
     name: str
@@ -69,6 +69,7 @@ class Field:
     shape: tuple[int | str, ...] | None = None
     codes: Any = None
     vocabulary: Callable[[str], Any] | None = None
+    spelled: Callable[[Any], str] = str
 
     def hdf5_key(self, kind: str = "") -> str:
         return _choose(self.key, kind) or self.name
@@ -222,7 +223,7 @@ def _attribute(field: Field, value):
     """An attribute value as h5py takes it: tuples as lists of names or arrays of numbers,
     words of a vocabulary as their text."""
     if field.vocabulary is not None:
-        return str(value)
+        return field.spelled(value)
     if isinstance(value, tuple):
         return np.array(value, dtype=float) if field.kind == "float" else list(value)
     return value
@@ -353,7 +354,7 @@ def write_table(group: h5py.Group, rows: Sequence, fields: Sequence[Field],
     for field in fields:
         values = [getattr(row, field.name) for row in rows]
         if field.vocabulary is not None:
-            values = [str(v) for v in values]
+            values = [field.spelled(v) for v in values]
         if field.width is not None:
             width = field.width if isinstance(field.width, int) else context[field.width]
             values = np.array(values, dtype=float).reshape(len(rows), width)

@@ -48,6 +48,7 @@ from ..results import (
     LocateStatus,
     MotionKind,
     Orbit,
+    Origin,
     ParameterValue,
     PointType,
     RunRecord,
@@ -80,15 +81,21 @@ SCHEMA = 2
 READABLE = (1, 2)
 
 # ------------------------------------------------------------------------- the declarations
+def _runs(text: str) -> tuple[str, ...]:
+    """A branch's AUTO runs from their stored text, "+"-joined ("": none)."""
+    return tuple(text.split("+")) if text else ()
+
+
 _PERIODIC = BranchKind.PERIODIC
 
 #: A :class:`Branch` in ``branches/<name>`` (its name is the group's).
 BRANCH = (
     Field("kind", "attribute", "text", vocabulary=BranchKind),
-    Field("origin", "attribute", "text"),
+    Field("origin", "attribute", "text", vocabulary=Origin.parse),
     Field("status", "attribute", "text", vocabulary=RunStatus),
     Field("message", "attribute", "text"),
-    Field("run", "attribute", "text"), Field("end", "attribute", "text"),
+    Field("runs", "attribute", "text", key="run", vocabulary=_runs, spelled="+".join),
+    Field("end", "attribute", "text"),
     Field("parameters", columns=("parameter_names", "parameter_units"),
           shape=("points", "parameter_names")),
     Field("state_max", columns=("state_names", "state_units"), shape=("points", "state_names")),

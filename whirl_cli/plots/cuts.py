@@ -110,7 +110,7 @@ def _equilibria_at(branch: Branch, value: float) -> list[Solution]:
 def _cycle(branch: Branch, orbit) -> Solution:
     row = orbit.index
     known = 0 <= row < len(branch) and bool(branch.stability_known[row])
-    parent = branch.origin.rpartition(" on ")[2] if " on " in branch.origin else ""
+    parent = branch.origin.branch
     return Solution(branch.name, branch.kind, bool(branch.stable[row]) if known else None,
                     np.asarray(orbit.states, dtype=float), f" of {parent}" if parent else "")
 
