@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..models import Model
-from ..results import Boundary, Branch, BranchKind, UnsafeInterval
+from ..results import Boundary, Branch, BranchKind, PointType, UnsafeInterval
 from . import linear
 
 Interval = tuple[float, float]
@@ -169,7 +169,7 @@ def branch_candidates(branches: tuple[Branch, ...]) -> dict[str, list[Interval]]
         if branch.kind == BranchKind.PERIODIC and (branch.stable
                                                    & branch.stability_known)[1:-1].any():
             found["flutter"].append(extent)
-        elif (branch.kind == BranchKind.EQUILIBRIUM and branch.origin.startswith("BP at")
+        elif (branch.kind == BranchKind.EQUILIBRIUM and branch.origin.point == PointType.BP
               and np.any(branch.point_type == 2)):
             found["divergence"].append(extent)
     return found
@@ -275,7 +275,7 @@ def boundary(name: str, model: Model, overrides: dict[str, float], pair: tuple[s
         rows = list(slices)
         candidates = [branch_candidates(tuple(
             b for b in branches if b.kind != BranchKind.PERIODIC
-            or b.origin.endswith(("main_down", "main_up")))) for branches in slice_branches]
+            or b.origin.branch in ("main_down", "main_up"))) for branches in slice_branches]
     # the stable part of each row, examined only where a candidate lies
     where = [merge([i for found in row.values() for i in found]) for row in candidates]
     stable = stable_intervals(model, overrides, first, second, rows, bounds[first], 4001,
