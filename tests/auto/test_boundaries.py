@@ -134,7 +134,7 @@ def test_hardening_sliver_left_of_the_left_hopf(results):
     _, large = simulate.integrate(model, params, np.radians([8.0, 0, 0, 0]), 60.0, 6000)
     assert np.degrees(large[-1000:, 0].max()) > 3.0  # ... yet a stable LCO is reached
     (family,) = [b for b in result.continuations[0].branches
-                 if b.kind == BranchKind.PERIODIC and "0.288" in b.origin]
+                 if b.kind == BranchKind.PERIODIC and "0.288" in str(b.origin)]
     stable = family.stable & (np.abs(family.parameter("K_theta") - k1) < 2e-3)
     assert stable.any()
     assert np.degrees(large[-1000:, 0].max()) == pytest.approx(

@@ -165,7 +165,7 @@ def test_a_supercritical_family_from_every_hopf_point(continuation):
         assert point.criticality == "supercritical" and point.lyapunov < 0 and not point.note
         family = branch(continuation, f"periodic_{j}")
         assert family.kind == BranchKind.PERIODIC and family.status == "ok"
-        assert family.origin == f"HB at alpha = {point.parameters[0]:.6g} on main_down"
+        assert str(family.origin) == f"HB at alpha = {point.parameters[0]:.6g} on main_down"
         assert family.end == "range" and family.parameters[-1, 0] == pytest.approx(RANGE[0])
         assert np.all(family.parameters[1:, 0] < point.parameters[0])
         known = family.stability_known

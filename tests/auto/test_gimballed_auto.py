@@ -161,11 +161,11 @@ def test_combined_periodic_families_and_cross_checks(combined):
     (continuation,) = result.continuations
     families = [b for b in continuation.branches if b.kind == BranchKind.PERIODIC]
     hopfs = [p for p in continuation.special_points if p.point_type == PointType.HB]
-    assert len(families) >= 4 and all(f.origin.startswith("HB at") for f in families)
+    assert len(families) >= 4 and all(f.origin.point == PointType.HB for f in families)
     for hopf in hopfs:
         value = float(hopf.parameters[0])
         assert any(abs(f.parameters[:, 0] - value).min() < 1e-3 * 0.8 for f in families
-                   if f.origin.endswith(f"on {hopf.branch}") or hopf.branch == "main_down")
+                   if f.origin.branch == hopf.branch or hopf.branch == "main_down")
     assert continuation.cross_checks and all(c.passed for c in continuation.cross_checks)
     assert all(b.state_max.shape[1] == 8 for b in continuation.branches)
     assert "cross-checks by time simulation" in text

@@ -139,7 +139,7 @@ def test_fold_of_cycles_locus_is_the_fold_of_a_one_parameter_run(soft, tmp_path)
     single = run_study(validate_text(text, "k1.yaml"), tmp_path, jobs=2)
     (continuation,) = single.continuations
     main = {b.name for b in continuation.branches
-            if b.kind == BranchKind.PERIODIC and b.origin.endswith("on main_down")}
+            if b.kind == BranchKind.PERIODIC and b.origin.branch == "main_down"}
     folds = [float(p.parameters[0]) for p in continuation.special_points
              if p.point_type == PointType.LPC and p.branch in main]
     assert folds and crossings
@@ -189,7 +189,7 @@ def test_unsafe_interval_by_time_simulation(soft):
     assert np.linalg.eigvals(MODEL.jacobian_numpy(np.zeros(8), params)).real.max() < 0
     (continuation,) = result.continuations
     (family,) = [b for b in continuation.branches if b.kind == BranchKind.PERIODIC
-                 and b.origin.endswith("main_down")]
+                 and b.origin.branch == "main_down"]
     expected = _stable_amplitude(family, inside)
     before, last = _pitch_amplitude(study, inside, 12.0, 20.0)
     print(f"\n  K1 = {inside:.5f}: simulated LCO {last:.4f} deg, AUTO {expected:.4f} deg")
@@ -232,7 +232,7 @@ def test_case5_main_family_ends_at_a_heteroclinic_approach(tmp_path):
     assert not verdict(result).problems, verdict(result).problems
     (continuation,) = result.continuations
     (family,) = [b for b in continuation.branches if b.kind == BranchKind.PERIODIC
-                 and b.origin.endswith("on main_down")]
+                 and b.origin.branch == "main_down"]
     assert family.end == "period blow-up: heteroclinic approach"
     assert 2 * family.period[0] < family.period.max() < 3 * family.period[0]
     (point,) = [p for p in continuation.special_points if p.branch == family.name

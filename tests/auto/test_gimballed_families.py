@@ -74,7 +74,7 @@ def test_a_family_from_hopf_point_to_hopf_point_has_no_global_bifurcation(combin
     (upper, upper_period), (lower, lower_period) = sorted(_origin_hopf_points(study))[::-1][:2]
     assert lower < upper
     (family,) = [b for b in continuation.branches if b.is_periodic
-                 and abs(b.parameters[0, 0] - upper) < 1e-4 and b.origin.endswith("main_down")]
+                 and abs(b.parameters[0, 0] - upper) < 1e-4 and b.origin.branch == "main_down"]
     assert abs(family.parameters[-1, 0] - lower) < 1e-3
     assert family.period[-1] == pytest.approx(lower_period, rel=1e-3)
     assert np.nanmax(family.period) < 1.01 * max(upper_period, lower_period)
@@ -141,7 +141,7 @@ def _mirror_pairs(continuation) -> list[tuple]:
     for hopf in (h for h in hopfs if h.branch == "secondary_1a"):
         (image,) = [h for h in hopfs if h.branch == "secondary_1b"
                     and abs(h.parameters[0] - hopf.parameters[0]) < 1e-9]
-        pair = [next(f for f in families if f.origin.endswith(f"on {h.branch}")
+        pair = [next(f for f in families if f.origin.branch == h.branch
                      and abs(f.parameters[0, 0] - h.parameters[0]) < 1e-9)
                 for h in (hopf, image)]
         pairs.append(tuple(pair))

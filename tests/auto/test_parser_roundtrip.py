@@ -21,7 +21,7 @@ from whirl_cli.continuation.engine import Engine, Numerics, RunSpec
 from whirl_cli.continuation.equilibria import equilibrium_constants
 from whirl_cli.continuation.periodic import periodic_constants
 from whirl_cli.models import get_model
-from whirl_cli.results import BranchKind, PointType
+from whirl_cli.results import BranchKind, Origin, PointType
 
 CASE = {"K2_theta": 10.0, "K3_theta": 0.0, "K_psi": 0.3}
 BOUNDS = (-0.3, 0.5)
@@ -35,7 +35,7 @@ def runs(tmp_path_factory):
     numerics = Numerics(orbits_at=(0.45, 0.35, 0.2, -0.1, -0.2))
     main = equilibrium_constants(model, numerics, "K_theta", BOUNDS, -1)
     main["PAR"] = {**CASE, "K_theta": 0.5}
-    (first,) = engine.run_many([RunSpec("rt/main", main, BranchKind.EQUILIBRIUM, "start",
+    (first,) = engine.run_many([RunSpec("rt/main", main, BranchKind.EQUILIBRIUM, Origin("start"),
                                         ("K_theta",))])
     solutions = parse_s(first.file("s").read_text())
     (pitchfork,) = [s for s in solutions if PointType.from_auto(s.ty) == PointType.BP]
@@ -47,9 +47,9 @@ def runs(tmp_path_factory):
                                   float(hopf.par[PERIOD_INDEX - 1]))
     periodic.update(NMX=41, NPR=10)
     second, third = engine.run_many([
-        RunSpec("rt/secondary", secondary, BranchKind.EQUILIBRIUM, "BP", ("K_theta",),
+        RunSpec("rt/secondary", secondary, BranchKind.EQUILIBRIUM, Origin("BP"), ("K_theta",),
                 restart=("rt.main", pitchfork.lab)),
-        RunSpec("rt/periodic", periodic, BranchKind.PERIODIC, "HB", ("K_theta",),
+        RunSpec("rt/periodic", periodic, BranchKind.PERIODIC, Origin("HB"), ("K_theta",),
                 restart=("rt.main", hopf.lab))])
     outcomes = {"main": first, "secondary": second, "periodic": third}
     assert all(o.status == "ok" for o in outcomes.values()), outcomes
@@ -136,7 +136,7 @@ def test_d_file_eigenvalues_are_the_model_jacobian_eigenvalues(runs, run):
     model, outcomes = runs
     segment, solutions, diagnostics = _files(outcomes[run])
     branch = read_branch(outcomes[run], model, name=run, kind=BranchKind.EQUILIBRIUM,
-                         origin="", parameter_names=("K_theta",))
+                         origin=Origin(""), parameter_names=("K_theta",))
     scale = np.asarray(model.state_scale)
     for solution in solutions:
         k = _row(segment, solution.lab)
@@ -186,7 +186,7 @@ def test_d_file_multipliers_are_the_monodromy_eigenvalues(runs):
     model, outcomes = runs
     segment, solutions, diagnostics = _files(outcomes["periodic"])
     branch = read_branch(outcomes["periodic"], model, name="periodic",
-                         kind=BranchKind.PERIODIC, origin="", parameter_names=("K_theta",))
+                         kind=BranchKind.PERIODIC, origin=Origin(""), parameter_names=("K_theta",))
     scale = np.asarray(model.state_scale)
     orbits = [s for s in solutions if s.ips == 2]
     assert len(branch.orbits) == len(orbits)

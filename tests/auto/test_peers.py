@@ -150,8 +150,9 @@ def test_criticality_by_the_family_and_by_the_lyapunov_coefficient(peers, case, 
     _, result = peers[case]
     hopf = _main_hopf(result)
     value = float(hopf.parameters[0])
-    families = [b for b in _periodic(result) if b.origin.startswith("HB at V")
-                and b.origin.endswith(f"on {hopf.branch}")]
+    families = [b for b in _periodic(result)
+                if (b.origin.point, b.origin.parameter) == (PointType.HB, "V")
+                and b.origin.branch == hopf.branch]
     assert len(families) == 1
     (family,) = families
     assert family.parameters[0, 0] == pytest.approx(value, abs=1e-9)

@@ -3,7 +3,6 @@ of the equilibria they hang off, eigenvalue-based Hopf criticality, and time sim
 
 from __future__ import annotations
 
-import re
 from functools import cache
 
 import numpy as np
@@ -53,7 +52,7 @@ def _pitch_amplitude(branch):
 
 def test_hardening_case2_flutter_branch_joins_the_two_hopf_points(run_thesis):
     result = run_thesis("hardening_case2")
-    main = [b for b in _periodic(result) if b.origin.endswith("on main_down")]
+    main = [b for b in _periodic(result) if b.origin.branch == "main_down"]
     assert len(main) == 1  # reached from both Hopf points, stored once
     (flutter,) = main
     # both ends at the Hopf points of the eigenvalues (models.md 4: 0.0807 and 0.2888)
@@ -87,7 +86,7 @@ def test_hardening_case2_secondary_flutter(run_thesis):
         hopfs = sorted(p.parameters[0] for p in _points(result, PointType.HB)
                        if p.branch == side)
         assert len(hopfs) == 2
-        (family,) = [b for b in _periodic(result) if b.origin.endswith(f"on {side}")]
+        (family,) = [b for b in _periodic(result) if b.origin.branch == side]
         assert family.end.startswith("returns to HB") and family.end.endswith(side)
         ends = sorted([family.parameter("K_theta")[0], family.parameter("K_theta")[-1]])
         np.testing.assert_allclose(ends, hopfs, atol=2e-3)
@@ -139,8 +138,8 @@ def test_softening_case2_overhang(softening_at_04, capsys):
     stays on a cycle for 150 periods; as far beyond it, it decays to the origin (in about 40
     periods: the ghost of the vanished cycles)."""
     study, result = softening_at_04
-    (flutter,) = [b for b in _periodic(result) if b.origin.endswith("main_down")
-                  and "0.288" in b.origin]
+    (flutter,) = [b for b in _periodic(result) if b.origin.branch == "main_down"
+                  and "0.288" in str(b.origin)]
     assert not flutter.stable[1:6].any()
     (fold,) = [p for p in _points(result, PointType.LPC) if p.branch == flutter.name]
     d = 1e-3 * 0.8
@@ -165,7 +164,7 @@ def test_softening_case2_coexisting_limit_cycle_by_simulation(softening_at_04, c
     study, result = softening_at_04
     model = get_model("classical")
     params = model.parameter_vector({**study.parameter_values(), "K_theta": 0.4})
-    (flutter,) = [b for b in _periodic(result) if "0.288" in b.origin]
+    (flutter,) = [b for b in _periodic(result) if "0.288" in str(b.origin)]
     at = [o for o in flutter.orbits if abs(o.parameters[0] - 0.4) < 1e-6]
     stable = [o for o in at if flutter.stable[o.index]]
     unstable = [o for o in at if not flutter.stable[o.index]]
@@ -206,9 +205,6 @@ def test_cross_checks_pass_on_every_stable_periodic_branch(run_thesis, case):
         (b.name, b.message) for b in continuation.branches if b.status != "ok"]
 
 
-_ORIGIN = re.compile(r"HB at (\S+) = (\S+) on (\S+)")
-
-
 def _family_sides(hopf, families, scale):
     """The sides of the parameter (+1/-1) on which the periodic families at ``hopf`` lie:
     families that start there (their origin names it) and families whose last orbit has
@@ -217,9 +213,9 @@ def _family_sides(hopf, families, scale):
     1e-3 of it, with K1 - K1_H proportional to the squared amplitude (Hopf normal form)."""
     value, sides = float(hopf.parameters[0]), []
     for family in families:
-        named = _ORIGIN.fullmatch(family.origin)
-        if named and named[3] == hopf.branch and abs(float(named[2]) - value) <= 5e-6 * abs(
-                value):  # the origin gives 6 significant digits
+        start = family.origin
+        if start.point == PointType.HB and start.branch == hopf.branch and abs(
+                start.value - value) <= 5e-6 * abs(value):  # 6 significant digits (read back)
             sides.append(float(np.sign(family.parameters[1, 0] - value)))
         amplitude, k1 = _pitch_amplitude(family), family.parameters[:, 0]
         if len(family) < 4 or not 0 < amplitude[-1] < min(amplitude[-2], 0.01):
@@ -332,7 +328,7 @@ def test_cross_check_fails_for_a_wrong_orbit(run_thesis):
     result = run_thesis("hardening_case2")
     model = get_model("classical")
     parameters = {"K_psi": 0.3, "K2_theta": 10.0, "K3_theta": 0.0}
-    (flutter,) = [b for b in _periodic(result) if "0.288" in b.origin]
+    (flutter,) = [b for b in _periodic(result) if "0.288" in str(b.origin)]
     orbit = next(o for o in flutter.orbits if 0 < o.index and flutter.stable[o.index])
     assert simulate.check_orbit(model, parameters, flutter, orbit).passed
     wrong = replace(orbit, states=orbit.states * 1.3)
@@ -346,7 +342,7 @@ def test_period_blow_up_is_bracketed(run_thesis):
     for case, kind in (("hardening_case3", PointType.HOMOCLINIC),
                        ("combined_case3", PointType.HETEROCLINIC)):
         result = run_thesis(case)
-        (main,) = [b for b in _periodic(result) if b.origin.endswith("main_down")]
+        (main,) = [b for b in _periodic(result) if b.origin.branch == "main_down"]
         assert main.end.startswith("period blow-up")
         found = [p for p in result.continuations[0].special_points
                  if p.branch == main.name and p.point_type in (PointType.HOMOCLINIC,
@@ -427,7 +423,7 @@ def _simulated_connection(case: str, estimate: float, saddle: tuple[float, ...])
 
 
 def _main_global_point(result):
-    (main,) = [b for b in _periodic(result) if b.origin.endswith("main_down")]
+    (main,) = [b for b in _periodic(result) if b.origin.branch == "main_down"]
     (point,) = [p for p in result.continuations[0].special_points if p.branch == main.name
                 and p.point_type in (PointType.HOMOCLINIC, PointType.HETEROCLINIC)]
     return point

@@ -16,7 +16,7 @@ from whirl_cli.continuation.engine import Engine, Numerics
 from whirl_cli.continuation.one_parameter import one_parameter
 from whirl_cli.continuation.periodic import OrbitStart
 from whirl_cli.pipeline import run_study
-from whirl_cli.results import Orbit, PointType
+from whirl_cli.results import Orbit, Origin, PointType
 from whirl_cli.study import load_study
 
 from ..conftest import STUDIES
@@ -42,7 +42,7 @@ def restarted(orbit: Orbit, value: float, origin: str):
     return one_parameter(engine, spec.name, spec.parameter, spec.start, tuple(spec.range),
                          study.parameter_values(), Numerics.from_settings(study.auto),
                          branch_points=spec.branch_points, periodic=False,
-                         start_orbits=(OrbitStart(orbit, value, origin),))
+                         start_orbits=(OrbitStart(orbit, value, Origin(origin)),))
 
 
 def family(result, name):
@@ -88,7 +88,7 @@ def test_a_family_restarted_from_its_own_stored_orbit_retraces_it():
     start = int(np.argmin(np.abs(branch.period - orbit.period)))
     assert abs(branch.parameters[start, 0] - orbit.parameters[0]) < 1e-9
     assert abs(branch.period[start] / orbit.period - 1) < 1e-6
-    assert branch.origin == "stored orbit of periodic_1"
+    assert branch.origin == Origin("stored orbit of periodic_1")
     # stability where both are stored: the same verdict on either side of every fold
     for point in (p for p in source.orbits if p.index not in (0, len(source) - 1)):
         rows = np.flatnonzero(np.isclose(branch.parameters[:, 0], point.parameters[0],

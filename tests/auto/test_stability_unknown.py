@@ -18,7 +18,7 @@ from whirl_cli.output import store
 from whirl_cli.output.compare import compare_results
 from whirl_cli.plots.diagrams import bifurcation_diagram, period_plot
 from whirl_cli.plots.key import PLOT_KEY, stability_segments
-from whirl_cli.results import BranchKind
+from whirl_cli.results import BranchKind, PointType
 
 from ..conftest import ROOT
 
@@ -38,7 +38,7 @@ def test_the_first_point_of_a_family_from_a_hopf_point_has_unknown_stability(con
     families = periodic(continuation)
     assert [b.name for b in families] == ["periodic_1", "periodic_3", "periodic_5"]
     for branch in families:
-        assert branch.origin.startswith("HB at")
+        assert branch.origin.point == PointType.HB
         nan = np.isnan(branch.eigenvalues).all(axis=1)
         assert list(np.flatnonzero(nan)) == [0], branch.name  # AUTO printed no multipliers
         assert not branch.stable[0] and branch.stable[1:4].all()  # AUTO's flag: "unstable"

@@ -123,12 +123,12 @@ def test_the_slice_at_another_gimbal_stiffness_finds_its_torus_point_on_the_locu
     continuation = _continuation()
     slice_points = [p for p in continuation.special_points if p.point_type == PointType.TR
                     and p.branch.startswith("slice_1.") and p.parameters[1] == 0.62]
-    from_first = [b for b in _loci() if " on slice_0." in b.origin]
+    from_first = [b for b in _loci() if b.origin.branch.startswith("slice_0.")]
     assert from_first and slice_points
     crossings = [c for b in from_first for c in _crossing(0.62) if c[0] == b.name]
     on_locus = []
     for point in slice_points:
-        if any(b.origin.endswith(f" on {point.branch}") for b in _loci()):
+        if any(b.origin.branch == point.branch for b in _loci()):
             continue  # it starts a locus of its own (the gimbal cycle's torus point)
         v, angle = point.parameters[0], point.torus_angle
         name, locus_v, locus_angle = min(crossings, key=lambda c: abs(c[1] - v))

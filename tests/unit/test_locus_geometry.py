@@ -162,13 +162,14 @@ def test_a_locus_chunk_that_adds_no_point_ends_the_locus(monkeypatch):
     is the loop's control, not a continuation result.)"""
     from whirl_cli.continuation import loci
     from whirl_cli.continuation.engine import Numerics, RunSpec
-    from whirl_cli.results import PointType
+    from whirl_cli.results import Origin, PointType
 
     curve = make_locus(np.array([[0.2, 0.1], [0.3, 0.2], [0.4, 0.3]]))
     curve.point_type[-1] = PointType.EP
     curve.label[-1] = 7
     curve = dataclasses.replace(curve, runs=("c.fold_of_cycles_1a2",))
-    spec = RunSpec("c/fold_of_cycles_1a2", {"NMX": loci.LOCUS_CHUNK}, curve.kind, "", ("p", "q"))
+    spec = RunSpec("c/fold_of_cycles_1a2", {"NMX": loci.LOCUS_CHUNK}, curve.kind, Origin(""),
+                   ("p", "q"))
     calls = []
 
     class Engine:
@@ -191,7 +192,7 @@ def test_a_locus_chunk_drawn_over_its_own_path_ends_the_locus(monkeypatch):
     (Stub runs: the loop's control, not a continuation result.)"""
     from whirl_cli.continuation import loci
     from whirl_cli.continuation.engine import Numerics, RunSpec
-    from whirl_cli.results import PointType
+    from whirl_cli.results import Origin, PointType
 
     def ending(points):
         curve = make_locus(points)
@@ -201,7 +202,8 @@ def test_a_locus_chunk_drawn_over_its_own_path_ends_the_locus(monkeypatch):
 
     path = np.column_stack([np.linspace(0.2, 0.6, 41), np.full(41, 0.2)])
     curve = dataclasses.replace(ending(path), runs=("c.fold_of_cycles_1a2",))
-    spec = RunSpec("c/fold_of_cycles_1a2", {"NMX": loci.LOCUS_CHUNK}, curve.kind, "", ("p", "q"))
+    spec = RunSpec("c/fold_of_cycles_1a2", {"NMX": loci.LOCUS_CHUNK}, curve.kind, Origin(""),
+                   ("p", "q"))
     for chunk, continued in ((path[::-1][:30], False),  # back over its path
                              (np.vstack([path[-1], path[-1] + [[0.01, 0.01]]]), True)):
         calls = []

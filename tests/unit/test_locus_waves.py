@@ -12,7 +12,7 @@ import numpy as np
 from whirl_cli.continuation import loci
 from whirl_cli.continuation.engine import _Slots
 from whirl_cli.continuation.numerics import Numerics
-from whirl_cli.results import PointType, SpecialPoint
+from whirl_cli.results import BranchKind, Origin, PointType, SpecialPoint
 
 from .locus_data import make_locus
 
@@ -101,7 +101,8 @@ def test_a_next_wave_start_on_a_locus_of_the_wave_before_is_set_aside(monkeypatc
         rows = []
         for k, point, _ in starts:
             for tag in "ab":
-                spec = loci.RunSpec(f"c/fold_of_cycles_{k}{tag}2", {}, "", "", ("p", "q"))
+                spec = loci.RunSpec(f"c/fold_of_cycles_{k}{tag}2", {},
+                                    BranchKind.FOLD_OF_CYCLES_LOCUS, Origin(""), ("p", "q"))
                 rows.append((k, PointType.LPC, spec, make_locus(np.array(
                     [point.parameters, point.parameters + [0.0, 0.1 if tag == "a" else -0.1]]))))
         return rows[::-1]  # any order: the recipe puts them in its own
