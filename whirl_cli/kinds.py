@@ -123,6 +123,14 @@ class CheckKind(Word):
     EQUILIBRIUM = "equilibrium"
 
 
+class SimulationLaw(Word):
+    """The law a time simulation integrates: the smoothed one AUTO continues, or the exact
+    piecewise one."""
+
+    SMOOTHED = "smoothed"
+    EXACT = "exact"
+
+
 class SweepAction(Word):
     """What a sweep does with a study: run it, skip it (up to date), only plot it, or report
     it invalid."""

@@ -23,11 +23,12 @@ from .kinds import (
     MotionKind,
     RunStatus,
     SeedKind,
+    SimulationLaw,
 )
 
 #: re-exported: the vocabulary results are written in
 __all__ = ["BranchKind", "CheckKind", "ContinuationKind", "Criticality", "LocateStatus",
-           "MotionKind", "RunStatus", "SeedKind"]
+           "MotionKind", "RunStatus", "SeedKind", "SimulationLaw"]
 
 
 def _brief(value) -> str:
@@ -664,7 +665,7 @@ class Simulation:
     event, e.g. a dof beyond the divergence bound; -1: the integration failed)."""
 
     name: str
-    law: str
+    law: SimulationLaw
     parameter_names: tuple[str, ...]
     parameter_units: tuple[str, ...]
     parameter_values: np.ndarray

@@ -21,7 +21,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..models import Model
-from ..results import Branch, BranchKind, CheckKind, CrossCheck, Orbit, PointType, Simulation
+from ..results import (
+    Branch,
+    BranchKind,
+    CheckKind,
+    CrossCheck,
+    Orbit,
+    PointType,
+    Simulation,
+    SimulationLaw,
+)
 from ..runtime import forked_map, preloaded
 from .global_bifurcations import BLOWUP_FACTOR
 
@@ -165,7 +174,7 @@ DIVERGENCE_LIMIT = 100.0
 
 
 def simulation(model: Model, params: np.ndarray, initial: np.ndarray, duration: float,
-               samples: int = 2001, law: str = "smoothed", name: str = "",
+               samples: int = 2001, law: SimulationLaw = SimulationLaw.SMOOTHED, name: str = "",
                overrides: dict[str, float] | None = None, rtol: float = 1e-9,
                limit: float = DIVERGENCE_LIMIT) -> Simulation:
     """The trajectory from ``initial`` (SI) over ``duration`` s at ``params``, sampled at
@@ -180,16 +189,20 @@ def simulation(model: Model, params: np.ndarray, initial: np.ndarray, duration: 
     status -1 and scipy's message."""
     from scipy.integrate import solve_ivp
 
+    try:
+        law = SimulationLaw(law)
+    except ValueError:
+        raise ValueError(f"unknown law {law!r} (smoothed | exact)") from None
     y0 = np.asarray(initial, dtype=float)
     grid = np.linspace(0.0, duration, samples)
     status, message = 0, "The solver successfully reached the end of the integration interval."
-    if law == "exact":
+    if law == SimulationLaw.EXACT:
         try:
             run = integrate_exact(model, params, y0, duration, samples, rtol=rtol)
             time, states = run.time, run.states
         except (RuntimeError, ArithmeticError, ValueError) as error:
             time, states, status, message = grid[:1], y0[None, :], -1, str(error)
-    elif law == "smoothed":
+    else:
         field, jacobian = model.field_at(params)
         scale = np.asarray(model.state_scale, dtype=float)
         watched = list(model.positions)
@@ -212,8 +225,6 @@ def simulation(model: Model, params: np.ndarray, initial: np.ndarray, duration: 
                            f"{solved.t_events[0][0]:.6g} s")
         except (ArithmeticError, ValueError, RuntimeError) as error:
             time, states, status, message = grid[:1], y0[None, :], -1, str(error)
-    else:
-        raise ValueError(f"unknown law {law!r} (smoothed | exact)")
     overrides = dict(overrides or {})
     matrix = model.hub_matrix
     used = {model.states[k].unit for k in np.flatnonzero(np.abs(matrix).sum(axis=0))}

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..auto import runner
 from ..auto.constants import TORUS_ANGLE_INDEX, par_layout
+from ..kinds import LocusKind
 from ..models import Model
 from ..results import (
     STEP_LIMIT,
@@ -43,11 +44,11 @@ from .periodic import OrbitStart
 
 #: Special point type -> (locus name in studies, branch kind of its locus).
 LOCI = {
-    PointType.HB: ("hopf", BranchKind.HOPF_LOCUS),
-    PointType.BP: ("branch_point", BranchKind.BRANCH_POINT_LOCUS),
-    PointType.LP: ("fold", BranchKind.FOLD_LOCUS),
-    PointType.LPC: ("fold_of_cycles", BranchKind.FOLD_OF_CYCLES_LOCUS),
-    PointType.TR: ("torus", BranchKind.TORUS_LOCUS),
+    PointType.HB: (LocusKind.HOPF, BranchKind.HOPF_LOCUS),
+    PointType.BP: (LocusKind.BRANCH_POINT, BranchKind.BRANCH_POINT_LOCUS),
+    PointType.LP: (LocusKind.FOLD, BranchKind.FOLD_LOCUS),
+    PointType.LPC: (LocusKind.FOLD_OF_CYCLES, BranchKind.FOLD_OF_CYCLES_LOCUS),
+    PointType.TR: (LocusKind.TORUS, BranchKind.TORUS_LOCUS),
 }
 
 #: Loci of bifurcations of cycles: AUTO starts them in two stages (see :func:`_trace`).

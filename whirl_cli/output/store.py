@@ -56,6 +56,7 @@ from ..results import (
     SeedKind,
     SeedOutcome,
     Simulation,
+    SimulationLaw,
     SpecialPoint,
     StudyResult,
     UnsafeInterval,
@@ -222,7 +223,8 @@ UNSAFE_INTERVAL = (
 )
 #: A :class:`Simulation` in ``simulations/<name>`` (its name is the group's).
 SIMULATION = (
-    Field("law", "attribute", "text"), Field("status", "attribute", "int"),
+    Field("law", "attribute", "text", vocabulary=SimulationLaw),
+    Field("status", "attribute", "int"),
     Field("message", "attribute", "text"),
     Field("parameter_values", key="parameters", columns=("parameter_names", "parameter_units"),
           shape=("parameter_names",)),

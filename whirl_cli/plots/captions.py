@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
-from ..results import Boundary, ContinuationKind, Simulation, StudyResult
+from ..results import Boundary, ContinuationKind, Simulation, SimulationLaw, StudyResult
 
 
 @dataclass(frozen=True)
@@ -64,7 +64,7 @@ class Captions:
         base = self.title(simulation.parameter_names)
         joint = ": " if base == self.study else ", " if base else ""
         shown = base + joint + ", ".join(own) if own else base
-        law = " (exact law)" if simulation.law == "exact" else ""
+        law = " (exact law)" if simulation.law == SimulationLaw.EXACT else ""
         return f"{shown}\n{simulation.name}{law}"
 
     def slice_label(self, continuation: str, k: int) -> str:
