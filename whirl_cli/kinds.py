@@ -73,9 +73,9 @@ class RunStatus(Word):
 
     OK = "ok"
     MX = "mx"  # no convergence: the branch ends early
+    ERROR = "error"
     TIMEOUT = "timeout"
     CRASHED = "crashed"
-    ERROR = "error"
 
 
 class Criticality(Word):
