@@ -16,7 +16,7 @@ import click
 
 from .errors import OutputError, WhirlError
 from .jobs import MAX_JOBS, default_jobs
-from .kinds import PLOT_KINDS, CheckKind
+from .kinds import PLOT_KINDS, CheckKind, RunStatus
 
 
 def _version() -> str:
@@ -231,8 +231,8 @@ def run(study_file: Path, output: Path | None, jobs: int, overwrite: bool, plots
     def report(outcome) -> None:
         # an MX is only said to be a problem at the end: at a period blow-up it is expected
         mark = "ok" if outcome.success else outcome.status.upper()
-        detail = {"ok": "", "mx": "  no convergence (MX)"}.get(outcome.status,
-                                                               f"  {outcome.message}")
+        detail = {RunStatus.OK: "", RunStatus.MX: "  no convergence (MX)"}.get(
+            outcome.status, f"  {outcome.message}")
         runs["done"] += 1
         width = len(str(runs["planned"]))
         count = f"[{runs['done']:>{width}}/{runs['planned']}]" if sys.stderr.isatty() else " "

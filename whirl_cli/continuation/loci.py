@@ -498,7 +498,7 @@ def _locus_end(curve: Branch, codim2: list[SpecialPoint], bounds: dict[str, tupl
         where = ", ".join(f"{v:.5g}" for v in point.parameters[:2])
         message = "ok" if curve.status == RunStatus.OK else \
             "AUTO stopped with MX at the codimension-2 point (the locus ends there)"
-        return replace(curve, end=f"{point.type_name} at ({where})", status="ok",
+        return replace(curve, end=f"{point.type_name} at ({where})", status=RunStatus.OK,
                        message=message)
     if curve.status == RunStatus.MX:
         return replace(curve, end="no convergence (MX)")

@@ -261,7 +261,7 @@ def _end(family: _Family, model: Model, hopfs: list[SpecialPoint], bounds: tuple
     if global_point is not None:
         end = f"period blow-up: {PointType(global_point.point_type).name.lower()} approach"
         if whole.status == RunStatus.MX:  # AUTO's expected failure right at the blow-up
-            whole = replace(whole, status="ok", message="ended with MX at the period "
+            whole = replace(whole, status=RunStatus.OK, message="ended with MX at the period "
                             "blow-up (expected near a global bifurcation)")
     return _Ended(replace(whole, end=end), global_point, returned_to)
 
