@@ -20,6 +20,7 @@ import re
 from collections.abc import Iterator
 from typing import Any
 
+from ..kinds import ContinuationKind, SimulationLaw
 from ..models import family_of, is_known
 from .messages import _choice_reason, _dotted
 from .resolve import (
@@ -132,7 +133,7 @@ def _continuation_name_problems(items: Any, names: Names) -> list[Problem]:
         for _, other, kind in named:
             if name.startswith(other + "."):
                 reason = f"its runs are named {other}.<run>"
-            elif smoothed and kind == "one-parameter" and re.fullmatch(
+            elif smoothed and kind == ContinuationKind.ONE_PARAMETER and re.fullmatch(
                     re.escape(other) + r"_eps\d+", name):
                 reason = (f"with a smoothed law its repetitions are named {other}_eps<k>")
             else:
@@ -173,7 +174,7 @@ def _simulation_problems(items: Any, names: Names, family: str,
         if isinstance(initial, dict):
             problems += [(loc + ("initial", key), _choice_reason(states, repr(key)))
                          for key in initial if isinstance(key, str) and key not in states]
-        if item.get("law") == "exact" and not names.model.piecewise_dofs:
+        if item.get("law") == SimulationLaw.EXACT and not names.model.piecewise_dofs:
             problems.append((loc + ("law",), "the exact law needs a piecewise stiffness law "
                              "(type: freeplay) on a dof; this study has none (use smoothed)"))
     return problems
@@ -413,7 +414,7 @@ def _continuation_problems(
             problems.append((loc + ("name",), f"duplicate continuation name {name!r}"))
         if isinstance(name, str):
             taken.add(name)
-        if item.get("type") == "two-parameter":
+        if item.get("type") == ContinuationKind.TWO_PARAMETER:
             problems += _pair_problems(loc, item, names, family, values)
             problems += _seed_problems(loc, item.get("seeds"), family)
             continue

@@ -19,6 +19,7 @@ from typing import Any
 
 from pydantic import BaseModel
 
+from ..kinds import ContinuationKind
 from ..models import LAWS, Model, Parameter, family_of, get_model, is_known
 
 #: Study law types: ``linear`` is the polynomial law with zero coefficients.
@@ -240,7 +241,7 @@ def _resolved_pair(item: dict, names: Names, values: dict[str, float] | None) ->
 
 def _resolved_item(item: Any, names: Names, values: dict[str, float] | None) -> Any:
     """A continuation or sweep with its canonical parameter name (and start, given values)."""
-    if isinstance(item, dict) and item.get("type") == "two-parameter":
+    if isinstance(item, dict) and item.get("type") == ContinuationKind.TWO_PARAMETER:
         return _resolved_pair(item, names, values)
     name = item.get("parameter") if isinstance(item, dict) else None
     if not isinstance(name, str) or name not in names.known_parameter_names():
