@@ -28,8 +28,8 @@ from pydantic import (
 from pydantic_core import PydanticCustomError
 
 from ..continuation.numerics import Numerics
-from ..kinds import PLOT_KINDS
 from ..models import FAMILIES, Model, is_known, is_model_file
+from ..plots.kinds import plot_kinds
 from .resolve import Names, _is_number, _resolved, names_of
 
 NAME_MAX = 64
@@ -441,7 +441,7 @@ class TwoParameterContinuation(_Strict):
         return tuple(s.label for s in self.slices)
 
 
-PlotKind = Literal[PLOT_KINDS]
+PlotKind = Literal[plot_kinds()]
 Continuation = Annotated[OneParameterContinuation | TwoParameterContinuation,
                         Field(discriminator="type")]
 
