@@ -193,13 +193,7 @@ def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str,
             for job in kind.figures(figures)]
 
 
-def _title(caption: Callable[[], Captions], continuation: ContinuationResult) -> str:
-    """The study's title over the parameters ``continuation`` does not vary."""
-    varied = {name for b in continuation.branches for name in b.parameter_names}
-    return caption().title(varied)
-
-
-def _slice_title(caption: Captions, boundary, k: int, value: float) -> str:
+def slice_title(caption: Captions, boundary, k: int, value: float) -> str:
     """``"<study title>\n<slice label>: <second parameter> = <value> <unit>"``."""
     fixed = Fixed(boundary.parameter_names[1], float(value), boundary.parameter_units[1])
     return (f"{caption.title(boundary.parameter_names)}\n"
@@ -222,7 +216,7 @@ def phase_labels(branch: Branch, most: int = PHASE_ORBITS) -> list[int]:
     return [o.label for o in orbits if id(o) in chosen]
 
 
-def _state_for(continuation: ContinuationResult, state: str | None) -> str | None:
+def state_for(continuation: ContinuationResult, state: str | None) -> str | None:
     """``state`` if every plotted branch has it, else None (the first state)."""
     branches = [b for b in continuation.branches if b.kind in _PLOTTED_KINDS]
     if state is None or not branches or all(state in b.state_names for b in branches):

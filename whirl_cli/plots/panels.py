@@ -14,12 +14,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from ..errors import WhirlError
 from ..results import Branch, ContinuationResult, LinearSweep, StudyResult
 from .captions import Fixed, captions
-from .key import display_unit, stability_curves
 from .kinds import overlay_kinds, panel_kinds, registry
 
 if TYPE_CHECKING:
@@ -65,7 +62,7 @@ def draw(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice = PanelCh
     return found.panel(result, ax, choice, replace(captions(result), named=False))
 
 
-def _continuation_title(continuation: ContinuationResult, choice: PanelChoice, caption
+def continuation_title(continuation: ContinuationResult, choice: PanelChoice, caption
                         ) -> str:
     """``choice.title``, else the study's title over what ``continuation`` does not vary."""
     if choice.title is not None:
@@ -76,7 +73,7 @@ def _continuation_title(continuation: ContinuationResult, choice: PanelChoice, c
     return caption.title(varied)
 
 
-def _replaced(ax: Axes, make) -> list[Axes]:
+def replaced(ax: Axes, make) -> list[Axes]:
     """Remove ``ax`` and let ``make(region)`` draw into its place; the new axes."""
     figure, region = ax.figure, ax.get_subplotspec()
     before = set(figure.axes)
@@ -105,7 +102,7 @@ def pick_continuation(result: StudyResult, name: str | None, kind: str = "bifurc
     return found[0]
 
 
-def _pick_branch(result: StudyResult, choice: PanelChoice) -> Branch:
+def pick_branch(result: StudyResult, choice: PanelChoice) -> Branch:
     """The periodic branch with stored orbits named ``choice.branch`` (None: the first)."""
     candidates = [b for c in result.continuations
                   if choice.continuation in (None, c.name) for b in c.branches
@@ -118,7 +115,7 @@ def _pick_branch(result: StudyResult, choice: PanelChoice) -> Branch:
     return candidates[0]
 
 
-def _pick_sweep(result: StudyResult, parameter: str | None) -> LinearSweep:
+def pick_sweep(result: StudyResult, parameter: str | None) -> LinearSweep:
     """The linear sweep of ``parameter`` (None: the first)."""
     sweeps = [s for s in result.linear_sweeps if parameter in (None, s.parameter)]
     if not sweeps:
@@ -163,31 +160,6 @@ def draw_overlay(results: Sequence[StudyResult], kind: str, ax: Axes,
     names = [labels[k] if k < len(labels) and labels[k] else auto[k]
              for k in range(len(results))]
     return found.overlay(results, names, ax, choice, title)
-
-
-def _shared_title(results: Sequence[StudyResult], varied: set[str]) -> str:
-    """The parameters off their datum that every result shares, but for ``varied``."""
-    shared = [p for p in results[0].parameters if p.name not in varied
-              and p.value != p.datum and all(
-                  any(q.name == p.name and q.value == p.value for q in r.parameters)
-                  for r in results[1:])]
-    return ", ".join(str(Fixed(p.name, p.value, p.unit)) for p in shared)
-
-
-def _draw_coloured(ax: Axes, branch: Branch, state: str, colour: str):
-    """One branch in ``colour``: stable solid, unstable dotted, periodic drawn by its max;
-    returns a solid line for the legend (None if nothing was drawn)."""
-    factor, _ = display_unit(branch.state_units[branch.state_names.index(state)], True)
-    y = branch.state(state, "max") * factor
-    solid = None
-    for xs, ys, stable in stability_curves(branch.parameters[:, 0], y, branch.stable,
-                                             branch.stability_known):
-        (line,) = ax.plot(xs, ys, color=colour, linestyle="-" if stable else ":",
-                          linewidth=1.4 if branch.is_periodic else 1.0, label="_curve")
-        solid = line if stable and solid is None else solid
-    if solid is None and len(y):
-        (solid,) = ax.plot([], [], color=colour, linestyle="-")
-    return solid if np.size(y) else None
 
 
 PANEL_KINDS = panel_kinds()

@@ -42,6 +42,11 @@ class Figures:
         """The result's one-parameter continuations."""
         return [c for c in self.result.continuations if c.kind == "one-parameter"]
 
+    def title(self, continuation: ContinuationResult) -> str:
+        """The study's title over the parameters ``continuation`` does not vary."""
+        return self.caption().title({name for branch in continuation.branches
+                                     for name in branch.parameter_names})
+
 
 @dataclass(frozen=True)
 class PlotKind:

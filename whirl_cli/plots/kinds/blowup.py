@@ -23,11 +23,11 @@ def _ends_globally(continuation: ContinuationResult) -> bool:
 
 def _blowup_panel(result, ax, choice, caption) -> list[Axes]:
     from ..blowup import blowup_plot
-    from ..panels import _continuation_title, pick_continuation
+    from ..panels import continuation_title, pick_continuation
 
     continuation = pick_continuation(result, choice.continuation, "blowup")
     blowup_plot(continuation, branch=choice.branch, ax=ax,
-                title=_continuation_title(continuation, choice, caption))
+                title=continuation_title(continuation, choice, caption))
     return [ax]
 
 

@@ -30,27 +30,26 @@ def _has_orbits(branch: Branch) -> bool:
 
 
 def _bifurcation_files(figures: Figures) -> list[FigureJob]:
-    from ..files import _state_for
+    from ..files import state_for
 
     return [(f"{figures.stem}_{c.name}_bifurcation.png",
-             partial(_bifurcation_figure, c, _state_for(c, figures.state), figures))
+             partial(_bifurcation_figure, c, state_for(c, figures.state), figures))
             for c in figures.one_parameter()]
 
 
 def _bifurcation_figure(continuation, state: str | None, figures: Figures):
     from ..diagrams import bifurcation_diagram
-    from ..files import _title
 
-    return bifurcation_diagram(continuation, state, title=_title(figures.caption, continuation))
+    return bifurcation_diagram(continuation, state, title=figures.title(continuation))
 
 
 def _bifurcation_panel(result, ax, choice, caption) -> list[Axes]:
     from ..diagrams import bifurcation_diagram
-    from ..panels import _continuation_title, pick_continuation
+    from ..panels import continuation_title, pick_continuation
 
     continuation = pick_continuation(result, choice.continuation, "bifurcation")
     bifurcation_diagram(continuation, choice.state, ax=ax,
-                        title=_continuation_title(continuation, choice, caption))
+                        title=continuation_title(continuation, choice, caption))
     if choice.cuts:
         from ..cuts import mark_cuts
 
@@ -63,7 +62,7 @@ def _overlay_bifurcations(results: Sequence[StudyResult], names: Sequence[str], 
     """Every result's bifurcation diagram on ``ax``, one colour per result."""
     from ..diagrams import _checked_branches, _draw_special_points, _label_axes
     from ..key import PLOT_KEY, _colours
-    from ..panels import _draw_coloured, _shared_title, pick_continuation
+    from ..panels import pick_continuation
 
     first: dict[str, object] = {}
     handles = []
@@ -92,6 +91,37 @@ def _overlay_bifurcations(results: Sequence[StudyResult], names: Sequence[str], 
     return [ax]
 
 
+def _shared_title(results: Sequence[StudyResult], varied: set[str]) -> str:
+    """The parameters off their datum that every result shares, but for ``varied``."""
+    from ..captions import Fixed
+
+    shared = [p for p in results[0].parameters if p.name not in varied
+              and p.value != p.datum and all(
+                  any(q.name == p.name and q.value == p.value for q in r.parameters)
+                  for r in results[1:])]
+    return ", ".join(str(Fixed(p.name, p.value, p.unit)) for p in shared)
+
+
+def _draw_coloured(ax: Axes, branch: Branch, state: str, colour: str):
+    """One branch in ``colour``: stable solid, unstable dotted, periodic drawn by its max;
+    returns a solid line for the legend (None if nothing was drawn)."""
+    import numpy as np
+
+    from ..key import display_unit, stability_curves
+
+    factor, _ = display_unit(branch.state_units[branch.state_names.index(state)], True)
+    y = branch.state(state, "max") * factor
+    solid = None
+    for xs, ys, stable in stability_curves(branch.parameters[:, 0], y, branch.stable,
+                                             branch.stability_known):
+        (line,) = ax.plot(xs, ys, color=colour, linestyle="-" if stable else ":",
+                          linewidth=1.4 if branch.is_periodic else 1.0, label="_curve")
+        solid = line if stable and solid is None else solid
+    if solid is None and len(y):
+        (solid,) = ax.plot([], [], color=colour, linestyle="-")
+    return solid if np.size(y) else None
+
+
 BIFURCATION = PlotKind(
     "bifurcation", 10, _bifurcation_panel, missing=_no_one_parameter,
     figures=_bifurcation_files, overlay=_overlay_bifurcations)
@@ -99,20 +129,19 @@ BIFURCATION = PlotKind(
 
 def _projections_files(figures: Figures) -> list[FigureJob]:
     from ..diagrams import projections_figure
-    from ..files import _title
 
     return [(f"{figures.stem}_{c.name}_projections.png",
-             lambda c=c: projections_figure(c, title=_title(figures.caption, c)))
+             lambda c=c: projections_figure(c, title=figures.title(c)))
             for c in figures.one_parameter()]
 
 
 def _projections_panel(result, ax, choice, caption) -> list[Axes]:
     from ..diagrams import projections_figure
-    from ..panels import _continuation_title, _replaced, pick_continuation
+    from ..panels import continuation_title, pick_continuation, replaced
 
     continuation = pick_continuation(result, choice.continuation, "projections")
-    title = _continuation_title(continuation, choice, caption)
-    return _replaced(ax, lambda region: projections_figure(continuation, title=title,
+    title = continuation_title(continuation, choice, caption)
+    return replaced(ax, lambda region: projections_figure(continuation, title=title,
                                                            region=region))
 
 
@@ -128,19 +157,18 @@ def _no_periodic(result: StudyResult) -> str:
 
 def _period_files(figures: Figures) -> list[FigureJob]:
     from ..diagrams import period_plot
-    from ..files import _title
 
     return [(f"{figures.stem}_{c.name}_period.png",
-             lambda c=c: period_plot(c, title=_title(figures.caption, c)))
+             lambda c=c: period_plot(c, title=figures.title(c)))
             for c in figures.result.continuations if _periodic(c)]
 
 
 def _period_panel(result, ax, choice, caption) -> list[Axes]:
     from ..diagrams import period_plot
-    from ..panels import _continuation_title, pick_continuation
+    from ..panels import continuation_title, pick_continuation
 
     continuation = pick_continuation(result, choice.continuation, "period")
-    period_plot(continuation, title=_continuation_title(continuation, choice, caption), ax=ax)
+    period_plot(continuation, title=continuation_title(continuation, choice, caption), ax=ax)
     return [ax]
 
 
@@ -156,24 +184,24 @@ def _no_orbits(result: StudyResult) -> str:
 
 def _phase_files(figures: Figures) -> list[FigureJob]:
     from ..diagrams import phase_plane
-    from ..files import _title, phase_labels
+    from ..files import phase_labels
 
     return [(f"{figures.stem}_{c.name}_{b.name}_phase.png",
              lambda b=b, c=c: phase_plane(b, labels=phase_labels(b),
-                                          title=f"{_title(figures.caption, c)}\n{b.name}"))
+                                          title=f"{figures.title(c)}\n{b.name}"))
             for c in figures.result.continuations for b in c.branches if _has_orbits(b)]
 
 
 def _phase_panel(result, ax, choice, caption) -> list[Axes]:
     from ..diagrams import phase_plane
-    from ..panels import _pick_branch, _replaced, pick_continuation
+    from ..panels import pick_branch, pick_continuation, replaced
 
     if choice.cuts:
         from ..cuts import phase_cuts
 
         continuation = pick_continuation(result, choice.continuation, "period")
-        return _replaced(ax, lambda region: phase_cuts(continuation, choice.cuts, region))
-    branch = _pick_branch(result, choice)
+        return replaced(ax, lambda region: phase_cuts(continuation, choice.cuts, region))
+    branch = pick_branch(result, choice)
     labels = list(choice.orbits) if choice.orbits is not None else None
     if labels is None:
         from ..files import phase_labels

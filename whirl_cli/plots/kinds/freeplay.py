@@ -33,11 +33,11 @@ def _amplitude_files(figures: Figures) -> list[FigureJob]:
 
 def _amplitude_panel(result, ax, choice, caption) -> list[Axes]:
     from ..freeplay import amplitude_diagram
-    from ..panels import _continuation_title, pick_continuation
+    from ..panels import continuation_title, pick_continuation
 
     continuation = pick_continuation(result, choice.continuation, "amplitude")
     amplitude_diagram(continuation, ax=ax)
-    ax.set_title(_continuation_title(continuation, choice, caption))
+    ax.set_title(continuation_title(continuation, choice, caption))
     return [ax]
 
 

@@ -30,11 +30,11 @@ def _linear_files(figures: Figures) -> list[FigureJob]:
 
 def _linear_panel(result, ax, choice, caption) -> list[Axes]:
     from ..linear import linear_sweep_plot
-    from ..panels import _pick_sweep, _replaced
+    from ..panels import pick_sweep, replaced
 
-    sweep = _pick_sweep(result, choice.sweep)
+    sweep = pick_sweep(result, choice.sweep)
     title = caption.title({sweep.parameter}) if choice.title is None else choice.title
-    return _replaced(ax, lambda region: linear_sweep_plot(
+    return replaced(ax, lambda region: linear_sweep_plot(
         sweep, hz=choice.hz, title=title,
         axes=tuple(region.subgridspec(2, 1).subplots(sharex=True))))
 
@@ -52,9 +52,9 @@ def _root_locus_files(figures: Figures) -> list[FigureJob]:
 
 def _root_locus_panel(result, ax, choice, caption) -> list[Axes]:
     from ..linear import root_locus_plot
-    from ..panels import _pick_sweep
+    from ..panels import pick_sweep
 
-    sweep = _pick_sweep(result, choice.sweep)
+    sweep = pick_sweep(result, choice.sweep)
     root_locus_plot(sweep, title=caption.title({sweep.parameter}) if choice.title is None
                     else choice.title, ax=ax)
     return [ax]
@@ -105,9 +105,9 @@ def _multiples_files(figures: Figures) -> list[FigureJob]:
 
 
 def _multiples_panel(result, ax, choice, caption) -> list[Axes]:
-    from ..panels import _replaced
+    from ..panels import replaced
 
-    return _replaced(ax, lambda region: _draw_multiples(result, region, choice, caption))
+    return replaced(ax, lambda region: _draw_multiples(result, region, choice, caption))
 
 
 def _draw_multiples(result: StudyResult, region, choice: PanelChoice, caption,
@@ -131,9 +131,9 @@ def _overlay_multiples(results: Sequence[StudyResult], names: Sequence[str], ax:
                        choice: PanelChoice, title: str | None) -> list[Axes]:
     """``ax`` split in two (damping, frequency) with every result's ``damping_multiples``:
     a colour per parameter, a line style per result (:func:`_multiples_into`)."""
-    from ..panels import _replaced
+    from ..panels import replaced
 
-    return _replaced(ax, lambda region: _multiples_into(results, names, region, choice,
+    return replaced(ax, lambda region: _multiples_into(results, names, region, choice,
                                                         title))
 
 

@@ -25,7 +25,7 @@ def _boundary_files(figures: Figures) -> list[FigureJob]:
     """A map per boundary and an overhang diagram per slice; the linear grid alone if there
     is no boundary."""
     from ...results import ContinuationResult
-    from ..files import _slice_title, _state_for
+    from ..files import slice_title, state_for
     from ..maps import _oriented_grid, boundary_plot, overhang_diagram, slice_continuation
 
     result, stem, state, view, caption = (figures.result, figures.stem, figures.state,
@@ -49,12 +49,12 @@ def _boundary_files(figures: Figures) -> list[FigureJob]:
                              and c.kind == "two-parameter"),
                             ContinuationResult(boundary.name, "one-parameter", (), ()))
         for k, value in enumerate(boundary.slices):
-            chosen = (_state_for(slice_continuation(continuation, k), state)
+            chosen = (state_for(slice_continuation(continuation, k), state)
                       if continuation.kind == "two-parameter" else state)
             jobs.append((f"{stem}_{boundary.name}_slice_{k}_overhang.png",
                          lambda c=continuation, b=boundary, v=value, s=chosen, k=k:
                          overhang_diagram(c, b, v, state=s,
-                                          title=_slice_title(caption(), b, k, v))))
+                                          title=slice_title(caption(), b, k, v))))
     return jobs
 
 
@@ -97,7 +97,7 @@ def _overhang_panel(result, ax, choice, caption) -> list[Axes]:
     """One slice of a boundary (``choice.slice``, None: the first), its unsafe intervals
     shaded."""
     from ...errors import WhirlError
-    from ..files import _slice_title
+    from ..files import slice_title
     from ..maps import overhang_diagram
 
     boundary = _chosen_boundary(result, choice)
@@ -110,7 +110,7 @@ def _overhang_panel(result, ax, choice, caption) -> list[Axes]:
     if continuation is None:
         raise WhirlError(f"{result.study_name}: no continuation {boundary.name!r} for the "
                          "overhang diagram")
-    title = choice.title or _slice_title(caption, boundary, k, value)
+    title = choice.title or slice_title(caption, boundary, k, value)
     overhang_diagram(continuation, boundary, value, state=choice.state, ax=ax, title=title)
     return [ax]
 

@@ -26,10 +26,9 @@ def _not_explored(result: StudyResult) -> str:
 def _per_continuation(figures: Figures, suffix: str, draw) -> list[FigureJob]:
     """One file per explored continuation, ``<stem>_<continuation>_<suffix>.png``, drawn by
     ``draw(continuation, title)``."""
-    from ..files import _title
 
     return [(f"{figures.stem}_{c.name}_{suffix}.png",
-             lambda c=c: draw(c, _title(figures.caption, c)))
+             lambda c=c: draw(c, figures.title(c)))
             for c in figures.result.continuations if _explored(c)]
 
 
@@ -42,10 +41,10 @@ def _poincare_files(figures: Figures) -> list[FigureJob]:
 
 def _poincare_panel(result, ax, choice, caption) -> list[Axes]:
     from ..motion import poincare_plot
-    from ..panels import _continuation_title, pick_continuation
+    from ..panels import continuation_title, pick_continuation
 
     continuation = pick_continuation(result, choice.continuation, "poincare")
-    poincare_plot(continuation, ax=ax, title=_continuation_title(continuation, choice, caption))
+    poincare_plot(continuation, ax=ax, title=continuation_title(continuation, choice, caption))
     return [ax]
 
 
@@ -62,10 +61,10 @@ def _spectrum_files(figures: Figures) -> list[FigureJob]:
 
 def _spectrum_panel(result, ax, choice, caption) -> list[Axes]:
     from ..motion import spectrum_plot
-    from ..panels import _continuation_title, pick_continuation
+    from ..panels import continuation_title, pick_continuation
 
     continuation = pick_continuation(result, choice.continuation, "spectrum")
-    spectrum_plot(continuation, ax=ax, title=_continuation_title(continuation, choice, caption))
+    spectrum_plot(continuation, ax=ax, title=continuation_title(continuation, choice, caption))
     return [ax]
 
 
@@ -88,11 +87,11 @@ def _orbit_diagram_files(figures: Figures) -> list[FigureJob]:
 
 def _orbit_diagram_panel(result, ax, choice, caption) -> list[Axes]:
     from ..motion import orbit_diagram
-    from ..panels import _continuation_title, pick_continuation
+    from ..panels import continuation_title, pick_continuation
 
     continuation = pick_continuation(result, choice.continuation, "orbit_diagram")
     orbit_diagram(continuation, choice.state, ax=ax,
-                  title=_continuation_title(continuation, choice, caption))
+                  title=continuation_title(continuation, choice, caption))
     return [ax]
 
 

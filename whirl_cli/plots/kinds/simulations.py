@@ -52,7 +52,7 @@ def _chosen(result: StudyResult, choice: PanelChoice) -> Simulation:
 def _time_history_panel(result, ax, choice, caption) -> list[Axes]:
     """Every dof against time, one panel each in ``ax``'s place (``choice.state``: that
     state alone, on ``ax``)."""
-    from ..panels import _replaced
+    from ..panels import replaced
     from ..simulations import time_history
 
     simulation = _chosen(result, choice)
@@ -61,7 +61,7 @@ def _time_history_panel(result, ax, choice, caption) -> list[Axes]:
         time_history(simulation, states=[choice.state], axes=ax, title=title)
         return [ax]
     dofs = len(simulation.dof_names)
-    return _replaced(ax, lambda region: time_history(
+    return replaced(ax, lambda region: time_history(
         simulation, axes=list(region.subgridspec(dofs, 1).subplots(sharex=True, squeeze=False)
                               [:, 0]), title=title))
 
