@@ -12,9 +12,8 @@ from __future__ import annotations
 import importlib
 import os
 from collections.abc import Callable
-from dataclasses import dataclass
 from functools import cache
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 if TYPE_CHECKING:
     from ...results import ContinuationResult, StudyResult
@@ -25,8 +24,7 @@ if TYPE_CHECKING:
 FigureJob = tuple[str, Callable[[], Any]]
 
 
-@dataclass(frozen=True)
-class Figures:
+class Figures(NamedTuple):
     """What a kind's files are drawn from: the result (without the special points flagged as
     artefacts unless the view asks for them), the file names' stem, the state bifurcation
     diagrams draw (None: the first), the view, and the study's captions (read when first
@@ -48,8 +46,7 @@ class Figures:
                                      for name in branch.parameter_names})
 
 
-@dataclass(frozen=True)
-class PlotKind:
+class PlotKind(NamedTuple):
     """One plot kind.
 
     ``rank``: its place in every list of kinds (the order of the ``plots:`` and ``--kind``
@@ -59,7 +56,8 @@ class PlotKind:
     ``panel(result, ax, choice, caption)``: draws one panel, returns the axes drawn on;
     ``overlay(results, labels, ax, choice, title)``: several results on one panel (None: the
     kind cannot be overlaid). ``fits(continuation)``: whether a one-parameter continuation has
-    what the kind draws (a panel picks the first that fits), ``need`` naming it."""
+    what the kind draws (a panel picks the first that fits), ``need`` naming it. (Named
+    tuples, not dataclasses: the command line builds these classes at start-up.)"""
 
     name: str
     rank: int
