@@ -31,6 +31,7 @@ def test_every_kind_draws_a_panel_and_a_file_kind_says_what_it_needs():
     for name, kind in registry().items():
         assert kind.name == name and callable(kind.panel)
         assert (kind.missing is None) == (kind.figures is None), name
+    assert len({kind.rank for kind in registry().values()}) == len(registry())  # one order
     assert set(plot_kinds()) < set(panel_kinds())
     assert set(overlay_kinds()) <= set(panel_kinds())
 
