@@ -225,16 +225,14 @@ def _coefficient_field(law: Law, coefficient: Coefficient) -> tuple[Any, Any]:
 def _law_block(law: Law) -> type[_Strict]:
     """The schema of a study's block of ``law``: ``type``, ``dof``, the coefficients a study
     must give, the law's own key for the dof's stiffness (if it has one), the others."""
-    fields: dict[str, tuple[Any, Any]] = {
-        "type": (Literal[law.name], Field(description=_type_doc())),
-        "dof": (Text | None, Field(None, description=_DOF_DOC))}
-    coefficients = sorted(law.coefficients, key=lambda c: not c.required)
-    for coefficient in coefficients[:sum(c.required for c in coefficients)]:
-        fields[coefficient.key] = _coefficient_field(law, coefficient)
-    if law.stiffness_key is not None:
-        fields[law.stiffness_key] = (Number | None, Field(None, description=law.stiffness_doc))
-    for coefficient in coefficients[sum(c.required for c in coefficients):]:
-        fields[coefficient.key] = _coefficient_field(law, coefficient)
+    stiffness = {} if law.stiffness_key is None else {
+        law.stiffness_key: (Number | None, Field(None, description=law.stiffness_doc))}
+    fields = {"type": (Literal[law.name], Field(description=_type_doc())),
+              "dof": (Text | None, Field(None, description=_DOF_DOC)),
+              **{c.key: _coefficient_field(law, c) for c in law.coefficients if c.required},
+              **stiffness,
+              **{c.key: _coefficient_field(law, c) for c in law.coefficients
+                 if not c.required}}
     return create_model(law.name.capitalize(), __base__=_Strict, __module__=__name__,
                         __doc__=law.description, **fields)
 
