@@ -16,7 +16,8 @@ import click
 
 from .errors import OutputError, WhirlError
 from .jobs import MAX_JOBS, default_jobs
-from .kinds import PLOT_KINDS, CheckKind, RunStatus
+from .kinds import CheckKind, RunStatus
+from .plots.kinds import plot_kinds
 
 
 def _version() -> str:
@@ -448,7 +449,7 @@ def _formats(ctx: click.Context, param: click.Parameter, value: str) -> tuple[st
 @cli.command()
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--kind", "kinds", multiple=True,
-              type=click.Choice(PLOT_KINDS),
+              type=click.Choice(plot_kinds()),
               help="Plot kind (repeatable) [default: every kind the file has the data for]; "
                    "a kind it lacks the data for is an error.")
 @click.option("-o", "--output", "--output-dir", "output_dir",

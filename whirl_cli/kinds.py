@@ -1,5 +1,5 @@
-"""whirl's vocabulary of kinds that several stages name, each declared once here (no imports):
-the study schema, the command line and the drawing code read them from this module.
+"""whirl's vocabulary of kinds that several stages name, each declared once here (no imports
+of whirl's); plot kinds are registered in :mod:`whirl_cli.plots.kinds`.
 
 The enums' values are the words result files store and whirl prints: a value never changes.
 """
@@ -7,15 +7,6 @@ The enums' values are the words result files store and whirl prints: a value nev
 from __future__ import annotations
 
 from enum import StrEnum
-
-#: The plot kinds of a study's figures (``plots:`` in a study, ``whirl plot --kind``), in the
-#: order a result's figures are drawn.
-PLOT_KINDS = ("bifurcation", "linear", "root_locus", "damping_multiples", "projections",
-              "period", "phase", "boundary", "amplitude", "time_history", "hub_path", "law",
-              "poincare", "spectrum", "orbit_diagram")
-
-#: The plot kinds drawn from a continuation's ``explore:`` classifications.
-MOTION_KINDS = ("poincare", "spectrum", "orbit_diagram")
 
 
 class Word(StrEnum):

@@ -14,7 +14,7 @@ from matplotlib.contour import QuadContourSet
 from matplotlib.patches import Polygon
 
 from whirl_cli.errors import WhirlError
-from whirl_cli.plots import files
+from whirl_cli.plots import files, maps
 from whirl_cli.plots.diagrams import (
     bifurcation_diagram,
     period_plot,
@@ -933,7 +933,7 @@ def test_save_study_plots_boundary_ignores_grid_of_other_parameters(tmp_path, mo
         seen.append((boundary, grid, tuple(cases)))
         return _new_figure()
 
-    monkeypatch.setattr(files, "boundary_plot", fake)
+    monkeypatch.setattr(maps, "boundary_plot", fake)
     boundary = replace(make_boundary(), slices=())
     grid = replace(make_grid(), y_parameter="V")
     result = StudyResult("study", "classical", (), (), (), boundaries=(boundary,),

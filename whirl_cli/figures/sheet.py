@@ -30,7 +30,7 @@ from pydantic import (
 )
 
 from ..errors import StudyError
-from ..plots.panels import OVERLAY_KINDS, PANEL_KINDS
+from ..plots.kinds import overlay_kinds, panel_kinds
 from ..study.messages import _report, _translate
 from ..study.schema import (
     Boolean,
@@ -45,7 +45,7 @@ from ..study.schema import (
 )
 from ..study.source import _compose, _read_text, _Tree
 
-PanelKind = Literal[PANEL_KINDS]  # the kinds plots.panels.draw draws
+PanelKind = Literal[panel_kinds()]  # the kinds plots.panels.draw draws
 _FIGURE_RE = re.compile(r"\d+(\.\d+)*[a-z]?")
 _MAX_PANELS = 64
 PANEL_SIZE = (5.2, 4.2)
@@ -129,8 +129,8 @@ class PanelSpec(_Strict):
     def _one_source(self) -> PanelSpec:
         if (self.study is None) == (not self.overlay):
             _fail("give exactly one of `study` and `overlay`")
-        if self.overlay and self.kind not in OVERLAY_KINDS:
-            kinds = ", ".join(OVERLAY_KINDS[:-1]) + f" and {OVERLAY_KINDS[-1]}"
+        if self.overlay and self.kind not in overlay_kinds():
+            kinds = ", ".join(overlay_kinds()[:-1]) + f" and {overlay_kinds()[-1]}"
             _fail(f"only {kinds} panels can be overlaid")
         return self
 

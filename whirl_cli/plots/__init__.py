@@ -30,7 +30,10 @@ Modules, lowest first:
 * :mod:`~whirl_cli.plots.motion` -- Poincaré sections, frequencies and orbit diagrams of the
   motion classified by simulation at a continuation's ``explore:`` values;
 * :mod:`~whirl_cli.plots.files` -- a study's figures as named PNG files (axis limits, Hz, the
-  kinds a result has the data for).
+  kinds a result has the data for);
+* :mod:`~whirl_cli.plots.panels` -- any kind drawn onto a given Axes, overlays;
+* :mod:`~whirl_cli.plots.kinds` -- the registry of plot kinds (what each needs, the files it
+  writes, its panel), read by all of the above and by the command line and study schema.
 """
 
 #: The modules drawing imports (matplotlib's Figure and Agg canvas, about 0.7 s): what a caller

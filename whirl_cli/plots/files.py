@@ -15,22 +15,18 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import OutputError, WhirlError
-from ..kinds import MOTION_KINDS, PLOT_KINDS
 from ..output.guard import PLOT_CHARACTERS, plot_stem
-from ..results import Branch, ContinuationKind, ContinuationResult, PointType, StudyResult
+from ..results import Branch, ContinuationResult, PointType, StudyResult
 from .captions import Captions, Fixed, captions
-from .diagrams import bifurcation_diagram, period_plot, phase_plane, projections_figure
-from .freeplay import amplitude_diagram, has_amplitudes
 from .key import _PLOTTED_KINDS
-from .laws import law_plot, nonlinear_laws
-from .linear import damping_multiples_plot, linear_sweep_plot, root_locus_plot, sweep_datum
-from .maps import _oriented_grid, boundary_plot, overhang_diagram, slice_continuation
-from .motion import orbit_diagram, poincare_plot, spectrum_plot
-from .simulations import hub_path, time_history
+from .kinds import Figures, plot_kinds, registry
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
+
+PLOT_KINDS = plot_kinds()
+"""The kinds a study's figures are drawn in (:mod:`whirl_cli.plots.kinds`), in drawing order."""
 
 PHASE_ORBITS = 12
 """Most orbits a study's phase-plane figure draws (a long family stores one every 20 steps)."""
@@ -51,52 +47,12 @@ class View:
 
 def missing_data(result: StudyResult, kind: str) -> str:
     """What ``result`` lacks to draw plot ``kind`` (a sentence), or "" if it can draw it."""
-    one_parameter = [c for c in result.continuations if c.kind == ContinuationKind.ONE_PARAMETER]
-    if kind in ("bifurcation", "projections") and not one_parameter:
-        return "no one-parameter continuation"
-    if kind == "period" and not any(b.is_periodic for c in result.continuations
-                                    for b in c.branches):
-        return "no periodic branch (a continuation with periodic: true)"
-    if kind == "phase" and not any(b.is_periodic and b.orbits and len(b.state_names) >= 2
-                                   for c in result.continuations for b in c.branches):
-        return "no stored orbits on a periodic branch (periodic: true; orbits_at stores more)"
-    if kind in ("linear", "root_locus", "damping_multiples") and not result.linear_sweeps:
-        return "no linear sweep (linear.sweeps)"
-    if kind == "damping_multiples" and not _multiple_sweeps(result):
-        return "no linear sweep of a parameter with a non-zero datum (linear.sweeps)"
-    if kind == "boundary" and not result.boundaries and result.linear_grid is None:
-        return "no stability boundary (a two-parameter continuation) and no linear grid " \
-               "(linear.grid)"
-    if kind == "amplitude" and not any(has_amplitudes(c) for c in result.continuations):
-        return "no freeplay amplitudes (a periodic branch of a model with a freeplay law)"
-    if kind == "law" and not nonlinear_laws(result):
-        return "no nonlinear stiffness law (nonlinearity) in the stored study"
-    if kind in ("time_history", "hub_path") and not result.simulations:
-        return "no simulation (simulations:)"
-    if kind in MOTION_KINDS and not any(c.explorations for c in result.continuations):
-        return "no explored values (a one-parameter continuation with explore:)"
-    return ""
-
-
-def _datums(result: StudyResult) -> dict[str, float]:
-    """The datum of every parameter, for files whose sweeps do not store theirs: from the
-    file's parameter set, else (schema 1 files) from the model of the study stored with it."""
-    if result.parameters:
-        return {p.name: p.datum for p in result.parameters}
-    if not result.linear_sweeps:
-        return {}
-    return captions(result).datums
-
-
-def _multiple_sweeps(result: StudyResult) -> list:
-    """The linear sweeps that can be drawn against parameter / datum (a non-zero datum)."""
-    datums = _datums(result)
-    return [s for s in result.linear_sweeps if sweep_datum(s, datums) is not None]
+    return registry()[kind].missing(result)
 
 
 def available_kinds(result: StudyResult) -> tuple[str, ...]:
     """The kinds of :data:`PLOT_KINDS` that ``result`` has the data for, in that order."""
-    return tuple(kind for kind in PLOT_KINDS if not missing_data(result, kind))
+    return tuple(kind for kind in plot_kinds() if not missing_data(result, kind))
 
 
 def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path, stem: str,
@@ -106,47 +62,10 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
     """Write a study's figures as PNG files into ``out_dir`` (and each also in the other
     ``formats`` of :data:`FORMATS`, beside it: ``<name>.pdf``); return the paths, sorted.
 
-    ``kinds`` (any of :data:`PLOT_KINDS`):
-
-    * "bifurcation" -> ``<stem>_<continuation>_bifurcation.png`` per one-parameter continuation
-      (``state`` vs the principal parameter, angles in degrees; ``state`` None: the first
-      state, i.e. the model's first degree of freedom);
-    * "projections" -> ``<stem>_<continuation>_projections.png`` per one-parameter continuation
-      (:func:`projections_figure`);
-    * "period" -> ``<stem>_<continuation>_period.png`` per continuation with a periodic branch
-      (:func:`period_plot`);
-    * "phase" -> ``<stem>_<continuation>_<branch>_phase.png`` per periodic branch with stored
-      orbits (:func:`phase_plane` of the branch's first two states, i.e. the model's first two
-      dofs: psi vs theta for the classical model; at most :data:`PHASE_ORBITS` orbits, those
-      stored at ``orbits_at`` values first, the others spread along the branch);
-    * "linear" -> ``<stem>_linear_<parameter>.png`` per linear sweep;
-    * "root_locus" -> ``<stem>_root_locus_<parameter>.png`` per linear sweep
-      (:func:`~whirl_cli.plots.linear.root_locus_plot`);
-    * "damping_multiples" -> ``<stem>_damping_multiples.png``, one for all the linear sweeps
-      of a parameter with a non-zero datum, given in multiples or not
-      (:func:`~whirl_cli.plots.linear.damping_multiples_plot`: the least-damped mode against
-      parameter / datum);
-    * "amplitude" -> ``<stem>_<continuation>_amplitude.png`` per continuation with freeplay
-      amplitudes (:func:`~whirl_cli.plots.freeplay.amplitude_diagram`: A/delta, the
-      describing-function estimate dashed);
-    * "time_history" -> ``<stem>_<simulation>_time_history.png`` per simulation
-      (:func:`~whirl_cli.plots.simulations.time_history`: every dof against time);
-    * "hub_path" -> ``<stem>_<simulation>_hub_path.png`` per simulation
-      (:func:`~whirl_cli.plots.simulations.hub_path`);
-    * "law" -> ``<stem>_law_<dof>.png`` per dof with a nonlinear law
-      (:func:`~whirl_cli.plots.laws.law_plot`: the law as continued, exact, and K x);
-    * "poincare", "spectrum", "orbit_diagram" -> ``<stem>_<continuation>_<kind>.png`` per
-      continuation with ``explore:`` classifications (:mod:`~whirl_cli.plots.motion`: the
-      Poincaré sections of the first two states, the frequencies found against the
-      parameter, the section's values of ``state`` (else the first dof) over the bifurcation
-      diagram);
-    * "boundary" -> per boundary of ``result.boundaries``: ``<stem>_<boundary>_boundary.png``
-      (:func:`boundary_plot` with ``result.linear_grid`` if it is over the same parameters, the
-      slices as cases) and ``<stem>_<boundary>_slice_<k>_overhang.png`` per slice k
-      (:func:`overhang_diagram` of the two-parameter continuation named like the boundary, or
-      of no branches if there is none; ``state`` as for "bifurcation"); without boundaries but
-      with a linear grid,
-      ``<stem>_linear_grid.png`` (the grid alone).
+    ``kinds``: any of :data:`PLOT_KINDS`; each kind's files are those its
+    :class:`~whirl_cli.plots.kinds.PlotKind` declares (``figures``; docs/plots.md lists
+    them), e.g. ``<stem>_<continuation>_bifurcation.png`` per one-parameter continuation
+    (``state``: the state drawn, None: the first state, i.e. the model's first dof).
 
     Titles name the study and the parameters it fixes (:mod:`~whirl_cli.plots.captions`,
     from the study stored with ``result``), slices by the study's labels; ``view`` sets axis
@@ -251,9 +170,9 @@ def _without_artefacts(result: StudyResult) -> StudyResult:
 def _named_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: str | None,
                 view: View = View()):
     """(unique filesystem-safe file name, figure factory) pairs of the requested kinds."""
-    unknown = set(kinds) - set(PLOT_KINDS)
+    unknown = set(kinds) - set(plot_kinds())
     if unknown:
-        raise WhirlError(f"unknown plot kind(s) {sorted(unknown)}; choose from {PLOT_KINDS}")
+        raise WhirlError(f"unknown plot kind(s) {sorted(unknown)}; choose from {plot_kinds()}")
     taken: list[Path] = []
     jobs = []
     for name, make in _figure_jobs(result, kinds, stem, state, view):
@@ -269,127 +188,12 @@ def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str,
     caption = cache(lambda: captions(result))  # read the stored study once, when drawing
     if not view.artefacts:
         result = _without_artefacts(result)
-    jobs = []
-    if "bifurcation" in kinds:
-        for continuation in result.continuations:
-            if continuation.kind == ContinuationKind.ONE_PARAMETER:
-                chosen = _state_for(continuation, state)
-                jobs.append((f"{stem}_{continuation.name}_bifurcation.png",
-                             lambda c=continuation, s=chosen: bifurcation_diagram(
-                                 c, s, title=_title(caption, c))))
-    if "projections" in kinds:
-        for continuation in result.continuations:
-            if continuation.kind == ContinuationKind.ONE_PARAMETER:
-                jobs.append((f"{stem}_{continuation.name}_projections.png",
-                             lambda c=continuation: projections_figure(
-                                 c, title=_title(caption, c))))
-    if "period" in kinds:
-        for continuation in result.continuations:
-            if any(b.is_periodic for b in continuation.branches):
-                jobs.append((f"{stem}_{continuation.name}_period.png",
-                             lambda c=continuation: period_plot(c, title=_title(caption, c))))
-    if "phase" in kinds:
-        for continuation in result.continuations:
-            for branch in continuation.branches:
-                if branch.is_periodic and branch.orbits and len(branch.state_names) >= 2:
-                    jobs.append((f"{stem}_{continuation.name}_{branch.name}_phase.png",
-                                 lambda b=branch, c=continuation: phase_plane(
-                                     b, labels=phase_labels(b),
-                                     title=f"{_title(caption, c)}\n{b.name}")))
-    if "linear" in kinds:
-        for sweep in result.linear_sweeps:
-            jobs.append((f"{stem}_linear_{sweep.parameter}.png",
-                         lambda s=sweep: linear_sweep_plot(
-                             s, hz=view.hz, title=caption().title({s.parameter}))))
-    if "root_locus" in kinds:
-        for sweep in result.linear_sweeps:
-            jobs.append((f"{stem}_root_locus_{sweep.parameter}.png",
-                         lambda s=sweep: root_locus_plot(s, title=caption().title(
-                             {s.parameter}))))
-    if "damping_multiples" in kinds:
-        chosen = _multiple_sweeps(result)
-        if chosen:
-            jobs.append((f"{stem}_damping_multiples.png",
-                         lambda c=tuple(chosen): damping_multiples_plot(
-                             c, _datums(result), hz=view.hz, title=caption().title(
-                                 {s.parameter for s in c}))))
-    if "boundary" in kinds:
-        jobs += _boundary_jobs(result, stem, state, caption, view)
-    if "amplitude" in kinds:
-        for continuation in result.continuations:
-            if has_amplitudes(continuation):
-                jobs.append((f"{stem}_{continuation.name}_amplitude.png",
-                             lambda c=continuation: amplitude_diagram(c)))
-    if "law" in kinds:
-        for model, values, dof in nonlinear_laws(result):
-            jobs.append((f"{stem}_law_{dof}.png",
-                         lambda m=model, v=values, d=dof: law_plot(m, v, d)))
-    for kind, draw in (("time_history", time_history), ("hub_path", hub_path)):
-        if kind in kinds:
-            for found in result.simulations:
-                jobs.append((f"{stem}_{found.name}_{kind}.png",
-                             lambda s=found, draw=draw: draw(
-                                 s, title=caption().simulation_title(s))))
-    for kind in (k for k in MOTION_KINDS if k in kinds):
-        for continuation in result.continuations:
-            if continuation.explorations:
-                jobs.append((f"{stem}_{continuation.name}_{kind}.png",
-                             lambda c=continuation, kind=kind: _motion_figure(
-                                 kind, c, state, _title(caption, c))))
-    return jobs
+    figures = Figures(result, stem, state, view, caption)
+    return [job for name, kind in registry().items() if name in kinds
+            for job in kind.figures(figures)]
 
 
-def _motion_figure(kind: str, continuation: ContinuationResult, state: str | None,
-                   title: str) -> Figure:
-    """The figure of a :data:`MOTION_KINDS` kind (``state``: the orbit diagram's, if the
-    explorations have it)."""
-    if kind == "poincare":
-        return poincare_plot(continuation, title=title)
-    if kind == "spectrum":
-        return spectrum_plot(continuation, title=title)
-    names = continuation.explorations[0].state_names
-    return orbit_diagram(continuation, state if state in names else None, title=title)
-
-
-def _title(caption: Callable[[], Captions], continuation: ContinuationResult) -> str:
-    """The study's title over the parameters ``continuation`` does not vary."""
-    varied = {name for b in continuation.branches for name in b.parameter_names}
-    return caption().title(varied)
-
-
-def _boundary_jobs(result: StudyResult, stem: str, state: str | None,
-                   caption: Callable[[], Captions], view: View = View()):
-    """(file name, figure factory) pairs of the "boundary" kind."""
-    grid = result.linear_grid
-    if not result.boundaries:
-        if grid is None:
-            return []
-        return [(f"{stem}_linear_grid.png", lambda: boundary_plot(
-            None, grid, title=caption().title({grid.x_parameter, grid.y_parameter}),
-            xlim=view.xlim, ylim=view.ylim))]
-    jobs = []
-    for boundary in result.boundaries:
-        matched = None if grid is None else _oriented_grid(grid, boundary.parameter_names)
-        jobs.append((f"{stem}_{boundary.name}_boundary.png",
-                     lambda b=boundary, g=matched: boundary_plot(
-                         b, g, cases=b.slices, case_labels=caption().case_labels(b),
-                         title=caption().title(b.parameter_names),
-                         xlim=view.xlim, ylim=view.ylim)))
-        continuation = next((c for c in result.continuations if c.name == boundary.name
-                             and c.kind == ContinuationKind.TWO_PARAMETER),
-                            ContinuationResult(boundary.name, ContinuationKind.ONE_PARAMETER,
-                                               (), ()))
-        for k, value in enumerate(boundary.slices):
-            chosen = (_state_for(slice_continuation(continuation, k), state)
-                      if continuation.kind == ContinuationKind.TWO_PARAMETER else state)
-            jobs.append((f"{stem}_{boundary.name}_slice_{k}_overhang.png",
-                         lambda c=continuation, b=boundary, v=value, s=chosen, k=k:
-                         overhang_diagram(c, b, v, state=s,
-                                          title=_slice_title(caption(), b, k, v))))
-    return jobs
-
-
-def _slice_title(caption: Captions, boundary, k: int, value: float) -> str:
+def slice_title(caption: Captions, boundary, k: int, value: float) -> str:
     """``"<study title>\n<slice label>: <second parameter> = <value> <unit>"``."""
     fixed = Fixed(boundary.parameter_names[1], float(value), boundary.parameter_units[1])
     return (f"{caption.title(boundary.parameter_names)}\n"
@@ -412,7 +216,7 @@ def phase_labels(branch: Branch, most: int = PHASE_ORBITS) -> list[int]:
     return [o.label for o in orbits if id(o) in chosen]
 
 
-def _state_for(continuation: ContinuationResult, state: str | None) -> str | None:
+def state_for(continuation: ContinuationResult, state: str | None) -> str | None:
     """``state`` if every plotted branch has it, else None (the first state)."""
     branches = [b for b in continuation.branches if b.kind in _PLOTTED_KINDS]
     if state is None or not branches or all(state in b.state_names for b in branches):

@@ -9,6 +9,7 @@ validates (:mod:`whirl_cli.study.resolve`).
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import math
 import operator
@@ -23,13 +24,15 @@ from pydantic import (
     ConfigDict,
     Field,
     PrivateAttr,
+    create_model,
     model_validator,
 )
 from pydantic_core import PydanticCustomError
 
 from ..continuation.numerics import Numerics
-from ..kinds import PLOT_KINDS
 from ..models import FAMILIES, Model, is_known, is_model_file
+from ..models.laws import LAWS, POLYNOMIAL, Coefficient, Law
+from ..plots.kinds import plot_kinds
 from .resolve import Names, _is_number, _resolved, names_of
 
 NAME_MAX = 64
@@ -187,61 +190,59 @@ class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
-_TYPE_DOC = (
-    "Stiffness law: `linear` (linear springs; the polynomial law with K2 = K3 = 0), "
-    "`polynomial` (restoring force K x + K2 x^3 + K3 x^5 on `dof`, K the dof's linear "
-    "stiffness, e.g. K_theta; x in the dof's unit, rad for angles) or `freeplay` (whirl's "
-    "law: a deadband of half-gap `delta`, stiffness `K_in` inside and `K_out` outside, "
-    "smoothed over `epsilon` by ln cosh)."
-)
+_LINEAR_DOC = "linear springs; the polynomial law with K2 = K3 = 0"
 _DOF_DOC = (
     "Degree of freedom the law acts on (classical: `theta` pitch, `psi` yaw); a dof has at most "
     "one law. Unset (a single law only): the model's first dof (classical: `theta`)."
 )
 
 
+def _type_doc() -> str:
+    """The ``type`` key described: ``linear`` and every law of :data:`LAWS`."""
+    kinds = [f"`linear` ({_LINEAR_DOC})"] + [f"`{law.name}` ({law.study_doc})"
+                                           for law in LAWS.values()]
+    return f"Stiffness law: {', '.join(kinds[:-1])} or {kinds[-1]}."
+
+
 class Linear(_Strict):
     """Linear springs: the polynomial law with K2 = K3 = 0 (one AUTO executable for both)."""
 
-    type: Literal["linear"] = Field(description=_TYPE_DOC)
+    type: Literal["linear"] = Field(description=_type_doc())
     dof: Text | None = Field(None, description=_DOF_DOC)
 
 
-class Polynomial(_Strict):
-    """Restoring force K x + K2 x^3 + K3 x^5 on one degree of freedom."""
-
-    type: Literal["polynomial"] = Field(description=_TYPE_DOC)
-    dof: Text | None = Field(None, description=_DOF_DOC)
-    K2: Number = Field(0.0, description="Cubic coefficient, force per unit^3 (classical: "
-                       "N m/rad^3); leaves the study as `K2_<dof>`.")
-    K3: Number = Field(0.0, description="Quintic coefficient, force per unit^5 (classical: "
-                       "N m/rad^5); leaves the study as `K3_<dof>`.")
-
-
-class Freeplay(_Strict):
-    """whirl's freeplay law on one degree of freedom (see :mod:`whirl_cli.models.laws.freeplay`).
-
-    After validation ``epsilon`` is filled (delta/100 when the study gives none); ``K_out``
-    unset leaves the dof's stiffness at its datum."""
-
-    type: Literal["freeplay"] = Field(description=_TYPE_DOC)
-    dof: Text | None = Field(None, description=_DOF_DOC)
-    delta: Number = Field(description="Half-gap of the deadband, in the dof's unit (rad for "
-                          "angles), > 0; leaves the study as `delta_<dof>`.")
-    K_out: Number | None = Field(
-        None, description="Stiffness outside the gap, force per unit (classical: N m/rad), "
-        "> `K_in`: it is the dof's linear stiffness parameter (`K_theta` on pitch; also "
-        "`K_out_<dof>`), so results, continuations and the linear model name it so; "
-        "`parameters` may not set it beside the law. Unset: that parameter's datum.")
-    K_in: Number = Field(0.0, description="Stiffness inside the gap, force per unit, >= 0; "
-                         "leaves the study as `K_in_<dof>`.")
-    epsilon: Number | None = Field(
-        None, description="Smoothing width, in the dof's unit, > 0 and < `delta` (the "
-        "smoothed law's largest error, (K_out - K_in) epsilon ln2 / 2, is at x = +-delta); "
-        "leaves the study as `epsilon_<dof>`. Unset: delta/100.")
+def _coefficient_field(law: Law, coefficient: Coefficient) -> tuple[Any, Any]:
+    """(type, field) of a law coefficient's key in a study's law block."""
+    doc = (f"{coefficient.doc}; leaves the study as "
+           f"`{law.parameter_name(coefficient.key, '<dof>')}`.")
+    if coefficient.required:
+        return Number, Field(description=doc)
+    if coefficient.unset:
+        return Number | None, Field(None, description=f"{doc} Unset: {coefficient.unset}.")
+    return Number, Field(coefficient.default, description=doc)
 
 
-LawBlock = Annotated[Linear | Polynomial | Freeplay, Field(discriminator="type")]
+def _law_block(law: Law) -> type[_Strict]:
+    """The schema of a study's block of ``law``: ``type``, ``dof``, the coefficients a study
+    must give, the law's own key for the dof's stiffness (if it has one), the others."""
+    stiffness = {} if law.stiffness_key is None else {
+        law.stiffness_key: (Number | None, Field(None, description=law.stiffness_doc))}
+    fields = {"type": (Literal[law.name], Field(description=_type_doc())),
+              "dof": (Text | None, Field(None, description=_DOF_DOC)),
+              **{c.key: _coefficient_field(law, c) for c in law.coefficients if c.required},
+              **stiffness,
+              **{c.key: _coefficient_field(law, c) for c in law.coefficients
+                 if not c.required}}
+    return create_model(law.name.capitalize(), __base__=_Strict, __module__=__name__,
+                        __doc__=law.description, **fields)
+
+
+#: The schema of a study's block of each law of :data:`LAWS`, by ``type``.
+LAW_BLOCKS: dict[str, type[_Strict]] = {name: _law_block(law) for name, law in LAWS.items()}
+Polynomial = LAW_BLOCKS[POLYNOMIAL.name]
+
+LawBlock = Annotated[functools.reduce(operator.or_, LAW_BLOCKS.values(), Linear),
+                     Field(discriminator="type")]
 
 
 def _as_laws(value: Any) -> Any:
@@ -441,7 +442,7 @@ class TwoParameterContinuation(_Strict):
         return tuple(s.label for s in self.slices)
 
 
-PlotKind = Literal[PLOT_KINDS]
+PlotKind = Literal[plot_kinds()]
 Continuation = Annotated[OneParameterContinuation | TwoParameterContinuation,
                         Field(discriminator="type")]
 
@@ -680,7 +681,7 @@ class Study(_Strict):
         return self._path
 
     @property
-    def laws(self) -> tuple[Linear | Polynomial | Freeplay, ...]:
+    def laws(self) -> tuple[Any, ...]:
         """The law blocks (after validation every one names its dof)."""
         return self.nonlinearity
 

@@ -9,7 +9,8 @@ at once. A law may name the dof's stiffness itself under a key of its own (freep
 ``K_out``: the stiffness outside the gap is K_theta on pitch).
 
 Laws are data plus sympy functions (:class:`~whirl_cli.models.laws.base.Law`); :data:`LAWS`
-is the registry by study ``type``:
+is the registry by study ``type``, of the laws declared here and in the modules of this package
+(a new smooth law is a new module; its coefficients make its block of the study schema):
 
 * ``polynomial`` (here): K x + K2 x^3 + K3 x^5;
 * ``freeplay`` (:mod:`~whirl_cli.models.laws.freeplay`): whirl's smoothed deadband
@@ -17,6 +18,9 @@ is the registry by study ``type``:
 """
 
 from __future__ import annotations
+
+import importlib
+import os
 
 from .base import Coefficient, Law, LawProblem
 from .freeplay import FREEPLAY
@@ -31,12 +35,31 @@ def _polynomial(x, k, c):
 POLYNOMIAL = Law(
     "polynomial", "poly",
     "M(x) = K x + K2 x^3 + K3 x^5 (K: the dof's linear stiffness, e.g. K_theta; x in its unit)",
-    (Coefficient("K2", 0.0, 3, "cubic coefficient"),
-     Coefficient("K3", 0.0, 5, "quintic coefficient")),
+    (Coefficient("K2", 0.0, 3, "cubic coefficient",
+                 doc="Cubic coefficient, force per unit^3 (classical: N m/rad^3)"),
+     Coefficient("K3", 0.0, 5, "quintic coefficient",
+                 doc="Quintic coefficient, force per unit^5 (classical: N m/rad^5)")),
     _polynomial,
     lambda values: values.get("K2", 0.0) == 0.0 and values.get("K3", 0.0) == 0.0,
+    study_doc="restoring force K x + K2 x^3 + K3 x^5 on `dof`, K the dof's linear stiffness, "
+    "e.g. K_theta; x in the dof's unit, rad for angles",
 )
 
 #: Laws by study ``type``. ``linear`` is no law of its own: a dof with linear springs is the
 #: polynomial law with K2 = K3 = 0, so both share one compiled AUTO program.
-LAWS: dict[str, Law] = {law.name: law for law in (POLYNOMIAL, FREEPLAY)}
+def _declared() -> dict[str, Law]:
+    """The laws declared here and in this package's modules, by name: this module's first,
+    then module by module in name order."""
+    found: dict[str, Law] = {POLYNOMIAL.name: POLYNOMIAL}
+    names = sorted({entry.name.removesuffix(".py") for folder in __path__
+                    for entry in os.scandir(folder)
+                    if entry.name.endswith(".py") and not entry.name.startswith("_")})
+    for name in names:
+        module = importlib.import_module(f"{__name__}.{name}")
+        for value in vars(module).values():
+            if isinstance(value, Law) and found.setdefault(value.name, value) is not value:
+                raise ValueError(f"stiffness law {value.name!r} declared twice")
+    return found
+
+
+LAWS: dict[str, Law] = _declared()

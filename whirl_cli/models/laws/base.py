@@ -25,7 +25,11 @@ class Coefficient:
     """A law coefficient as a study writes it (``key``), with its datum, its unit and its
     description. The unit is a force per ``power`` of the dof's unit (K2 multiplies x^3:
     ``power`` 3; ``power`` 1 is a stiffness), or the dof's own unit if ``in_dof_unit`` (a
-    length or angle of the law, e.g. freeplay's half-gap)."""
+    length or angle of the law, e.g. freeplay's half-gap).
+
+    Its key in a study's law block (the schema is made from these): ``doc`` describes it,
+    ``required``: a study must give it; ``unset``: a study may leave it out, and it then
+    becomes what this says (the law's ``derived_defaults``); else it defaults to ``default``."""
 
     key: str
     default: float
@@ -33,6 +37,9 @@ class Coefficient:
     description: str
     bounds: Bounds = Bounds()
     in_dof_unit: bool = False
+    doc: str = ""
+    required: bool = False
+    unset: str = ""
 
 
 @dataclass(frozen=True)
@@ -62,6 +69,9 @@ class Law:
 
     ``numeric(x, k, c)``: the same restoring force on numpy arrays and floats (to draw the
     law), where ``moment`` needs sympy-only functions; None: ``moment`` itself takes arrays.
+
+    ``study_doc``: the law in a study's ``type`` description; ``stiffness_doc``: the study key
+    ``stiffness_key`` described (the rest of the law's study keys are its coefficients).
     :meth:`force` and :meth:`exact_force` evaluate the law and its exact form numerically.
     """
 
@@ -78,6 +88,8 @@ class Law:
     breakpoints: Callable[[Mapping[str, float]], tuple[float, ...]] | None = None
     smoothing_key: str | None = None
     numeric: Callable[..., object] | None = None
+    study_doc: str = ""
+    stiffness_doc: str = ""
 
     def force(self, x, k: float, c: Mapping[str, float]):
         """The restoring force at ``x`` (array, the dof's unit) for stiffness ``k`` and

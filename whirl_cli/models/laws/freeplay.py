@@ -148,10 +148,16 @@ FREEPLAY = Law(
     "freeplay", "fp",
     "whirl's law (models.md 7): deadband of half-gap delta, stiffness K_in inside and K_out "
     "(the dof's linear stiffness, e.g. K_theta) outside, smoothed over epsilon by ln cosh",
-    (Coefficient("delta", 0.01, 0, "half-gap", bounds=POSITIVE, in_dof_unit=True),
-     Coefficient("K_in", 0.0, 1, "stiffness inside the gap", bounds=NON_NEGATIVE),
+    (Coefficient("delta", 0.01, 0, "half-gap", bounds=POSITIVE, in_dof_unit=True,
+                 doc="Half-gap of the deadband, in the dof's unit (rad for angles), > 0",
+                 required=True),
+     Coefficient("K_in", 0.0, 1, "stiffness inside the gap", bounds=NON_NEGATIVE,
+                 doc="Stiffness inside the gap, force per unit, >= 0"),
      Coefficient("epsilon", 0.01 * EPSILON_FRACTION, 0, "smoothing width", bounds=POSITIVE,
-                 in_dof_unit=True)),
+                 in_dof_unit=True,
+                 doc="Smoothing width, in the dof's unit, > 0 and < `delta` (the smoothed "
+                 "law's largest error, (K_out - K_in) epsilon ln2 / 2, is at x = +-delta)",
+                 unset=f"delta/{round(1 / EPSILON_FRACTION)}")),
     _moment,
     lambda values: values.get("K_in", 0.0) == values.get("K_out"),
     stiffness_key="K_out",
@@ -161,4 +167,10 @@ FREEPLAY = Law(
     breakpoints=_breakpoints,
     smoothing_key="epsilon",
     numeric=_moment_numeric,
+    study_doc="whirl's law: a deadband of half-gap `delta`, stiffness `K_in` inside and "
+    "`K_out` outside, smoothed over `epsilon` by ln cosh",
+    stiffness_doc="Stiffness outside the gap, force per unit (classical: N m/rad), > `K_in`: "
+    "it is the dof's linear stiffness parameter (`K_theta` on pitch; also `K_out_<dof>`), so "
+    "results, continuations and the linear model name it so; `parameters` may not set it "
+    "beside the law. Unset: that parameter's datum.",
 )
