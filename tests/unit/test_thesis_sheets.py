@@ -63,7 +63,98 @@ def test_3_13_and_3_15_differ_in_content():
     assert not any("locus" in label for label in labels)
 
 
-@pytest.mark.parametrize("number", ["3.13"])
+@pytest.mark.parametrize("number", ["3.12", "3.13"])
 def test_linear_sheets_are_pixel_identical_run_to_run(number):
     first = rendered_formats(drawn(number), ("png",), 80)["png"]
     assert rendered_formats(drawn(number), ("png",), 80)["png"] == first
+
+
+def _bisect(f, low: float, high: float) -> float:
+    """The root of ``f`` in [low, high] (a sign change or a change of value at the ends)."""
+    a = f(low)
+    same = (lambda u: u == a) if isinstance(a, int) else (lambda u: u * a > 0)
+    for _ in range(60):
+        middle = 0.5 * (low + high)
+        if same(f(middle)):
+            low = middle
+        else:
+            high = middle
+    return 0.5 * (low + high)
+
+
+def _roots(k_theta: float) -> np.ndarray:
+    return np.linalg.eigvals(linear_matrix({"K_theta": k_theta, "K_psi": 0.3}))
+
+
+def _lowest_pair(k_theta: float) -> complex:
+    """The complex root of smallest positive Im (the backward whirl pair's upper root)."""
+    roots = _roots(k_theta)
+    upper = roots[roots.imag > 1e-6]
+    return upper[np.argmin(upper.imag)]
+
+
+def _real_count(k_theta: float) -> int:
+    return int(np.sum(np.abs(_roots(k_theta).imag) <= 1e-9))
+
+
+def _changes(f, low: float, high: float) -> list[float]:
+    """Every point of [low, high] where ``f`` changes sign (or value, integer ``f``)."""
+    ks = np.linspace(low, high, 401)
+    found = []
+    for a, b in zip(ks[:-1], ks[1:], strict=True):
+        fa, fb = f(a), f(b)
+        if (fa != fb) if isinstance(fa, int) else fa * fb < 0:
+            found.append(_bisect(f, a, b))
+    return found
+
+
+def _marked(ax, marker: str) -> np.ndarray:
+    lines = [line for line in ax.get_lines() if line.get_marker() == marker]
+    assert len(lines) == 1
+    return np.asarray(lines[0].get_xydata(), dtype=float)
+
+
+def test_3_12_zooms_on_the_backward_pair_crossings_and_marks_them():
+    figure = drawn("3.12")
+    ax = figure.axes[0]
+    (zoom,) = ax.child_axes
+    # where the backward pair crosses the imaginary axis and the real roots coalesce, from
+    # numpy's eigenvalues of the model written out apart from whirl
+    has_pair = [k for k in np.linspace(-0.3, 0.5, 801) if _real_count(k) < 2]
+    crossings = [(k, _lowest_pair(k).imag) for k in
+                 _changes(lambda k: float(_lowest_pair(k).real), min(has_pair), 0.5)]
+    assert len(crossings) == 2
+    (coalescence,) = _changes(_real_count, -0.3, 0.5)
+    meeting = _lowest_pair(coalescence + 1e-9).real
+    for axes in (ax, zoom):
+        squares = _marked(axes, "s")
+        assert len(squares) == len(crossings)
+        for (x, y), (_, im) in zip(sorted(squares.tolist(), key=lambda p: p[1]),
+                                   sorted(crossings, key=lambda c: c[1]), strict=True):
+            assert x == 0.0 and y == pytest.approx(im, abs=0.05)
+        ((x, y),) = _marked(axes, "D")
+        assert y == 0.0 and x == pytest.approx(meeting, abs=0.1)
+    (left, right), (bottom, top) = zoom.get_xlim(), zoom.get_ylim()
+    assert left < 0.0 < right and left > -2.0 and right < 2.0  # a zoom on the axis
+    for _, im in crossings:
+        assert bottom < im < top
+    assert left < meeting < right and bottom < 0.0 < top
+
+
+def test_3_12_arrows_point_the_way_k_theta_increases_and_the_axes_lie_under_the_roots():
+    figure = drawn("3.12")
+    ax = figure.axes[0]
+    for axes in (ax, *ax.child_axes):
+        arrows = [t for t in axes.texts if getattr(t, "arrow_patch", None) is not None]
+        assert arrows
+        for arrow in arrows:
+            tail, head = np.asarray(arrow.xyann), np.asarray(arrow.xy)
+            ks = np.linspace(-0.3, 0.5, 321)
+            nearest = [ks[np.argmin([np.min(np.abs(_roots(k) - complex(*p))) for k in ks])]
+                       for p in (tail, head)]
+            assert nearest[1] > nearest[0]
+        lines = [line for line in axes.get_lines() if line.get_label().endswith("axis")]
+        assert len(lines) == 2
+        assert max(line.get_zorder() for line in lines) < min(
+            c.get_zorder() for c in axes.collections)
+    assert any("increasing" in t.get_text() for t in ax.texts)
