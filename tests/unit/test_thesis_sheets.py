@@ -63,7 +63,7 @@ def test_3_13_and_3_15_differ_in_content():
     assert not any("locus" in label for label in labels)
 
 
-@pytest.mark.parametrize("number", ["3.12", "3.13"])
+@pytest.mark.parametrize("number", ["3.7", "3.8", "3.12", "3.13"])
 def test_linear_sheets_are_pixel_identical_run_to_run(number):
     first = rendered_formats(drawn(number), ("png",), 80)["png"]
     assert rendered_formats(drawn(number), ("png",), 80)["png"] == first
@@ -158,3 +158,80 @@ def test_3_12_arrows_point_the_way_k_theta_increases_and_the_axes_lie_under_the_
         assert max(line.get_zorder() for line in lines) < min(
             c.get_zorder() for c in axes.collections)
     assert any("increasing" in t.get_text() for t in ax.texts)
+
+
+def _mode_sense(values: dict, highest: bool) -> int:
+    """+1 (counterclockwise) or -1: the sense in which the hub, (y, z) = (-psi, -theta),
+    turns in the plane drawn y right, z up, for the lower (or ``highest``) oscillatory mode
+    of the model written out, from its eigenvector over one period."""
+    roots, vectors = np.linalg.eig(linear_matrix(values))
+    upper = np.flatnonzero(roots.imag > 1e-6)
+    k = upper[np.argmax(roots[upper].imag)] if highest else upper[np.argmin(roots[upper].imag)]
+    t = np.linspace(0.0, 2 * np.pi / roots[k].imag, 400, endpoint=False)
+    wave = np.exp(1j * roots[k].imag * t)
+    y, z = np.real(-vectors[1, k] * wave), np.real(-vectors[0, k] * wave)
+    return int(np.sign(np.sum(y * np.roll(z, -1) - np.roll(y, -1) * z)))
+
+
+def _spin_sense() -> int:
+    """The sense of the mode whose frequency rises with the spin Omega (forward whirl turns
+    with the spin)."""
+    def frequencies(omega):
+        roots = np.linalg.eigvals(linear_matrix({"V": 7.8, "Omega": omega}))
+        return np.sort(roots.imag[roots.imag > 1e-6])
+    low, high = frequencies(40.0), frequencies(44.0)
+    rising_is_highest = high[-1] > low[-1]
+    return _mode_sense({"V": 7.8}, highest=rising_is_highest)
+
+
+def _arrow_sense(arrow) -> int:
+    (ay, az), (by, bz) = arrow._posA_posB  # tail, head in data coordinates (hub plane)
+    return int(np.sign(ay * bz - az * by))
+
+
+def _arrows(ax) -> dict:
+    return {p.get_gid(): p for p in ax.patches if p.get_gid() in ("whirl", "spin")}
+
+
+def test_3_8_hub_paths_carry_whirl_and_spin_arrows():
+    figure = drawn("3.8")
+    panels = [ax for ax in figure.axes if ax.get_xlabel().startswith("hub y")]
+    assert len(panels) == 2
+    spin = _spin_sense()
+    growing = _mode_sense({"V": 7.8}, highest=False)  # the backward mode flutters here
+    assert growing == -spin
+    for ax in panels:
+        arrows = _arrows(ax)
+        assert set(arrows) == {"whirl", "spin"}
+        assert _arrow_sense(arrows["spin"]) == spin
+        assert _arrow_sense(arrows["whirl"]) == growing
+        assert any(t.get_text() == "whirl (BW)" for t in ax.texts)
+
+
+def test_3_7_is_snapshots_of_one_whirl_cycle_and_envelopes():
+    figure = drawn("3.7")
+    (whirl,) = [ax for ax in figure.axes if ax.get_xlabel().startswith("hub y")]
+    dots = [line for line in whirl.get_lines() if line.get_gid() == "snapshot"]
+    assert len(dots) == 8
+    angles = np.unwrap([np.arctan2(*line.get_xydata()[0][::-1]) for line in dots])
+    steps = np.degrees(np.diff(angles))
+    sense = _mode_sense({"V": 7.8}, highest=False)
+    np.testing.assert_allclose(steps, sense * 45.0, atol=8.0)  # one cycle, eight steps
+    assert _arrow_sense(_arrows(whirl)["whirl"]) == sense
+    assert _arrow_sense(_arrows(whirl)["spin"]) == _spin_sense()
+    histories = [ax for ax in figure.axes if ax.get_xlabel() == "t [s]" or ax.get_ylabel()
+                 in ("$\\theta$ [deg]", "$\\psi$ [deg]")]
+    assert len(histories) == 2
+    for ax in histories:  # the 60 s history as its envelope, not a band of 300 cycles
+        lines = [line for line in ax.get_lines() if len(line.get_xdata()) > 2]
+        assert len(lines) == 2 and all(len(line.get_xdata()) < 1000 for line in lines)
+        upper = max(lines, key=lambda line: np.mean(line.get_ydata()))
+        growth = np.interp([30.0, 59.0], upper.get_xdata(), upper.get_ydata())
+        assert growth[1] / growth[0] == pytest.approx(np.exp(29.0 * _growth_rate()), rel=0.05)
+
+
+def _growth_rate() -> float:
+    """Re lambda of the backward mode at V = 7.8 m/s [1/s]."""
+    roots = np.linalg.eigvals(linear_matrix({"V": 7.8}))
+    upper = roots[roots.imag > 1e-6]
+    return float(upper[np.argmin(upper.imag)].real)

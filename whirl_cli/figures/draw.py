@@ -14,6 +14,7 @@ from ..errors import WhirlError
 from ..plots.key import _new_figure
 from ..plots.panels import PanelChoice, draw, draw_overlay
 from ..results import StudyResult
+from .extra import SHEET_PANELS
 from .sheet import PanelSpec, Sheet
 
 if TYPE_CHECKING:
@@ -97,7 +98,9 @@ def _draw_panel(sheet: Sheet, panel: PanelSpec, results: Mapping[Path, StudyResu
                          state=panel.state, sweep=panel.sweep, slice=panel.slice,
                          orbits=panel.orbits, simulation=panel.simulation, hz=panel.hz,
                          title=panel.title, cuts=panel.cuts)
-    if panel.overlay:
+    if panel.kind in SHEET_PANELS:
+        SHEET_PANELS[panel.kind](results[sheet.resolve(panel.study)], ax, choice)
+    elif panel.overlay:
         members = [results[sheet.resolve(m.study)] for m in panel.overlay]
         draw_overlay(members, panel.kind, ax, [m.label for m in panel.overlay], choice,
                      title=panel.title)

@@ -44,8 +44,9 @@ from ..study.schema import (
     _Strict,
 )
 from ..study.source import _compose, _read_text, _Tree
+from .extra import SHEET_KINDS
 
-PanelKind = Literal[PANEL_KINDS]  # the kinds plots.panels.draw draws
+PanelKind = Literal[PANEL_KINDS + SHEET_KINDS]  # plots.panels.draw's and the sheets' own
 _FIGURE_RE = re.compile(r"\d+(\.\d+)*[a-z]?")
 _MAX_PANELS = 64
 PANEL_SIZE = (5.2, 4.2)
