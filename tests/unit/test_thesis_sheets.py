@@ -235,3 +235,38 @@ def _growth_rate() -> float:
     roots = np.linalg.eigvals(linear_matrix({"V": 7.8}))
     upper = roots[roots.imag > 1e-6]
     return float(upper[np.argmin(upper.imag)].real)
+
+
+def test_a_narrow_blowup_approach_gets_a_zoom_holding_the_fit_and_its_asymptote():
+    from tests.unit.test_thesis_figures import ASYMPTOTE, blowup_continuation
+    from whirl_cli.plots.blowup import blowup_plot, fit_blowup
+
+    continuation = blowup_continuation()
+    (family,) = continuation.branches
+    parameter = family.parameters[:, 0]
+    fit = fit_blowup(parameter, family.period)
+    ax = blowup_plot(continuation).axes[0]
+    (zoom,) = ax.child_axes
+    left, right = zoom.get_xlim()
+    main = abs(np.diff(ax.get_xlim())[0])
+    assert right - left < 0.2 * main  # a zoom, not the same view
+    for value in (ASYMPTOTE, parameter[fit.start], parameter[fit.stop], -0.0801):
+        assert left < value < right
+    assert [line.get_label() for line in zoom.lines if line.get_label() == "_fit"]
+
+
+def test_a_heteroclinic_marker_stays_visible_on_a_blowup_plot():
+    from dataclasses import replace
+
+    from tests.unit.test_thesis_figures import blowup_continuation
+    from whirl_cli.plots.blowup import blowup_plot
+    from whirl_cli.results import PointType
+
+    continuation = blowup_continuation()
+    points = tuple(replace(p, point_type=int(PointType.HETEROCLINIC))
+                   if p.point_type == int(PointType.HOMOCLINIC) else p
+                   for p in continuation.special_points)
+    ax = blowup_plot(replace(continuation, special_points=points)).axes[0]
+    (marker,) = [line for line in ax.lines if line.get_marker() == "^"]
+    assert marker.get_markerfacecolor() == "none"
+    assert marker.get_markeredgecolor() not in ("white", "w", (1, 1, 1, 1))
