@@ -270,3 +270,30 @@ def test_a_heteroclinic_marker_stays_visible_on_a_blowup_plot():
     (marker,) = [line for line in ax.lines if line.get_marker() == "^"]
     assert marker.get_markerfacecolor() == "none"
     assert marker.get_markeredgecolor() not in ("white", "w", (1, 1, 1, 1))
+
+
+def test_saddles_at_a_cut_are_marked_apart_from_other_unstable_equilibria():
+    """Three equilibria at K1 = 0.1: one stable, one with a real root > 0 beside stable
+    ones (a saddle), one unstable through a complex pair only (not a saddle)."""
+    from dataclasses import replace
+
+    from tests.unit.test_figure_cuts import branch
+    from whirl_cli.plots.cuts import phase_cut
+    from whirl_cli.plots.key import _new_figure
+    from whirl_cli.results import BranchKind, ContinuationResult
+
+    k1 = np.linspace(0.0, 0.2, 5)
+    roots = {"stable": [-1 + 5j, -1 - 5j, -2, -3], "saddle": [2.0, -3, -1 + 5j, -1 - 5j],
+             "focus": [0.5 + 3j, 0.5 - 3j, -1, -2]}
+    branches = tuple(
+        replace(branch(name, BranchKind.EQUILIBRIUM, k1, theta + 0 * k1, [name == "stable"] * 5),
+                eigenvalues=np.tile(np.asarray(roots[name], complex), (5, 1)))
+        for name, theta in (("stable", 0.0), ("saddle", 0.1), ("focus", -0.1)))
+    ax = _new_figure().add_subplot()
+    phase_cut(ContinuationResult("k1", "one-parameter", branches, ()), 0.1, ax)
+    marks = {line.get_label().split()[0]: np.asarray(line.get_xydata()) for line in ax.lines}
+    theta_deg = np.degrees(0.1)
+    np.testing.assert_allclose(marks["saddle"], [[0.5 * theta_deg, theta_deg]])  # psi, theta
+    np.testing.assert_allclose(marks["unstable"], [[-0.5 * theta_deg, -theta_deg]])
+    np.testing.assert_allclose(marks["stable"], [[0.0, 0.0]])
+    assert {line.get_marker() for line in ax.lines} == {"x", "X"}
