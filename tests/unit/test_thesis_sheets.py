@@ -297,3 +297,24 @@ def test_saddles_at_a_cut_are_marked_apart_from_other_unstable_equilibria():
     np.testing.assert_allclose(marks["unstable"], [[-0.5 * theta_deg, -theta_deg]])
     np.testing.assert_allclose(marks["stable"], [[0.0, 0.0]])
     assert {line.get_marker() for line in ax.lines} == {"x", "X"}
+
+
+@pytest.mark.parametrize("sweep_of", ["3.12", "airspeed"])
+def test_a_root_locus_zoom_never_hides_roots(sweep_of):
+    from whirl_cli.analysis import linear
+    from whirl_cli.models import get_model
+    from whirl_cli.plots.linear import root_locus_plot
+
+    if sweep_of == "3.12":
+        figure = drawn("3.12")
+        roots = np.concatenate([_roots(k) for k in np.linspace(-0.3, 0.5, 161)])
+    else:  # one crossing, roots in every corner: no room for a zoom
+        sweep = linear.sweep(get_model("classical"), {}, "V", np.linspace(0.0, 10.0, 201))
+        figure = root_locus_plot(sweep)
+        roots = np.asarray(sweep.eigenvalues).reshape(-1)
+    ax = figure.axes[0]
+    figure.canvas.draw()
+    shown = ax.transData.transform(np.column_stack([roots.real, roots.imag]))
+    for zoom in ax.child_axes:
+        assert zoom.get_window_extent().count_contains(shown) <= 0.01 * len(roots)
+    assert len(ax.child_axes) == (1 if sweep_of == "3.12" else 0)

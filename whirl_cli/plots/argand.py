@@ -26,6 +26,8 @@ COALESCENCE_STYLE = {"marker": "D", "markersize": 7, "markerfacecolor": "white",
 ZOOM_SIZE = 0.4
 """Width and height of the zoom, in fractions of the axes."""
 _CLEARANCE = 0.05  # axes fractions around a corner box counted as covered
+_ZOOM_WORTH = 0.2  # a zoom box wider and taller than this fraction of the axes is no zoom
+_HIDDEN = 0.01  # the largest fraction of the roots an inset may cover
 _ZOOM_MARGIN = 0.15  # of the zoomed span, on each side
 _CORNERS = ((1.0, 1.0), (0.0, 1.0), (1.0, 0.0), (0.0, 0.0))  # upper right first
 
@@ -93,9 +95,13 @@ def direction_arrows(ax: Axes, sweep: LinearSweep, label: str = "") -> list:
             arrowprops={"arrowstyle": "-|>", "color": "black", "linewidth": 1.2,
                         "mutation_scale": 14, "shrinkA": 0, "shrinkB": 0}))
     if label and arrows:
-        tail = arrows[-1].xyann
-        ax.annotate(label, xy=tail, xytext=(-8, 0), textcoords="offset points", ha="right",
-                    va="center", fontsize="small", zorder=5)
+        tail, head = np.asarray(arrows[-1].xyann), np.asarray(arrows[-1].xy)
+        along = ax.transData.transform(head) - ax.transData.transform(tail)
+        side = np.array([-along[1], along[0]]) / max(float(np.hypot(*along)), 1e-12)
+        side = side if side[1] >= 0 else -side  # above the arrow
+        ax.annotate(label, xy=(tail + head) / 2, xytext=tuple(14.0 * side),
+                    textcoords="offset points", ha="center", va="bottom",
+                    fontsize="small", zorder=5)
     return arrows
 
 
@@ -149,24 +155,35 @@ def emptiest_corner(points: np.ndarray, size: float = ZOOM_SIZE) -> tuple[float,
     counts = []
     for cx, cy in _CORNERS:
         x0, y0 = cx * (1.0 - size), cy * (1.0 - size)
-        inside = ((points[:, 0] >= x0 - _CLEARANCE) & (points[:, 0] <= x0 + size + _CLEARANCE)
-                  & (points[:, 1] >= y0 - _CLEARANCE) & (points[:, 1] <= y0 + size + _CLEARANCE))
-        counts.append((int(inside.sum()), (x0, y0)))
+        counts.append((int(np.count_nonzero(_inside(points, x0, y0, size))), (x0, y0)))
     return min(counts, key=lambda c: c[0])[1]
 
 
-def draw_zoom(ax: Axes, sweep: LinearSweep, events: LocusEvents, draw_roots) -> Axes | None:
+def _inside(points: np.ndarray, x0: float, y0: float, size: float) -> np.ndarray:
+    """Which of ``points`` (axes fractions) lie in the box at (x0, y0) or near it."""
+    return ((points[:, 0] >= x0 - _CLEARANCE) & (points[:, 0] <= x0 + size + _CLEARANCE)
+            & (points[:, 1] >= y0 - _CLEARANCE) & (points[:, 1] <= y0 + size + _CLEARANCE))
+
+
+def draw_zoom(ax: Axes, sweep: LinearSweep, events: LocusEvents, draw_roots
+              ) -> tuple[float, float] | None:
     """An inset of ``ax`` in its emptiest corner (:func:`emptiest_corner` of the roots as
     drawn) showing :func:`zoom_box`: the roots again (``draw_roots(inset)``), the events,
-    the arrows; the zoomed region outlined on ``ax``. None (nothing drawn) without a
-    crossing."""
+    the arrows; the zoomed region outlined on ``ax``. Returns the corner (x0, y0) in axes
+    fractions; None (nothing drawn) without a crossing, where the box is not much smaller
+    than the axes or where the inset would hide more than :data:`_HIDDEN` of the roots."""
     box = zoom_box(sweep, events)
     if box is None:
         return None
     ax.autoscale_view()
     roots = np.asarray(sweep.eigenvalues).reshape(-1)
     points = ax.transLimits.transform(np.column_stack([roots.real, roots.imag]))
+    corners = ax.transLimits.transform(np.array(box).T)
+    if np.all(np.abs(np.diff(corners, axis=0)) > _ZOOM_WORTH):
+        return None
     x0, y0 = emptiest_corner(points)
+    if np.count_nonzero(_inside(points, x0, y0, ZOOM_SIZE)) > _HIDDEN * len(points):
+        return None
     inset = ax.inset_axes([x0, y0, ZOOM_SIZE, ZOOM_SIZE])
     draw_roots(inset)
     mark_events(inset, events)
@@ -175,4 +192,4 @@ def draw_zoom(ax: Axes, sweep: LinearSweep, events: LocusEvents, draw_roots) -> 
     inset.set_ylim(*box[1])
     inset.tick_params(labelsize="x-small")
     ax.indicate_inset_zoom(inset, edgecolor="black", alpha=0.6)
-    return inset
+    return x0, y0

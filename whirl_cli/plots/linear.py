@@ -134,11 +134,11 @@ def root_locus_plot(sweep: LinearSweep, title: str | None = None, ax: Axes | Non
     direction_arrows(ax, sweep, f"{symbol(sweep.parameter)} increasing")
     if scale is not None:
         figure.colorbar(scale, ax=ax, label=axis_label(sweep.parameter, sweep.unit))
-    inset = draw_zoom(ax, sweep, events, lambda inset: _draw_roots(inset, sweep))
-    if scale is not None:
-        corner = "upper right" if inset is not None and inset.get_position().x0 < 0.5 \
-            else "upper left"
-        ax.legend(fontsize="small", loc=corner)
+    corner = draw_zoom(ax, sweep, events, lambda inset: _draw_roots(inset, sweep))
+    if scale is not None:  # the legend beside the zoom, if there is one
+        ax.legend(fontsize="small", loc="best" if corner is None else
+                  f"{'upper' if corner[1] > 0 else 'lower'} "
+                  f"{'right' if corner[0] == 0 else 'left'}")
     ax.set_xlabel(axis_label("Re $\\lambda$", "1/s"))
     ax.set_ylabel(axis_label("Im $\\lambda$", "rad/s"))
     ax.set_title(f"root locus vs {sweep.parameter}" if title is None else title)
