@@ -4,6 +4,7 @@ model written out apart from whirl (tests.classical_exact)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import cache
 from pathlib import Path
 
@@ -12,10 +13,18 @@ import pytest
 from matplotlib.collections import QuadMesh
 
 from tests.classical_exact import linear_matrix
+from tests.unit.plot_data import make_branch, make_point
+from whirl_cli.analysis import linear
 from whirl_cli.api import run
 from whirl_cli.figures.draw import draw_sheet
 from whirl_cli.figures.sheet import load_sheet
+from whirl_cli.models import get_model
+from whirl_cli.plots.blowup import blowup_plot, fit_blowup
+from whirl_cli.plots.cuts import phase_cut
 from whirl_cli.plots.files import rendered_formats
+from whirl_cli.plots.key import _new_figure
+from whirl_cli.plots.linear import root_locus_plot
+from whirl_cli.results import BranchKind, ContinuationResult, PointType
 
 SHEETS = Path(__file__).resolve().parents[2] / "sheets" / "thesis_ch3"
 
@@ -237,10 +246,26 @@ def _growth_rate() -> float:
     return float(upper[np.argmin(upper.imag)].real)
 
 
-def test_a_narrow_blowup_approach_gets_a_zoom_holding_the_fit_and_its_asymptote():
-    from tests.unit.test_thesis_figures import ASYMPTOTE, blowup_continuation
-    from whirl_cli.plots.blowup import blowup_plot, fit_blowup
+ASYMPTOTE = -0.08
 
+
+def blowup_continuation(global_type: PointType = PointType.HOMOCLINIC) -> ContinuationResult:
+    """A family from p = 0.3 turning at a fold (p = -0.04, back to -0.03), then approaching
+    p = -0.08 as T = 0.3 + 0.02 / (p + 0.08) over 1e-4 to 0.05 from it: the approach is a
+    small part of the family's span."""
+    run = ASYMPTOTE + np.geomspace(0.05, 1e-4, 40)
+    parameter = np.concatenate([np.linspace(0.3, -0.04, 40), np.linspace(-0.04, -0.03, 6)[1:],
+                                run])
+    period = np.concatenate([0.26 + 0.001 * np.arange(40), 0.30 + 0.01 * np.arange(1, 6),
+                             0.3 + 0.02 / (run - ASYMPTOTE)])
+    family = replace(make_branch("periodic_1", BranchKind.PERIODIC, parameter,
+                                 0.1 + 0 * parameter, np.arange(len(parameter)) < 60),
+                     period=period)
+    return ContinuationResult("k1", "one-parameter", (family,),
+                              (make_point("periodic_1", global_type, -0.0801, 0.0),))
+
+
+def test_a_narrow_blowup_approach_gets_a_zoom_holding_the_fit_and_its_asymptote():
     continuation = blowup_continuation()
     (family,) = continuation.branches
     parameter = family.parameters[:, 0]
@@ -256,17 +281,7 @@ def test_a_narrow_blowup_approach_gets_a_zoom_holding_the_fit_and_its_asymptote(
 
 
 def test_a_heteroclinic_marker_stays_visible_on_a_blowup_plot():
-    from dataclasses import replace
-
-    from tests.unit.test_thesis_figures import blowup_continuation
-    from whirl_cli.plots.blowup import blowup_plot
-    from whirl_cli.results import PointType
-
-    continuation = blowup_continuation()
-    points = tuple(replace(p, point_type=int(PointType.HETEROCLINIC))
-                   if p.point_type == int(PointType.HOMOCLINIC) else p
-                   for p in continuation.special_points)
-    ax = blowup_plot(replace(continuation, special_points=points)).axes[0]
+    ax = blowup_plot(blowup_continuation(PointType.HETEROCLINIC)).axes[0]
     (marker,) = [line for line in ax.lines if line.get_marker() == "^"]
     assert marker.get_markerfacecolor() == "none"
     assert marker.get_markeredgecolor() not in ("white", "w", (1, 1, 1, 1))
@@ -275,36 +290,26 @@ def test_a_heteroclinic_marker_stays_visible_on_a_blowup_plot():
 def test_saddles_at_a_cut_are_marked_apart_from_other_unstable_equilibria():
     """Three equilibria at K1 = 0.1: one stable, one with a real root > 0 beside stable
     ones (a saddle), one unstable through a complex pair only (not a saddle)."""
-    from dataclasses import replace
-
-    from tests.unit.test_figure_cuts import branch
-    from whirl_cli.plots.cuts import phase_cut
-    from whirl_cli.plots.key import _new_figure
-    from whirl_cli.results import BranchKind, ContinuationResult
-
     k1 = np.linspace(0.0, 0.2, 5)
     roots = {"stable": [-1 + 5j, -1 - 5j, -2, -3], "saddle": [2.0, -3, -1 + 5j, -1 - 5j],
              "focus": [0.5 + 3j, 0.5 - 3j, -1, -2]}
     branches = tuple(
-        replace(branch(name, BranchKind.EQUILIBRIUM, k1, theta + 0 * k1, [name == "stable"] * 5),
+        replace(make_branch(name, BranchKind.EQUILIBRIUM, k1, theta + 0 * k1,
+                            [name == "stable"] * 5),
                 eigenvalues=np.tile(np.asarray(roots[name], complex), (5, 1)))
         for name, theta in (("stable", 0.0), ("saddle", 0.1), ("focus", -0.1)))
     ax = _new_figure().add_subplot()
     phase_cut(ContinuationResult("k1", "one-parameter", branches, ()), 0.1, ax)
     marks = {line.get_label().split()[0]: np.asarray(line.get_xydata()) for line in ax.lines}
     theta_deg = np.degrees(0.1)
-    np.testing.assert_allclose(marks["saddle"], [[0.5 * theta_deg, theta_deg]])  # psi, theta
-    np.testing.assert_allclose(marks["unstable"], [[-0.5 * theta_deg, -theta_deg]])
+    np.testing.assert_allclose(marks["saddle"], [[0.1 * theta_deg, theta_deg]])  # psi, theta
+    np.testing.assert_allclose(marks["unstable"], [[-0.1 * theta_deg, -theta_deg]])
     np.testing.assert_allclose(marks["stable"], [[0.0, 0.0]])
     assert {line.get_marker() for line in ax.lines} == {"x", "X"}
 
 
 @pytest.mark.parametrize("sweep_of", ["3.12", "airspeed"])
 def test_a_root_locus_zoom_never_hides_roots(sweep_of):
-    from whirl_cli.analysis import linear
-    from whirl_cli.models import get_model
-    from whirl_cli.plots.linear import root_locus_plot
-
     if sweep_of == "3.12":
         figure = drawn("3.12")
         roots = np.concatenate([_roots(k) for k in np.linspace(-0.3, 0.5, 161)])
