@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import WhirlError
 from ..results import Simulation
-from .key import _BLACK, _new_figure, axis_label, display_unit, next_colour
+from .key import _BLACK, _new_figure, axis_label, display_unit, next_colour, symbol
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -91,7 +91,7 @@ def draw_envelope(ax: Axes, time: np.ndarray, values: np.ndarray, colour: str, n
     """The upper and lower envelope of an oscillation (its maxima and minima joined), the
     band between them lightly filled; labelled "<name> (envelope of <n> cycles)"."""
     up, down = peaks(values)
-    label = f"{name} (envelope of {cycles(values)} cycles)"
+    label = f"{symbol(name)} (envelope of {cycles(values)} cycles)"
     ax.plot(time[up], values[up], color=colour, linewidth=1.2, label=label)
     ax.plot(time[down], values[down], color=colour, linewidth=1.2, label="_lower envelope")
     grid = np.asarray(time, dtype=float)
