@@ -695,12 +695,18 @@ def polyline(ax, points) -> object:
     return found[0]
 
 
-def test_boundary_plot_shades_linearly_unstable_region():
+@pytest.mark.parametrize("with_loci", [False, True])
+def test_boundary_plot_shades_linearly_unstable_region(with_loci):
+    """Grey under a boundary's loci; hatched over the max Re lambda surface of a grid alone."""
     grid = make_grid()
-    ax = boundary_plot(None, grid).axes[0]
+    boundary = make_boundary(polygons=()) if with_loci else None
+    ax = boundary_plot(boundary, grid).axes[0]
     (contours,) = contour_sets(ax)
     np.testing.assert_array_equal(contours.levels, [0.0, np.inf])
-    assert same_color(contours.get_facecolor()[0], "lightgrey")
+    if with_loci:
+        assert same_color(contours.get_facecolor()[0], "lightgrey")
+    else:
+        assert contours.hatches == ["//"]
     paths = contours.get_paths()
     xx, yy = np.meshgrid(grid.x, grid.y)
     inside = np.array([any(path.contains_point(xy) for path in paths)

@@ -38,8 +38,12 @@ def test_the_root_locus_crosses_the_imaginary_axis_at_the_hopf_point():
     assert len(crossings) == 2  # the conjugate pair
     np.testing.assert_allclose(crossings, hopf, atol=1e-6)
     labels = {t.get_text() for t in ax.get_legend().get_texts()}
-    assert labels <= {"FW", "BW", "real root"} and labels & {"FW", "BW"}
-    assert ax.get_xlabel() == "Re lambda [1/s]" and ax.get_ylabel() == "Im lambda [rad/s]"
+    assert labels <= {"FW", "BW", "real root", "crossing Re $\\lambda$ = 0 (Hopf)",
+                      "real roots coalesce"} and labels & {"FW", "BW"}
+    (square,) = [line for line in ax.get_lines() if line.get_marker() == "s"]
+    np.testing.assert_array_equal(square.get_xdata(), [0.0])  # the crossing marked
+    assert ax.get_xlabel() == "Re $\\lambda$ [1/s]"
+    assert ax.get_ylabel() == "Im $\\lambda$ [rad/s]"
     assert figure.axes[1].get_ylabel() == "V [m/s]"  # the colour bar names the parameter
 
 

@@ -146,7 +146,7 @@ def test_every_panel_kind_draws_or_names_what_is_missing(continuation):  # noqa:
     assert freq.get_ylabel() == "frequency [rad/s]"
     assert damp.get_ylabel() == "damping ratio [-]"
     assert len(drawn["projections"]) == len(STATES)
-    assert drawn["root_locus"][0].get_xlabel() == "Re lambda [1/s]"
+    assert drawn["root_locus"][0].get_xlabel() == "Re $\\lambda$ [1/s]"
     assert drawn["period"][0].get_ylabel() == "period [s]"
     assert "no stability boundary" in drawn["boundary"]
     assert "no stability boundary" in drawn["overhang"]

@@ -21,6 +21,7 @@ from .key import (
     axis_label,
     branch_style,
     stability_curves,
+    symbol,
 )
 
 if TYPE_CHECKING:
@@ -30,6 +31,7 @@ if TYPE_CHECKING:
 _GLOBAL = (PointType.HOMOCLINIC, PointType.HETEROCLINIC)
 _FAMILY_POINTS = (PointType.HB, PointType.LPC, PointType.BPC, PointType.PD, PointType.TR)
 _MIN_ROWS = 5  # fewest rows a fit is made from
+_ZOOM_WORTH = 0.2  # an approach narrower than this fraction of the x-axis gets a zoom
 _GRID = 600  # trial asymptotes, spaced logarithmically in their distance from the approach
 
 #: Styles of the fitted curve and of its asymptote.
@@ -148,16 +150,15 @@ def blowup_plot(continuation: ContinuationResult, branch: str | None = None,
     styles of :data:`PLOT_KEY` with its Hopf, fold (LPC), branch and torus points, the
     global point whirl located (at the family's last period), the 1/x curve of
     :func:`fit_blowup` (dash-dot) and its asymptote (dashed, its value in the legend). The
-    x-axis spans the approach and the asymptote. Draws on ``ax`` if given, else on a new
+    x-axis spans the approach and the asymptote; an inset zooms on the rows the fit was made
+    from and the asymptote (:func:`approach_box`). Draws on ``ax`` if given, else on a new
     figure; returns the figure. Title: ``title`` (None: the family's name)."""
     family, global_point = blowup_family(continuation, branch)
     if ax is None:
         ax = _new_figure().add_subplot()
     x, period = family.parameters[:, 0], family.period
     first: dict[str, object] = {}
-    for xs, ys, stable in stability_curves(x, period, family.stable, family.stability_known):
-        _plot_styled(ax, xs, ys, branch_style(family.kind, stable), first)
-    _family_points(ax, continuation, family, global_point, first)
+    _draw_family(ax, continuation, family, global_point, first)
     name, unit = family.parameter_names[0], family.parameter_units[0]
     handles = [first[key] for key in PLOT_KEY if key in first]
     labels = [str(PLOT_KEY[key]["label"]) for key in PLOT_KEY if key in first]
@@ -165,22 +166,18 @@ def blowup_plot(continuation: ContinuationResult, branch: str | None = None,
         style = MARKER_STYLE[PointType(int(global_point.point_type))]
         if style in first:
             labels[[k for k in PLOT_KEY if k in first].index(style)] = (
-                f"{PLOT_KEY[style]['label']} (whirl: {name} = "
+                f"{PLOT_KEY[style]['label']} (whirl: {symbol(name)} = "
                 f"{float(global_point.parameters[0]):.5g})")
     try:
         fit = fit_blowup(x, period)
     except ValueError:
         fit = None
     if fit is not None:
-        start = x[fit.start]
         top = 1.15 * float(np.nanmax(period))
-        near = fit.asymptote + fit.scale / (top - fit.offset) if fit.scale else fit.asymptote
-        curve_x = np.linspace(start, near, 400)
-        (line,) = ax.plot(curve_x, fit.period(curve_x), label="_fit", **FIT_STYLE)
-        asymptote = ax.axvline(fit.asymptote, label="_asymptote", **ASYMPTOTE_STYLE)
+        line, asymptote = _draw_fit(ax, fit, x[fit.start], top)
         handles += [line, asymptote]
         labels += ["fitted 1/x curve",
-                   f"fitted asymptote {name} = {fit.asymptote:.5g}"
+                   f"fitted asymptote {symbol(name)} = {fit.asymptote:.5g}"
                    + (f" {unit}" if unit else "")]
         run = x[growth_run(x, period)[0]]
         margin = 0.06 * abs(run - fit.asymptote)
@@ -188,11 +185,75 @@ def blowup_plot(continuation: ContinuationResult, branch: str | None = None,
                              fit.asymptote - np.sign(run - fit.asymptote) * margin)))
         shown = (x >= min(ax.get_xlim())) & (x <= max(ax.get_xlim()))
         ax.set_ylim(0.95 * float(np.nanmin(period[shown])), top)
+        _zoom_approach(ax, continuation, family, global_point, fit, top)
     ax.set_xlabel(axis_label(name, unit))
     ax.set_ylabel(axis_label("period", "s"))
     ax.legend(handles, labels, fontsize="small")
     ax.set_title(family.name if title is None else title)
     return ax.figure
+
+
+def _draw_family(ax: Axes, continuation: ContinuationResult, family: Branch, global_point,
+                 first: dict) -> None:
+    """The family's period by stability and its points (:func:`_family_points`)."""
+    for xs, ys, stable in stability_curves(family.parameters[:, 0], family.period,
+                                           family.stable, family.stability_known):
+        _plot_styled(ax, xs, ys, branch_style(family.kind, stable), first)
+    _family_points(ax, continuation, family, global_point, first)
+
+
+def _draw_fit(ax: Axes, fit: BlowupFit, start: float, top: float) -> tuple:
+    """The fitted curve from ``start`` up to the period ``top``, and its asymptote."""
+    near = fit.asymptote + fit.scale / (top - fit.offset) if fit.scale else fit.asymptote
+    curve_x = np.linspace(start, near, 400)
+    (line,) = ax.plot(curve_x, fit.period(curve_x), label="_fit", **FIT_STYLE)
+    return line, ax.axvline(fit.asymptote, label="_asymptote", **ASYMPTOTE_STYLE)
+
+
+def approach_box(parameter: np.ndarray, period: np.ndarray, fit: BlowupFit, global_at=None
+                 ) -> tuple[tuple[float, float], tuple[float, float]]:
+    """(x limits, y limits) of the approach the fit was made from, its asymptote and the
+    global point's parameter ``global_at`` (if given), with margins."""
+    ends = [float(parameter[fit.start]), float(parameter[fit.stop]), fit.asymptote]
+    if global_at is not None:
+        ends.append(float(global_at))
+    low, high = min(ends), max(ends)
+    pad = 0.08 * (high - low)
+    inside = (parameter >= low - pad) & (parameter <= high + pad)
+    shown = period[inside & np.isfinite(period)]
+    bottom, peak = float(np.min(shown)), float(np.max(shown))
+    return (low - pad, high + pad), (bottom - 0.05 * (peak - bottom),
+                                     peak + 0.15 * (peak - bottom))
+
+
+def _zoom_approach(ax: Axes, continuation: ContinuationResult, family: Branch, global_point,
+                   fit: BlowupFit, top: float) -> Axes | None:
+    """An inset of ``ax`` in its emptiest corner zooming on :func:`approach_box`: the family,
+    its points, the fit and its asymptote again; the region outlined on ``ax``. None
+    (nothing drawn) where the box spans more than :data:`_ZOOM_WORTH` of the x-axis."""
+    from matplotlib.ticker import MaxNLocator
+
+    from .argand import ZOOM_SIZE, emptiest_corner
+
+    x, period = family.parameters[:, 0], family.period
+    at = None if global_point is None else global_point.parameters[0]
+    xlim, ylim = approach_box(x, period, fit, at)
+    left, right = ax.get_xlim()
+    if xlim[1] - xlim[0] > _ZOOM_WORTH * abs(right - left):
+        return None
+    ax.autoscale_view()
+    finite = np.isfinite(period)
+    points = ax.transLimits.transform(np.column_stack([x[finite], period[finite]]))
+    x0, y0 = emptiest_corner(points)
+    inset = ax.inset_axes([x0, y0, ZOOM_SIZE, ZOOM_SIZE])
+    _draw_family(inset, continuation, family, global_point, {})
+    _draw_fit(inset, fit, x[fit.start], top)
+    inset.set_xlim(*xlim)
+    inset.set_ylim(*ylim)
+    inset.tick_params(labelsize="x-small")
+    inset.xaxis.set_major_locator(MaxNLocator(3))
+    ax.indicate_inset_zoom(inset, edgecolor="black", alpha=0.6)
+    return inset
 
 
 def _family_points(ax: Axes, continuation: ContinuationResult, family: Branch, global_point,
@@ -220,5 +281,6 @@ def _family_points(ax: Axes, continuation: ContinuationResult, family: Branch, g
             xs, ys = np.array(points[style]).T
             _plot_styled(ax, xs, ys, style, first)
             if style in ("homoclinic", "heteroclinic"):  # on top of the fold beside it
-                first[style].set(zorder=5, markersize=11, markeredgecolor="white",
-                                 markeredgewidth=0.8)
+                hollow = PLOT_KEY[style].get("markerfacecolor") == "none"
+                first[style].set(zorder=5, markersize=11, markeredgewidth=1.4 if hollow
+                                 else 0.8, markeredgecolor="black" if hollow else "white")

@@ -27,6 +27,9 @@ _STABLE_POINT = {"marker": "x", "markersize": 8, "markeredgewidth": 1.8, "color"
                  "label": "stable fixed point (cross)"}
 _UNSTABLE_POINT = {"marker": "x", "markersize": 7, "markeredgewidth": 1.0, "color": "grey",
                    "label": "unstable fixed point (cross)"}
+_SADDLE_POINT = {"marker": "X", "markersize": 10, "markeredgewidth": 0.8, "color": "dimgrey",
+                 "markeredgecolor": _BLACK, "label": "saddle (cross, a real eigenvalue > 0)"}
+_REAL = 1e-9  # |Im| of an eigenvalue counted as real, relative to its modulus
 
 
 @dataclass(frozen=True)
@@ -40,6 +43,17 @@ class Solution:
     stable: bool | None
     states: np.ndarray
     parent: str = ""  # " of <branch>" where a periodic family was born on another branch
+    saddle: bool = False  # an equilibrium with a real eigenvalue > 0 and one of Re < 0
+
+
+def is_saddle(eigenvalues: np.ndarray) -> bool:
+    """An equilibrium's eigenvalues [1/s] have a real one > 0 and one with Re < 0 (NaN:
+    not known, False)."""
+    roots = np.asarray(eigenvalues, dtype=complex)
+    if not np.all(np.isfinite(roots)):
+        return False
+    real = np.abs(roots.imag) <= _REAL * np.maximum(np.abs(roots), 1.0)
+    return bool(np.any(real & (roots.real > 0)) and np.any(roots.real < 0))
 
 
 def _span(continuation: ContinuationResult) -> float:
@@ -100,10 +114,12 @@ def _equilibria_at(branch: Branch, value: float) -> list[Solution]:
             row = k if w < 0.5 else k + 1
             stable = bool(branch.stable[row]) if branch.stability_known[row] else None
             out.append(Solution(branch.name, branch.kind, stable,
-                                (states[k] + w * (states[k + 1] - states[k]))[None, :]))
+                                (states[k] + w * (states[k + 1] - states[k]))[None, :],
+                                saddle=is_saddle(branch.eigenvalues[row])))
     if len(x) and x[-1] == value:
         stable = bool(branch.stable[-1]) if branch.stability_known[-1] else None
-        out.append(Solution(branch.name, branch.kind, stable, states[-1][None, :]))
+        out.append(Solution(branch.name, branch.kind, stable, states[-1][None, :],
+                            saddle=is_saddle(branch.eigenvalues[-1])))
     return out
 
 
@@ -142,9 +158,10 @@ def phase_cut(continuation: ContinuationResult, value: float, ax: Axes, title: s
               degrees: bool = True) -> int:
     """Every solution at ``value`` (:func:`solutions_at`) on ``ax``: the second dof
     horizontal, the first vertical, equal aspect; equilibria as crosses (black stable, grey
-    unstable), each limit cycle closed in a colour of its own in the figure
-    (:func:`~whirl_cli.plots.key.next_colour`), solid if stable and dotted if not, with an
-    arrow for its direction of motion, labelled by family and stability. Returns the number
+    unstable, a filled cross for a saddle: :func:`is_saddle`), each limit cycle closed in a
+    colour of its own in the figure (:func:`~whirl_cli.plots.key.next_colour`), solid if
+    stable and dotted if not, with an arrow for its direction of motion, labelled by family
+    and stability. Returns the number
     of limit cycles drawn."""
     ref = next((b for b in continuation.branches if len(b)), None)
     if ref is None or len(ref.state_names) < 2:
@@ -153,12 +170,13 @@ def phase_cut(continuation: ContinuationResult, value: float, ax: Axes, title: s
     fx, unit_x = display_unit(ref.state_units[ix], degrees)
     fy, unit_y = display_unit(ref.state_units[iy], degrees)
     cycles = 0
-    points: dict[bool | None, list[np.ndarray]] = {}
+    points: dict[bool | str | None, list[np.ndarray]] = {}
     letter = title.split(")")[0] + ") " if title.startswith("(") else ""
     for solution in solutions_at(continuation, value):
         xs, ys = solution.states[:, ix] * fx, solution.states[:, iy] * fy
         if solution.kind == BranchKind.EQUILIBRIUM:
-            points.setdefault(solution.stable, []).append(np.array([xs[0], ys[0]]))
+            kind = "saddle" if solution.saddle else solution.stable
+            points.setdefault(kind, []).append(np.array([xs[0], ys[0]]))
             continue
         cycles += 1
         status = {True: "stable", False: "unstable", None: "stability unknown"}[solution.stable]
@@ -169,7 +187,7 @@ def phase_cut(continuation: ContinuationResult, value: float, ax: Axes, title: s
                 label=f"{letter}limit cycle {solution.family}{solution.parent} ({status})")
         _arrow(ax, xs, ys, colour)
     for stable, style in ((True, _STABLE_POINT), (False, _UNSTABLE_POINT),
-                          (None, _UNSTABLE_POINT)):
+                          (None, _UNSTABLE_POINT), ("saddle", _SADDLE_POINT)):
         if stable in points:
             xy = np.array(points[stable])
             ax.plot(xy[:, 0], xy[:, 1], linestyle="none", zorder=4, **style)

@@ -115,12 +115,39 @@ def root_locus_plot(sweep: LinearSweep, title: str | None = None, ax: Axes | Non
                     ) -> Figure:
     """The eigenvalues of every point of ``sweep`` in the complex plane [1/s], coloured by
     the parameter (colour bar), one marker per whirl direction (circle FW, square BW, cross
-    real), with the imaginary axis drawn: a root crossing it to the right is a Hopf point
-    (flutter), through the origin a divergence. Title: ``title`` (None: ``"root locus vs
-    <parameter>"``). Draws on ``ax`` if given, else on a new figure; returns the figure."""
+    real), with the axes drawn under them: a root crossing the imaginary axis to the right
+    is a Hopf point (flutter), through the origin a divergence. Marked
+    (:mod:`whirl_cli.plots.argand`): each crossing of the imaginary axis and each
+    coalescence of real roots, an arrow per oscillatory mode in the sense of the increasing
+    parameter, and a zoom on the crossings in the emptiest corner. Title: ``title`` (None:
+    ``"root locus vs <parameter>"``). Draws on ``ax`` if given, else on a new figure;
+    returns the figure."""
+    from .argand import direction_arrows, draw_zoom, locus_events, mark_events
+    from .key import symbol
+
     if ax is None:
         ax = _new_figure().add_subplot()
     figure = ax.figure
+    scale = _draw_roots(ax, sweep)
+    events = locus_events(sweep)
+    mark_events(ax, events)
+    direction_arrows(ax, sweep, f"{symbol(sweep.parameter)} increasing")
+    if scale is not None:
+        figure.colorbar(scale, ax=ax, label=axis_label(sweep.parameter, sweep.unit))
+    corner = draw_zoom(ax, sweep, events, lambda inset: _draw_roots(inset, sweep))
+    if scale is not None:  # the legend beside the zoom, if there is one
+        ax.legend(fontsize="small", loc="best" if corner is None else
+                  f"{'upper' if corner[1] > 0 else 'lower'} "
+                  f"{'right' if corner[0] == 0 else 'left'}")
+    ax.set_xlabel(axis_label("Re $\\lambda$", "1/s"))
+    ax.set_ylabel(axis_label("Im $\\lambda$", "rad/s"))
+    ax.set_title(f"root locus vs {sweep.parameter}" if title is None else title)
+    return figure
+
+
+def _draw_roots(ax: Axes, sweep: LinearSweep):
+    """The roots of ``sweep`` on ``ax`` by whirl direction, over the real and imaginary
+    axes; the last scatter (for a colour bar), None if nothing was drawn."""
     whirl = np.asarray(sweep.whirl).astype(str)
     values = np.repeat(np.asarray(sweep.values)[:, None], sweep.eigenvalues.shape[1], axis=1)
     scale = None
@@ -130,17 +157,11 @@ def root_locus_plot(sweep: LinearSweep, title: str | None = None, ax: Axes | Non
             scale = ax.scatter(sweep.eigenvalues.real[chosen], sweep.eigenvalues.imag[chosen],
                                c=values[chosen], cmap="viridis", marker=marker, s=9,
                                vmin=float(np.min(sweep.values)),
-                               vmax=float(np.max(sweep.values)),
+                               vmax=float(np.max(sweep.values)), zorder=2,
                                label={"--": "real root"}.get(direction, direction))
-    ax.axvline(0.0, color="black", linewidth=0.8, label="_imaginary axis")
-    ax.axhline(0.0, color="grey", linewidth=0.5, label="_real axis")
-    if scale is not None:
-        figure.colorbar(scale, ax=ax, label=axis_label(sweep.parameter, sweep.unit))
-        ax.legend(fontsize="small", loc="upper left")
-    ax.set_xlabel(axis_label("Re lambda", "1/s"))
-    ax.set_ylabel(axis_label("Im lambda", "rad/s"))
-    ax.set_title(f"root locus vs {sweep.parameter}" if title is None else title)
-    return figure
+    ax.axvline(0.0, color="black", linewidth=0.8, label="_imaginary axis", zorder=0)
+    ax.axhline(0.0, color="grey", linewidth=0.5, label="_real axis", zorder=0)
+    return scale
 
 
 def sweep_datum(sweep: LinearSweep, datums: Mapping[str, float] | None = None

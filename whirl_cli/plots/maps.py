@@ -23,6 +23,7 @@ _LOCUS_KINDS = ("hopf", "branch_point", "fold", "fold_of_cycles", "torus")
 _SLICE_TOLERANCE = 1e-12  # slice values equal within this are the same slice
 _BAND_ALPHA = 0.25  # unsafe bands of overhang diagrams
 _CASE_LABEL_GAP = 0.04  # least distance of case labels, in axes fractions
+_LINEAR_FRACTION = 0.01  # of the surface's largest magnitude: its colour scale's linear part
 _LIMIT_MARGIN = 0.02  # fraction of the data span added around loci-derived axis limits
 
 
@@ -38,7 +39,9 @@ def boundary_plot(boundary: Boundary | None, grid: LinearGrid | None,
 
     * from ``grid``: the linearly unstable region (``max_real`` > 0) shaded light grey and the
       linear zero contour thin black, solid where the critical eigenvalue is complex (flutter),
-      dashed where it is real (divergence);
+      dashed where it is real (divergence); a grid drawn without a boundary shows the surface
+      ``max_real`` itself (:data:`SURFACE_MAP`, a colour bar in 1/s), the unstable region
+      hatched over it (:func:`stability_surface`);
     * from ``boundary``: its loci (Hopf solid dark blue, branch point dashed black, fold
       dash-dot grey, fold of cycles solid orange, torus dotted green strung with the thesis
       key's hollow circles; other kinds are not drawn) and the unsafe (overhang) region, its
@@ -69,7 +72,7 @@ def boundary_plot(boundary: Boundary | None, grid: LinearGrid | None,
         ax = _new_figure().add_subplot()
     first: dict[str, object] = {}
     if grid is not None:
-        _draw_grid(ax, grid, first)
+        _draw_grid(ax, grid, first, surface=boundary is None)
     if boundary is not None:
         _draw_loci(ax, boundary, first)
         for polygon in boundary.polygons:
@@ -113,10 +116,40 @@ def _oriented_grid(grid: LinearGrid, names: Sequence[str]) -> LinearGrid | None:
     return None
 
 
-def _draw_grid(ax: Axes, grid: LinearGrid, first: dict) -> None:
-    """Shade max_real > 0 (contourf, levels [0, inf]); draw the zero contour by kind."""
+SURFACE_MAP = "cividis"
+"""Colour map of the max Re lambda surface (its lightness rises monotonically: it reads in
+greyscale)."""
+
+
+def stability_surface(ax: Axes, grid: LinearGrid):
+    """The surface ``grid.max_real`` [1/s] over (x, y) as a colour mesh with a colour bar,
+    the region where it is > 0 hatched; returns the mesh (its array is ``max_real``). The
+    colour scale is linear within 1 % of the largest magnitude of zero and logarithmic beyond,
+    so that slow flutter growth shows beside fast divergence."""
+    from matplotlib.colors import SymLogNorm
+
     max_real = np.ma.masked_invalid(np.asarray(grid.max_real, dtype=float))
+    low, high = float(max_real.min()), float(max_real.max())
+    norm = SymLogNorm(linthresh=_LINEAR_FRACTION * max(abs(low), abs(high), 1e-300),
+                      vmin=low, vmax=high, base=10)
+    mesh = ax.pcolormesh(grid.x, grid.y, max_real, cmap=SURFACE_MAP, norm=norm,
+                         shading="nearest", zorder=0, rasterized=True)
+    ax.figure.colorbar(mesh, ax=ax, label=axis_label("max Re $\\lambda$", "1/s"))
     if np.ma.any(max_real > 0):
+        ax.contourf(grid.x, grid.y, max_real, levels=[0.0, np.inf], colors="none",
+                    hatches=["//"], zorder=0.5)
+    return mesh
+
+
+def _draw_grid(ax: Axes, grid: LinearGrid, first: dict, surface: bool = False) -> None:
+    """Shade max_real > 0 (contourf, levels [0, inf]), or draw the surface with that region
+    hatched (``surface``); draw the zero contour by kind."""
+    max_real = np.ma.masked_invalid(np.asarray(grid.max_real, dtype=float))
+    if surface:
+        stability_surface(ax, grid)
+        if np.ma.any(max_real > 0):
+            first["linearly_unstable"] = _hatch_proxy()
+    elif np.ma.any(max_real > 0):
         style = BOUNDARY_KEY["linearly_unstable"]
         ax.contourf(grid.x, grid.y, max_real, levels=[0.0, np.inf], colors=[style["color"]],
                     zorder=0)
@@ -124,6 +157,14 @@ def _draw_grid(ax: Axes, grid: LinearGrid, first: dict) -> None:
     for key, lines in (("linear_flutter", grid.flutter), ("linear_divergence", grid.divergence)):
         for line in lines:
             _plot_polyline(ax, line, key, first, zorder=1)
+
+
+def _hatch_proxy():
+    """A legend handle for the hatched unstable region of a surface."""
+    from matplotlib.patches import Patch
+
+    return Patch(facecolor="none", edgecolor=_BLACK, hatch="//",
+                 label=BOUNDARY_KEY["linearly_unstable"]["label"])
 
 
 def _plot_polyline(ax: Axes, line: np.ndarray, key: str, first: dict, zorder: float) -> None:

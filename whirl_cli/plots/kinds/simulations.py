@@ -78,3 +78,17 @@ TIME_HISTORY = PlotKind("time_history", 100, _time_history_panel, missing=_no_si
                         figures=_time_history_files)
 HUB_PATH = PlotKind("hub_path", 110, _hub_path_panel, missing=_no_simulation,
                     figures=_hub_path_files)
+
+
+def _whirl_snapshots_panel(result, ax, choice, caption) -> list[Axes]:
+    """Snapshots of the nacelle axis through the last cycle of a simulation (a sheet panel)."""
+    from ..simulations import whirl_snapshots
+
+    simulation = _chosen(result, choice)
+    whirl_snapshots(simulation, ax=ax,
+                    title=choice.title or caption.simulation_title(simulation))
+    return [ax]
+
+
+#: Panel-only (no files of its own): the thesis's figure of the whirl motion.
+WHIRL_SNAPSHOTS = PlotKind("whirl_snapshots", 115, _whirl_snapshots_panel)
