@@ -214,8 +214,8 @@ def test_sheet_panel_errors_name_sheet_and_panel(tmp_path, continuation):  # noq
 # -- index ---------------------------------------------------------------------------------------
 
 def test_index_lists_figures_in_number_order_escaped():
-    entries = [Entry("3.12", "roots <b>", "", "fig3_12.png", ("s.yaml",), "whirl figures x"),
-               Entry("3.3", "damping", "a note", None, ("t.yaml",), "whirl figures y",
+    entries = [Entry("3.12", "roots <b>", "", "fig3_12.png", ("s.yaml",), "s.yaml"),
+               Entry("3.3", "damping", "a note", None, ("t.yaml",), "t.yaml",
                      "study failed")]
     page = index_html(entries, "whirl figures")
     assert page.index("Figure 3.3") < page.index("Figure 3.12")

@@ -36,6 +36,7 @@ from ..study.schema import (
     Boolean,
     Integer,
     Number,
+    Range,
     Text,
     _as_number,
     _at_most_orbits,
@@ -44,6 +45,7 @@ from ..study.schema import (
     _Strict,
 )
 from ..study.source import _compose, _read_text, _Tree
+from .numbers import POINTS
 
 PanelKind = Literal[PANEL_KINDS]  # the kinds plots.panels.draw draws
 _FIGURE_RE = re.compile(r"\d+(\.\d+)*[a-z]?")
@@ -135,6 +137,42 @@ class PanelSpec(_Strict):
         return self
 
 
+class ThesisNumber(_Strict):
+    """A number the thesis gives for the figure, and the special point of a study's result
+    that is whirl's (for the index's table)."""
+
+    name: Text = Field(description="What the number is, e.g. 'Hopf point HB1'.")
+    value: Number | None = Field(None, description="The thesis's value; unset with `between` "
+                                 "unset: not recovered.")
+    between: Range | None = Field(None, description="The thesis's value as a range [low, "
+                                  "high] (it gives one, e.g. 0.03 to 0.04), instead of `value`.")
+    unit: Text = Field(description="Unit of the value, as whirl stores the parameter's.")
+    point: Literal[POINTS] = Field(description="Type of whirl's special point.")
+    study: Text | None = Field(None, description="Study of whirl's point, one the sheet draws; "
+                               "unset: the first it draws.")
+    continuation: Text | None = Field(None, description="Its continuation; unset: any "
+                                      "one-parameter one.")
+    branch: Text | None = Field(None, description="Its branch; unset: any.")
+    near: Number | None = Field(None, description="Of several, whirl's point nearest this; "
+                                "unset: nearest the thesis's value.")
+
+    @model_validator(mode="after")
+    def _one_value(self) -> ThesisNumber:
+        if self.value is not None and self.between is not None:
+            _fail("give at most one of `value` and `between`")
+        if self.value is None and self.between is None and self.near is None:
+            _fail("give `near` (where whirl's point lies) when the thesis's value is unset")
+        return self
+
+    @property
+    def target(self) -> float:
+        """Where whirl's point is looked for: ``near``, else the thesis's value (the middle
+        of its range)."""
+        if self.near is not None:
+            return self.near
+        return self.value if self.value is not None else sum(self.between) / 2
+
+
 class Sheet(_Strict):
     """One figure of a sheet folder."""
 
@@ -155,6 +193,9 @@ class Sheet(_Strict):
         "limits on this axis (a comparison grid).")
     panels: Annotated[tuple[PanelSpec, ...], BeforeValidator(_panel_count)] = Field(
         description="The panels, row by row.")
+    thesis: tuple[ThesisNumber, ...] = Field(
+        (), description="The thesis's numbers the figure shows, each beside whirl's in the "
+        "index's table.")
 
     _path: Path = PrivateAttr(Path("."))
 
@@ -190,6 +231,10 @@ class Sheet(_Strict):
                     found.append(path)
         return found
 
+    def thesis_study(self, number: ThesisNumber) -> Path:
+        """The study file of whirl's value of ``number``."""
+        return self.resolve(number.study) if number.study else self.studies()[0]
+
     def resolve(self, name: str) -> Path:
         """A study path of the sheet, relative to the sheet's folder, normalised."""
         return Path(os.path.normpath(self._path.parent / name))
@@ -209,6 +254,7 @@ def load_sheet(path: str | os.PathLike[str]) -> Sheet:
     if sheet is not None:
         sheet._path = path
         problems += _missing_studies(sheet)
+        problems += _foreign_thesis_studies(sheet)
         rows, columns = sheet.shape
         if len(sheet.panels) > rows * columns:
             problems.append((("layout",), f"{len(sheet.panels)} panels do not fit a {rows} x "
@@ -240,6 +286,14 @@ def _missing_studies(sheet: Sheet) -> list:
             if not sheet.resolve(name).is_file():
                 problems.append((loc, f"no study file {sheet.resolve(name)}"))
     return problems
+
+
+def _foreign_thesis_studies(sheet: Sheet) -> list:
+    """(key path, reason) of every ``thesis:`` study that no panel of the sheet draws."""
+    drawn = sheet.studies()
+    return [(("thesis", k, "study"), "expected a study a panel of the sheet draws, got "
+             f"{number.study}") for k, number in enumerate(sheet.thesis)
+            if number.study and sheet.resolve(number.study) not in drawn]
 
 
 def find_sheets(paths) -> list[Path]:
