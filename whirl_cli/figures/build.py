@@ -261,14 +261,12 @@ class _Artist:
     def _image(self, sheet: Sheet, key: str) -> tuple[dict[str, bytes] | None, str]:
         """The sheet's file of each format (carrying ``key``), or None and why it cannot be
         drawn."""
-        from ..plots.files import rendered_formats
-        from .draw import draw_sheet
+        from .draw import sheet_files
 
         try:
             for path in sheet.studies():
                 self.result(path)
-            return rendered_formats(draw_sheet(sheet, self.read), self.formats, self.dpi,
-                                    key), ""
+            return sheet_files(sheet, self.read, self.formats, self.dpi, key), ""
         except WhirlError as error:
             return None, str(error)
         except Exception as error:  # noqa: BLE001 - a bug in drawing: this sheet only

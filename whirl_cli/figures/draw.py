@@ -19,6 +19,19 @@ from .sheet import PanelSpec, Sheet
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
+def sheet_files(sheet: Sheet, results: Mapping[Path, StudyResult], formats: tuple[str, ...],
+                dpi: int, key: str | None = None) -> dict[str, bytes]:
+    """The figure of ``sheet`` in each of ``formats`` (:func:`whirl_cli.plots.files.
+    rendered_formats`), drawn and written with the sheet's :attr:`~Sheet.style` (tick labels
+    take their size when written)."""
+    from matplotlib import rc_context
+
+    from ..plots.files import rendered_formats
+
+    with rc_context(sheet.style):
+        return rendered_formats(draw_sheet(sheet, results), formats, dpi, key)
+
+
 def draw_sheet(sheet: Sheet, results: Mapping[Path, StudyResult]) -> Figure:
     """The figure of ``sheet`` from ``results`` (keyed by :meth:`Sheet.resolve` paths):
     panels row by row on the sheet's layout, titled "Figure <number>: <caption>" (legends

@@ -54,6 +54,10 @@ PANEL_SIZE = (5.2, 4.2)
 """Default width and height of one panel, inches."""
 INCHES = (1.0, 40.0)
 """Smallest and largest width or height of a figure, inches (40 in: 6000 pixels at 150 dpi)."""
+COLUMNS = {"single": 3.5, "double": 7.2}
+"""Width in inches of a figure set in one column of a journal page, or across both."""
+COLUMN_FONT_SIZE = 8.0
+"""Text size, points, of a figure set in a journal column (its small text about 6.7 pt)."""
 
 
 _MAX_CUTS = 8
@@ -185,6 +189,10 @@ class Sheet(_Strict):
     size: tuple[Inches, Inches] | None = Field(
         None, description=f"[width, height] in inches, each {INCHES[0]:g} to {INCHES[1]:g}; "
         f"unset: {PANEL_SIZE[0]:g} x {PANEL_SIZE[1]:g} per panel.")
+    column: Literal[tuple(COLUMNS)] | None = Field(
+        None, description=f"Journal column the figure is set in: {COLUMNS['single']:g} in "
+        f"wide (single) or {COLUMNS['double']:g} in (double), as high as `size` (else the "
+        f"panels) in proportion, text at {COLUMN_FONT_SIZE:g} pt; unset: `size`.")
     legends: Literal["all", "first", "figure"] = Field(
         "figure", description="One legend for the figure with every style drawn on it "
         "(below the panels), legends on every panel, or on the first panel only.")
@@ -206,10 +214,20 @@ class Sheet(_Strict):
 
     @property
     def figure_size(self) -> tuple[float, float]:
-        """(width, height) in inches: ``size``, else :data:`PANEL_SIZE` per panel."""
+        """(width, height) in inches: ``size``, else :data:`PANEL_SIZE` per panel; scaled to
+        the width of ``column`` if set."""
         rows, columns = self.shape
-        return tuple(self.size) if self.size else (PANEL_SIZE[0] * columns,
-                                                   PANEL_SIZE[1] * rows)
+        width, height = self.size if self.size else (PANEL_SIZE[0] * columns,
+                                                     PANEL_SIZE[1] * rows)
+        if self.column is None:
+            return width, height
+        return COLUMNS[self.column], COLUMNS[self.column] * height / width
+
+    @property
+    def style(self) -> dict[str, float]:
+        """matplotlib settings the figure is drawn and written with: the text size of a
+        journal column if ``column`` is set."""
+        return {"font.size": COLUMN_FONT_SIZE} if self.column else {}
 
     @property
     def stem(self) -> str:
@@ -266,8 +284,12 @@ def load_sheet(path: str | os.PathLike[str]) -> Sheet:
 
 
 def _default_size_problems(sheet: Sheet) -> list:
-    """A sheet without ``size`` whose panels at their default size make too large a figure."""
+    """A sheet without ``size`` whose panels at their default size make too large a figure,
+    or one set in a column so flat or tall that its height leaves :data:`INCHES`."""
     width, height = sheet.figure_size
+    if sheet.column and not INCHES[0] <= height <= INCHES[1]:
+        return [(("column",), f"{width:g} in wide, the figure would be {height:.3g} in high, "
+                              f"outside {INCHES[0]:g} to {INCHES[1]:g}; change `size`")]
     if sheet.size or max(width, height) <= INCHES[1]:
         return []
     rows, columns = sheet.shape
