@@ -20,6 +20,7 @@ from .key import (
     _plot_styled,
     axis_label,
     branch_style,
+    log_scale_if_decades,
     stability_curves,
 )
 
@@ -188,6 +189,7 @@ def blowup_plot(continuation: ContinuationResult, branch: str | None = None,
                              fit.asymptote - np.sign(run - fit.asymptote) * margin)))
         shown = (x >= min(ax.get_xlim())) & (x <= max(ax.get_xlim()))
         ax.set_ylim(0.95 * float(np.nanmin(period[shown])), top)
+    log_scale_if_decades(ax, "y", ax.get_ylim() if fit is not None else period)
     ax.set_xlabel(axis_label(name, unit))
     ax.set_ylabel(axis_label("period", "s"))
     ax.legend(handles, labels, fontsize="small")
