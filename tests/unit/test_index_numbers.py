@@ -133,3 +133,14 @@ def test_redraw_command_repeats_the_call():
 ])
 def test_invoked_as_is_how_whirl_was_called(argv0, expected):
     assert invoked_as(argv0, "/usr/bin/python3") == expected
+
+
+def test_a_study_without_result_is_the_rows_problem(tmp_path):
+    from whirl_cli.errors import WhirlError
+
+    def failed(path):
+        raise WhirlError(f"{path.name}: AUTO failed")
+
+    sheet = sheet_with(tmp_path, "  - {name: HB1, value: 0.08, unit: N m/rad, point: HB}\n")
+    (row,) = comparisons(sheet, failed)
+    assert (row.whirl, row.problem, row.value) == (None, "a.yaml: AUTO failed", 0.08)

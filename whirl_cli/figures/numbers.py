@@ -5,6 +5,7 @@ table (:func:`comparisons`) with their relative difference."""
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -53,12 +54,15 @@ def whirl_point(result: StudyResult, number: ThesisNumber) -> SpecialPoint:
     return min(points, key=lambda p: abs(float(p.parameters[0]) - number.target))
 
 
-def comparison(figure: str, number: ThesisNumber, result: StudyResult) -> Comparison:
-    """One row of the table: ``number`` beside whirl's value in ``result`` (a row with its
-    problem if whirl has no such point, or stores it in another unit)."""
+def comparison(figure: str, number: ThesisNumber, read: Callable[[], StudyResult]
+               ) -> Comparison:
+    """One row of the table: ``number`` beside whirl's value in the result ``read`` returns
+    (a row with its problem if there is no result, whirl has no such point or stores it in
+    another unit)."""
     row = Comparison(figure, number.name, number.value, number.between, number.unit,
                      number.point)
     try:
+        result = read()
         point = whirl_point(result, number)
     except WhirlError as error:
         return row._replace(problem=str(error))
@@ -75,13 +79,5 @@ def comparison(figure: str, number: ThesisNumber, result: StudyResult) -> Compar
 def comparisons(sheet: Sheet, read: Callable[[Path], StudyResult]) -> list[Comparison]:
     """The rows of ``sheet``'s ``thesis:`` entries, whirl's values from ``read`` (a study path
     -> its result; a WhirlError there is the row's problem)."""
-    rows = []
-    for number in sheet.thesis:
-        try:
-            result = read(sheet.thesis_study(number))
-        except WhirlError as error:
-            rows.append(Comparison(sheet.figure, number.name, number.value, number.between,
-                                   number.unit, number.point, problem=str(error)))
-            continue
-        rows.append(comparison(sheet.figure, number, result))
-    return rows
+    return [comparison(sheet.figure, number, partial(read, sheet.thesis_study(number)))
+            for number in sheet.thesis]
