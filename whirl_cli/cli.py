@@ -608,6 +608,19 @@ def sweep(paths: tuple[Path, ...], out_dir: Path, jobs: int, dask_address: str |
 
 
 # ------------------------------------------------------------------------------------ figures
+def invoked_as(argv0: str, executable: str) -> str:
+    """The shell words that call whirl as this process was called: the console script's path
+    as typed (e.g. ``.venv/bin/whirl``), ``<python> -m whirl_cli``, else ``whirl``."""
+    import shlex
+
+    name = os.path.basename(argv0)
+    if name == "whirl":
+        return shlex.quote(argv0)
+    if name == "__main__.py" and os.path.basename(os.path.dirname(argv0)) == "whirl_cli":
+        return shlex.join([executable, "-m", "whirl_cli"])
+    return "whirl"
+
+
 @cli.command()
 @click.argument("paths", nargs=-1, required=True, type=click.Path(path_type=Path))
 @click.option("-o", "--output", "--out-dir", "out_dir",
@@ -633,7 +646,8 @@ def figures(paths: tuple[Path, ...], out_dir: Path, results_dir: Path, jobs: int
 
     try:
         outcomes = make_figures(paths, out_dir, results_dir, jobs=jobs, force=force,
-                                console=_console(), formats=formats)
+                                console=_console(), formats=formats,
+                                program=invoked_as(sys.argv[0], sys.executable))
     except KeyboardInterrupt as error:
         click.echo("interrupted", err=True)
         raise SystemExit(128 + getattr(error, "signum", 2)) from None

@@ -148,3 +148,60 @@ def test_piped_figures_say_when_each_study_starts_and_ends(tmp_path):
         started = [k for k, line in enumerate(lines) if line.split() == ["start", name]]
         ended = [k for k, line in enumerate(lines) if line.split()[1:3] == ["ok", name]]
         assert len(started) == len(ended) == 1 and started[0] < ended[0], lines
+
+
+def test_index_numbers_are_the_results_and_the_sheets_and_its_command_redraws(tmp_path):
+    """Two shipped sheets (3.5, 3.14) with their studies, drawn by the console script from
+    their folder as `make figures` does: the index's table holds each sheet's `thesis:` values
+    and, beside them, the special points stored in the result files (read with h5py); its
+    redraw command, run as printed from that folder, redraws nothing and succeeds."""
+    import html
+    import re
+    import subprocess
+
+    import yaml
+
+    from ..robustness.helpers import WHIRL, environment
+
+    copy_studies(tmp_path / "studies" / "thesis_ch3",
+                 ("linear_case2", "linear_ktheta", "linear_datum_airspeed"))
+    sheets = tmp_path / "sheets" / "thesis_ch3"
+    sheets.mkdir(parents=True)
+    for name in ("fig3_5", "fig3_14"):
+        (sheets / f"{name}.yaml").write_text(
+            (ROOT / "sheets" / "thesis_ch3" / f"{name}.yaml").read_text())
+    command = [str(WHIRL), "figures", "sheets/thesis_ch3", "-o", "figs", "--results", "res"]
+    done = subprocess.run(command, cwd=tmp_path, env=environment(), capture_output=True,
+                          text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    page = (tmp_path / "figs" / "index.html").read_text()
+
+    declared = {}
+    for name in ("fig3_5", "fig3_14"):
+        sheet = yaml.safe_load((sheets / f"{name}.yaml").read_text())
+        for number in sheet["thesis"]:
+            study = number.get("study", sheet["panels"][0]["study"])
+            declared[number["name"]] = (number, Path(study).stem.replace("_", "-"))
+    rows = re.findall(r"<tr><td><a [^>]*>([\d.]+)</a></td><td>([^<]*)</td><td>(\w+)</td>"
+                      r'<td class="n">([^<]*)</td><td class="n" data-value="([^"]+)">', page)
+    assert sorted(html.unescape(r[1]) for r in rows) == sorted(declared)
+    for _, name, point, thesis, whirl in rows:
+        number, stem = declared[html.unescape(name)]
+        assert point == number["point"]
+        expected = (f"{number['between'][0]:g} to {number['between'][1]:g}"
+                    if "between" in number else f"{number['value']:g}")
+        assert thesis == expected
+        with h5py.File(tmp_path / "res" / f"{stem}.h5") as stored:
+            (group,) = stored["continuations"].values()
+            points = group["special_points"]
+            values = [float(v) for v, kind in zip(points["parameters"][:, 0],
+                                                  points["type_name"][()], strict=True)
+                      if kind.decode() == point]
+        assert float(whirl) in values
+
+    redraw = html.unescape(re.search(r"<li>redraw: <code>([^<]*)</code>", page).group(1))
+    assert redraw == " ".join(command)
+    again = subprocess.run(redraw, shell=True, cwd=tmp_path, env=environment(),
+                           capture_output=True, text=True, timeout=300)
+    assert again.returncode == 0, again.stderr
+    assert "2 of 2 figures (2 up to date, not redrawn)" in again.stdout

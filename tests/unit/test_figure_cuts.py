@@ -212,7 +212,7 @@ def test_index_lists_thumbnails_linked_and_what_made_the_figures():
     from whirl_cli.figures.index import Entry, index_html
 
     page = index_html([Entry("3.16", "cuts", "one orbit per cut", "fig3_16.png", ("s.yaml",),
-                             "whirl figures s.yaml -o out")], "whirl figures",
+                             "s.yaml")], "whirl figures",
                       {"whirl": "0.1.0", "commit": "abc123", "engine": "0.9.2"})
     assert '<a href="#fig3.16"><img src="fig3_16.png"' in page  # the contents' thumbnail
     assert '<a href="fig3_16.png"><img src="fig3_16.png"' in page  # full size

@@ -214,8 +214,8 @@ def test_sheet_panel_errors_name_sheet_and_panel(tmp_path, continuation):  # noq
 # -- index ---------------------------------------------------------------------------------------
 
 def test_index_lists_figures_in_number_order_escaped():
-    entries = [Entry("3.12", "roots <b>", "", "fig3_12.png", ("s.yaml",), "whirl figures x"),
-               Entry("3.3", "damping", "a note", None, ("t.yaml",), "whirl figures y",
+    entries = [Entry("3.12", "roots <b>", "", "fig3_12.png", ("s.yaml",), "s.yaml"),
+               Entry("3.3", "damping", "a note", None, ("t.yaml",), "t.yaml",
                      "study failed")]
     page = index_html(entries, "whirl figures")
     assert page.index("Figure 3.3") < page.index("Figure 3.12")
@@ -265,3 +265,27 @@ def test_simulation_panels_one_axes_per_dof_and_a_hub_path(continuation):  # noq
     assert hub.get_xlabel() == "hub y [deg]"
     with pytest.raises(WhirlError, match="no simulation 'other' \\(simulations: kick\\)"):
         draw(result, "hub_path", _new_figure().add_subplot(), PanelChoice(simulation="other"))
+
+
+@pytest.mark.parametrize("size, font", [(7.2, 8.0), (12.0, 10.0)])
+def test_figure_legend_takes_as_many_columns_as_its_labels_fit(size, font):
+    """The columns of the figure legend come from its labels' measured width at the text size
+    drawn: more than one where they fit, the legend within the figure."""
+    from matplotlib import rc_context
+
+    from whirl_cli.figures.draw import figure_legend
+
+    labels = ["stable equilibrium", "neutral equilibria (zero eigenvalue)",
+              "damping ratio 0 ($K_\\theta$ = 0.08071 N m/rad)", "Hopf (HB)", "BW", "FW"]
+    with rc_context({"font.size": font}):
+        figure = _new_figure(figsize=(size, 4.0))
+        for k, ax in enumerate(figure.subplots(1, 2)):
+            for label in labels[3 * k:3 * k + 3]:
+                ax.plot([0, 1], [0, k], label=label)
+            ax.legend()
+        figure_legend(figure)
+        (legend,) = figure.legends
+        figure.canvas.draw()
+        box = legend.get_window_extent()
+    assert legend._ncols >= 2  # one column (the count at 10 pt) made 3.14's legend as tall
+    assert 0 <= box.x0 and box.x1 <= figure.bbox.width  # as its panels at 7.2 in

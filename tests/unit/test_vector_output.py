@@ -73,3 +73,55 @@ def test_unknown_format_is_refused(tmp_path, given):
     done = CliRunner().invoke(cli, ["figures", str(tmp_path), "--format", given])
     assert done.exit_code == 2
     assert "expected formats among png, pdf, svg" in done.output
+
+
+def text_sizes(pdf: bytes) -> list[float]:
+    """The size of every text the PDF sets (its ``Tf`` operators), points."""
+    import zlib
+
+    sizes = []
+    for stream in re.findall(rb"stream\r?\n(.*?)\r?\nendstream", pdf, re.S):
+        try:
+            content = zlib.decompress(stream)
+        except zlib.error:
+            continue
+        sizes += [float(s) for s in re.findall(rb"/F\d+ ([\d.]+) Tf", content)]
+    return sizes
+
+
+@pytest.mark.parametrize("column, width", [("single", 3.5), ("double", 7.2)])
+def test_a_sheet_set_in_a_journal_column_is_that_wide_with_legible_text(
+        tmp_path, continuation, column, width):  # noqa: F811
+    from whirl_cli.figures.draw import sheet_files
+    from whirl_cli.figures.sheet import load_sheet
+
+    from .test_sheets import STUDY, result_with
+
+    (tmp_path / "a.yaml").write_text(STUDY)
+    (tmp_path / "f.yaml").write_text(
+        f'figure: "3.1"\ncaption: a bifurcation diagram and its period\ncolumn: {column}\n'
+        "layout: [2, 1]\nsize: [6, 7]\npanels:\n  - {kind: bifurcation, study: a.yaml}\n"
+        "  - {kind: period, study: a.yaml}\n")
+    sheet = load_sheet(tmp_path / "f.yaml")
+    assert sheet.figure_size == pytest.approx((width, width * 7 / 6))
+    files = sheet_files(sheet, {tmp_path / "a.yaml": result_with(continuation, 10.0)},
+                        ("png", "pdf", "svg"), 100)
+    check_pdf(files["pdf"])
+    check_svg(files["svg"])
+    box = re.search(rb"/MediaBox \[\s*0 0 ([\d.]+) ([\d.]+)\s*\]", files["pdf"])
+    assert float(box.group(1)) == pytest.approx(72 * width)
+    sizes = text_sizes(files["pdf"])
+    assert sizes and 6 <= min(sizes) and max(sizes) <= 9, sorted(set(sizes))
+
+
+def test_a_column_too_flat_for_its_size_is_refused(tmp_path):
+    from whirl_cli.errors import StudyError
+    from whirl_cli.figures.sheet import load_sheet
+
+    (tmp_path / "a.yaml").write_text("name: s\nmodel: classical\n")
+    (tmp_path / "f.yaml").write_text(
+        'figure: "3.1"\ncaption: c\ncolumn: single\nsize: [40, 5]\n'
+        "panels:\n  - {kind: bifurcation, study: a.yaml}\n")
+    with pytest.raises(StudyError, match=r"f.yaml:3: column: 3.5 in wide, the figure would be "
+                                         r"0.438 in high, outside 1 to 40; change `size`"):
+        load_sheet(tmp_path / "f.yaml")

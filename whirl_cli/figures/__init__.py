@@ -7,8 +7,9 @@ studies they name as one sweep (reusing up-to-date results), draws each sheet to
 
 Modules, lowest first:
 
-* :mod:`~whirl_cli.figures.sheet` -- sheet files, read and checked like studies;
 * :mod:`~whirl_cli.figures.index` -- the index page (pure text);
+* :mod:`~whirl_cli.figures.numbers` -- the thesis's numbers beside whirl's, for the index;
+* :mod:`~whirl_cli.figures.sheet` -- sheet files, read and checked like studies;
 * :mod:`~whirl_cli.figures.draw` -- one sheet as one matplotlib Figure
   (:mod:`whirl_cli.plots.panels` draws each panel);
 * :mod:`~whirl_cli.figures.build` -- run, draw, publish and index.

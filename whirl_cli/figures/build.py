@@ -13,7 +13,9 @@ index (:func:`make_figures`).
    reported and left out, the others are drawn. A figure is not redrawn when its PNG holds the
    same key (:func:`figure_key`: the sheet's text, whirl's code, the resolution and the result
    files it draws);
-4. ``<out>/index.html`` lists every figure with its caption, studies and command.
+4. ``<out>/index.html`` lists every figure with its caption, studies and sheet, the thesis's
+   numbers beside whirl's (the sheets' ``thesis:`` entries) and the command that redraws
+   the figures.
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ from ..errors import StudyError, WhirlError
 from ..kinds import SweepStatus
 from ..results import StudyResult
 from .index import Entry, figure_order, index_html
+from .numbers import comparisons
 from .sheet import Sheet, find_sheets, load_sheet
 
 KEY = "whirl-figure-key"
@@ -102,10 +105,12 @@ def _figure_and_caption(path: Path) -> tuple[str, str]:
 
 def make_figures(paths: Sequence[str | os.PathLike[str]], out_dir: Path, results_dir: Path,
                  jobs: int = 1, force: bool = False, console=None, dpi: int = 150,
-                 formats: Sequence[str] = DEFAULT_FORMATS) -> list[FigureOutcome]:
+                 formats: Sequence[str] = DEFAULT_FORMATS, program: str = "whirl"
+                 ) -> list[FigureOutcome]:
     """Run, draw and index (module docstring); the outcome of every sheet, in figure order.
     Each figure is written in every format of ``formats`` (:data:`whirl_cli.plots.files.
-    FORMATS`; the PNG always, the index shows it).
+    FORMATS`; the PNG always, the index shows it). The index's redraw command starts with
+    ``program`` (how whirl was called).
 
     While a worker is idle (no study left waiting for one), each study stored lets one sheet
     whose studies are all stored be drawn, so sheets of the short studies are drawn while the
@@ -137,11 +142,24 @@ def make_figures(paths: Sequence[str | os.PathLike[str]], out_dir: Path, results
     outcomes = [artist.outcome(sheet) for sheet in sheets]
     outcomes += [FigureOutcome(sheet, None, sheet.problem) for sheet in refused]
     outcomes.sort(key=lambda o: figure_order(o.sheet.figure))
-    page = index_html([_entry(o, out_dir) for o in outcomes], "whirl figures",
-                      _about(artist.read.values()))
+    numbers = tuple(row for sheet in sheets for row in comparisons(sheet, artist.result))
+    redraw = redraw_command(program, paths, out_dir, results_dir, formats)
+    page = index_html([_entry(o) for o in outcomes], "whirl figures",
+                      _about(artist.read.values()), numbers, redraw)
     publish(page.encode("utf-8"), out_dir / "index.html", overwrite=True, what="the index",
             own=PAGE)
     return outcomes
+
+
+def redraw_command(program: str, paths: Sequence[str | os.PathLike[str]], out_dir: Path,
+                   results_dir: Path, formats: Sequence[str]) -> str:
+    """The shell command that draws the figures again as this call did (from the same
+    folder; up-to-date results and figures are reused)."""
+    words = [*shlex.split(program), "figures", *map(str, paths), "-o", str(out_dir),
+             "--results", str(results_dir)]
+    if tuple(formats) != DEFAULT_FORMATS:
+        words += ["--format", ",".join(formats)]
+    return shlex.join(words)
 
 
 def _about(results) -> dict[str, str]:
@@ -231,19 +249,26 @@ class _Artist:
             return key, FigureOutcome(sheet, target, reused=True)
         return key, None
 
+    def result(self, path: Path) -> StudyResult:
+        """The stored result of the study at ``path`` (read once); a WhirlError says why
+        there is none."""
+        from ..output import store
+
+        if path not in self.read:
+            if path not in self.outputs:
+                raise WhirlError(self.failed.get(path, f"{path}: no result"))
+            self.read[path] = store.read(self.outputs[path])
+        return self.read[path]
+
     def _image(self, sheet: Sheet, key: str) -> tuple[dict[str, bytes] | None, str]:
         """The sheet's file of each format (carrying ``key``), or None and why it cannot be
         drawn."""
-        from ..output import store
-        from ..plots.files import rendered_formats
-        from .draw import draw_sheet
+        from .draw import sheet_files
 
         try:
             for path in sheet.studies():
-                if path not in self.read:
-                    self.read[path] = store.read(self.outputs[path])
-            return rendered_formats(draw_sheet(sheet, self.read), self.formats, self.dpi,
-                                    key), ""
+                self.result(path)
+            return sheet_files(sheet, self.read, self.formats, self.dpi, key), ""
         except WhirlError as error:
             return None, str(error)
         except Exception as error:  # noqa: BLE001 - a bug in drawing: this sheet only
@@ -314,9 +339,8 @@ def stored_key(path: Path) -> str | None:
     return None
 
 
-def _entry(outcome: FigureOutcome, out_dir: Path) -> Entry:
+def _entry(outcome: FigureOutcome) -> Entry:
     sheet = outcome.sheet
-    command = f"whirl figures {shlex.quote(str(sheet.path))} -o {shlex.quote(str(out_dir))}"
     return Entry(sheet.figure, sheet.caption, sheet.note,
                  outcome.image.name if outcome.image else None,
-                 tuple(str(p) for p in sheet.studies()), command, outcome.problem)
+                 tuple(str(p) for p in sheet.studies()), str(sheet.path), outcome.problem)

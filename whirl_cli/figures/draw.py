@@ -19,6 +19,19 @@ from .sheet import PanelSpec, Sheet
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
+def sheet_files(sheet: Sheet, results: Mapping[Path, StudyResult], formats: tuple[str, ...],
+                dpi: int, key: str | None = None) -> dict[str, bytes]:
+    """The figure of ``sheet`` in each of ``formats`` (:func:`whirl_cli.plots.files.
+    rendered_formats`), drawn and written with the sheet's :attr:`~Sheet.style` (tick labels
+    take their size when written)."""
+    from matplotlib import rc_context
+
+    from ..plots.files import rendered_formats
+
+    with rc_context(sheet.style):
+        return rendered_formats(draw_sheet(sheet, results), formats, dpi, key)
+
+
 def draw_sheet(sheet: Sheet, results: Mapping[Path, StudyResult]) -> Figure:
     """The figure of ``sheet`` from ``results`` (keyed by :meth:`Sheet.resolve` paths):
     panels row by row on the sheet's layout, titled "Figure <number>: <caption>" (legends
@@ -47,8 +60,21 @@ def draw_sheet(sheet: Sheet, results: Mapping[Path, StudyResult]) -> Figure:
     return figure
 
 
-_CHAR_INCHES = 0.075  # width of a character of a small legend text (an upper bound)
-_ENTRY_INCHES = 0.7  # a legend entry's handle and gaps
+_ENTRY_EMS = 2.0 + 0.8 + 2.0  # a legend entry's handle, its gap to the text, the column gap
+
+
+def _legend_columns(labels: list[str], width: float) -> int:
+    """How many columns of ``labels`` (small text, at the current font size) fit in 95 % of
+    ``width`` inches, each as wide as the widest entry (measured as its glyphs' outlines)."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import TextToPath
+
+    font = FontProperties(size="small")
+    points = font.get_size_in_points()
+    measure = TextToPath().get_text_width_height_descent
+    widest = max(measure(label, font, ismath=label.count("$") >= 2)[0] for label in labels)
+    entry = (widest + _ENTRY_EMS * points) / 72.0
+    return max(1, min(len(labels), int(0.95 * width / entry)))
 
 
 def figure_legend(figure: Figure) -> None:
@@ -64,10 +90,7 @@ def figure_legend(figure: Figure) -> None:
         legend.remove()
     if not entries:
         return
-    width = figure.get_size_inches()[0]
-    longest = max(len(label) for label in entries)
-    columns = max(1, min(len(entries), int(0.95 * width / (_ENTRY_INCHES + _CHAR_INCHES
-                                                               * longest))))
+    columns = _legend_columns(list(entries), figure.get_size_inches()[0])
     figure.legend(list(entries.values()), list(entries), loc="outside lower center",
                   ncols=columns, fontsize="small", frameon=False)
 

@@ -36,6 +36,7 @@ from ..study.schema import (
     Boolean,
     Integer,
     Number,
+    Range,
     Text,
     _as_number,
     _at_most_orbits,
@@ -44,6 +45,7 @@ from ..study.schema import (
     _Strict,
 )
 from ..study.source import _compose, _read_text, _Tree
+from .numbers import POINTS
 
 PanelKind = Literal[panel_kinds()]  # the kinds plots.panels.draw draws
 _FIGURE_RE = re.compile(r"\d+(\.\d+)*[a-z]?")
@@ -52,6 +54,10 @@ PANEL_SIZE = (5.2, 4.2)
 """Default width and height of one panel, inches."""
 INCHES = (1.0, 40.0)
 """Smallest and largest width or height of a figure, inches (40 in: 6000 pixels at 150 dpi)."""
+COLUMNS = {"single": 3.5, "double": 7.2}
+"""Width in inches of a figure set in one column of a journal page, or across both."""
+COLUMN_FONT_SIZE = 8.0
+"""Text size, points, of a figure set in a journal column (its small text about 6.7 pt)."""
 
 
 _MAX_CUTS = 8
@@ -135,6 +141,42 @@ class PanelSpec(_Strict):
         return self
 
 
+class ThesisNumber(_Strict):
+    """A number the thesis gives for the figure, and the special point of a study's result
+    that is whirl's (for the index's table)."""
+
+    name: Text = Field(description="What the number is, e.g. 'Hopf point HB1'.")
+    value: Number | None = Field(None, description="The thesis's value; unset with `between` "
+                                 "unset: not recovered.")
+    between: Range | None = Field(None, description="The thesis's value as a range [low, "
+                                  "high] (it gives one, e.g. 0.03 to 0.04), instead of `value`.")
+    unit: Text = Field(description="Unit of the value, as whirl stores the parameter's.")
+    point: Literal[POINTS] = Field(description="Type of whirl's special point.")
+    study: Text | None = Field(None, description="Study of whirl's point, one the sheet draws; "
+                               "unset: the first it draws.")
+    continuation: Text | None = Field(None, description="Its continuation; unset: any "
+                                      "one-parameter one.")
+    branch: Text | None = Field(None, description="Its branch; unset: any.")
+    near: Number | None = Field(None, description="Of several, whirl's point nearest this; "
+                                "unset: nearest the thesis's value.")
+
+    @model_validator(mode="after")
+    def _one_value(self) -> ThesisNumber:
+        if self.value is not None and self.between is not None:
+            _fail("give at most one of `value` and `between`")
+        if self.value is None and self.between is None and self.near is None:
+            _fail("give `near` (where whirl's point lies) when the thesis's value is unset")
+        return self
+
+    @property
+    def target(self) -> float:
+        """Where whirl's point is looked for: ``near``, else the thesis's value (the middle
+        of its range)."""
+        if self.near is not None:
+            return self.near
+        return self.value if self.value is not None else sum(self.between) / 2
+
+
 class Sheet(_Strict):
     """One figure of a sheet folder."""
 
@@ -147,6 +189,10 @@ class Sheet(_Strict):
     size: tuple[Inches, Inches] | None = Field(
         None, description=f"[width, height] in inches, each {INCHES[0]:g} to {INCHES[1]:g}; "
         f"unset: {PANEL_SIZE[0]:g} x {PANEL_SIZE[1]:g} per panel.")
+    column: Literal[tuple(COLUMNS)] | None = Field(
+        None, description=f"Journal column the figure is set in: {COLUMNS['single']:g} in "
+        f"wide (single) or {COLUMNS['double']:g} in (double), as high as `size` (else the "
+        f"panels) in proportion, text at {COLUMN_FONT_SIZE:g} pt; unset: `size`.")
     legends: Literal["all", "first", "figure"] = Field(
         "figure", description="One legend for the figure with every style drawn on it "
         "(below the panels), legends on every panel, or on the first panel only.")
@@ -155,6 +201,9 @@ class Sheet(_Strict):
         "limits on this axis (a comparison grid).")
     panels: Annotated[tuple[PanelSpec, ...], BeforeValidator(_panel_count)] = Field(
         description="The panels, row by row.")
+    thesis: tuple[ThesisNumber, ...] = Field(
+        (), description="The thesis's numbers the figure shows, each beside whirl's in the "
+        "index's table.")
 
     _path: Path = PrivateAttr(Path("."))
 
@@ -165,10 +214,20 @@ class Sheet(_Strict):
 
     @property
     def figure_size(self) -> tuple[float, float]:
-        """(width, height) in inches: ``size``, else :data:`PANEL_SIZE` per panel."""
+        """(width, height) in inches: ``size``, else :data:`PANEL_SIZE` per panel; scaled to
+        the width of ``column`` if set."""
         rows, columns = self.shape
-        return tuple(self.size) if self.size else (PANEL_SIZE[0] * columns,
-                                                   PANEL_SIZE[1] * rows)
+        width, height = self.size if self.size else (PANEL_SIZE[0] * columns,
+                                                     PANEL_SIZE[1] * rows)
+        if self.column is None:
+            return width, height
+        return COLUMNS[self.column], COLUMNS[self.column] * height / width
+
+    @property
+    def style(self) -> dict[str, float]:
+        """matplotlib settings the figure is drawn and written with: the text size of a
+        journal column if ``column`` is set."""
+        return {"font.size": COLUMN_FONT_SIZE} if self.column else {}
 
     @property
     def stem(self) -> str:
@@ -190,6 +249,10 @@ class Sheet(_Strict):
                     found.append(path)
         return found
 
+    def thesis_study(self, number: ThesisNumber) -> Path:
+        """The study file of whirl's value of ``number``."""
+        return self.resolve(number.study) if number.study else self.studies()[0]
+
     def resolve(self, name: str) -> Path:
         """A study path of the sheet, relative to the sheet's folder, normalised."""
         return Path(os.path.normpath(self._path.parent / name))
@@ -209,6 +272,7 @@ def load_sheet(path: str | os.PathLike[str]) -> Sheet:
     if sheet is not None:
         sheet._path = path
         problems += _missing_studies(sheet)
+        problems += _foreign_thesis_studies(sheet)
         rows, columns = sheet.shape
         if len(sheet.panels) > rows * columns:
             problems.append((("layout",), f"{len(sheet.panels)} panels do not fit a {rows} x "
@@ -220,8 +284,12 @@ def load_sheet(path: str | os.PathLike[str]) -> Sheet:
 
 
 def _default_size_problems(sheet: Sheet) -> list:
-    """A sheet without ``size`` whose panels at their default size make too large a figure."""
+    """A sheet without ``size`` whose panels at their default size make too large a figure,
+    or one set in a column so flat or tall that its height leaves :data:`INCHES`."""
     width, height = sheet.figure_size
+    if sheet.column and not INCHES[0] <= height <= INCHES[1]:
+        return [(("column",), f"{width:g} in wide, the figure would be {height:.3g} in high, "
+                              f"outside {INCHES[0]:g} to {INCHES[1]:g}; change `size`")]
     if sheet.size or max(width, height) <= INCHES[1]:
         return []
     rows, columns = sheet.shape
@@ -240,6 +308,14 @@ def _missing_studies(sheet: Sheet) -> list:
             if not sheet.resolve(name).is_file():
                 problems.append((loc, f"no study file {sheet.resolve(name)}"))
     return problems
+
+
+def _foreign_thesis_studies(sheet: Sheet) -> list:
+    """(key path, reason) of every ``thesis:`` study that no panel of the sheet draws."""
+    drawn = sheet.studies()
+    return [(("thesis", k, "study"), "expected a study a panel of the sheet draws, got "
+             f"{number.study}") for k, number in enumerate(sheet.thesis)
+            if number.study and sheet.resolve(number.study) not in drawn]
 
 
 def find_sheets(paths) -> list[Path]:

@@ -20,6 +20,7 @@ from .key import (
     _plot_styled,
     axis_label,
     branch_style,
+    log_scale_if_decades,
     stability_curves,
     symbol,
 )
@@ -186,6 +187,7 @@ def blowup_plot(continuation: ContinuationResult, branch: str | None = None,
         shown = (x >= min(ax.get_xlim())) & (x <= max(ax.get_xlim()))
         ax.set_ylim(0.95 * float(np.nanmin(period[shown])), top)
         _zoom_approach(ax, continuation, family, global_point, fit, top)
+    log_scale_if_decades(ax, "y", ax.get_ylim() if fit is not None else period)
     ax.set_xlabel(axis_label(name, unit))
     ax.set_ylabel(axis_label("period", "s"))
     ax.legend(handles, labels, fontsize="small")

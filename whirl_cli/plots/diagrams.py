@@ -24,6 +24,7 @@ from .key import (
     branch_style,
     display_unit,
     is_neutral_line,
+    log_scale_if_decades,
     stability_curves,
 )
 
@@ -35,7 +36,6 @@ if TYPE_CHECKING:
 _PERIOD_POINTS = (PointType.HB, PointType.LPC, PointType.PD, PointType.TR, PointType.BPC,
                   PointType.HOMOCLINIC, PointType.HETEROCLINIC)
 _GLOBAL_POINTS = (PointType.HOMOCLINIC, PointType.HETEROCLINIC)
-_LOG_SPAN = 20.0  # period plots switch to a log y-axis above this max/min ratio
 
 
 def bifurcation_diagram(continuation: ContinuationResult, state: str | None = None,
@@ -256,8 +256,7 @@ def period_plot(continuation: ContinuationResult, title: str | None = None,
                               label="_bracket")
         handles.append(bar)
         labels.append("bracket (global bifurcation)")
-    if periods.size and periods.max() > _LOG_SPAN * periods.min():
-        ax.set_yscale("log")
+    log_scale_if_decades(ax, "y", periods)
     if periodic:
         ax.set_xlabel(axis_label(periodic[0].parameter_names[0], periodic[0].parameter_units[0]))
     ax.set_ylabel(axis_label("period", "s"))

@@ -14,6 +14,7 @@ from .key import (
     _plot_styled,
     axis_label,
     branch_style,
+    log_scale_if_decades,
     stability_curves,
 )
 
@@ -42,12 +43,14 @@ def amplitude_diagram(continuation: ContinuationResult, ax: Axes | None = None) 
     estimate = None
     onsets: set[float] = set()
     dofs = []
+    ratios = []
     x_label = None
     for found in continuation.freeplay:
         branch = by_name.get(found.branch)
         if branch is None:
             continue
         dofs.append(found.dof)
+        ratios.append(found.amplitude_ratio)
         x_label = axis_label(branch.parameter_names[0], branch.parameter_units[0])
         for xs, ys, stable in stability_curves(branch.parameters[:, 0], found.amplitude_ratio,
                                                  branch.stable, branch.stability_known):
@@ -70,7 +73,8 @@ def amplitude_diagram(continuation: ContinuationResult, ax: Axes | None = None) 
         ax.axhline(1.0, color="grey", linestyle=":", linewidth=0.8)
         ax.set_xlabel(x_label)
         ax.set_ylabel(axis_label(f"A/delta of {', '.join(sorted(set(dofs)))}", "1"))
-        ax.set_ylim(bottom=0.0)
+        if not log_scale_if_decades(ax, "y", np.concatenate(ratios)):
+            ax.set_ylim(bottom=0.0)
     if handles:
         ax.legend(handles, labels, fontsize="small")
     ax.set_title(f"{continuation.name}: amplitude in half-gaps")

@@ -267,6 +267,27 @@ def axis_label(name: str, unit: str) -> str:
     return _plain_axis_label(symbol(head) + sep + tail, unit)
 
 
+DECADES = 20.0
+"""An axis whose values are all positive and whose largest is more than this many times its
+smallest is drawn on a log scale (:func:`log_scale_if_decades`)."""
+
+
+def spans_decades(values) -> bool:
+    """True if the finite ``values`` are all positive and max/min exceeds :data:`DECADES`."""
+    values = np.asarray(values, dtype=float).ravel()
+    values = values[np.isfinite(values)]
+    return bool(values.size and values.min() > 0 and values.max() > DECADES * values.min())
+
+
+def log_scale_if_decades(ax: Axes, axis: str, values) -> bool:
+    """Put ``ax``'s ``axis`` ("x" or "y") on a log scale if ``values`` (what it shows)
+    :func:`span decades <spans_decades>`; True if it did."""
+    if not spans_decades(values):
+        return False
+    getattr(ax, f"set_{axis}scale")("log")
+    return True
+
+
 def _plot_styled(ax: Axes, x: np.ndarray, y: np.ndarray, style: str, first: dict) -> None:
     """Plot with ``PLOT_KEY[style]``; remember the first artist of each style for the legend."""
     kwargs = dict(PLOT_KEY[style])

@@ -13,7 +13,15 @@ import numpy as np
 from ..errors import WhirlError
 from ..results import Boundary, ContinuationKind, ContinuationResult, LinearGrid
 from .diagrams import _checked_branches, _draw_bifurcation
-from .key import _BLACK, _UNSAFE_LABEL, BOUNDARY_KEY, _new_figure, _patch_proxy, axis_label
+from .key import (
+    _BLACK,
+    _UNSAFE_LABEL,
+    BOUNDARY_KEY,
+    _new_figure,
+    _patch_proxy,
+    axis_label,
+    log_scale_if_decades,
+)
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -186,29 +194,43 @@ def _draw_loci(ax: Axes, boundary: Boundary, first: dict) -> None:
 
 
 def _set_map_limits(ax: Axes, boundary: Boundary | None, grid: LinearGrid | None) -> None:
-    """Grid extent; else loci extent (polygons if no loci) with a margin; else leave as is."""
+    """Grid extent; else loci extent (polygons if no loci) with a margin; else leave as is.
+    An axis whose extent spans decades is logarithmic (:func:`log_scale_if_decades`), its
+    margin then a factor."""
+    extent = _map_extent(boundary, grid)
+    if extent is None:
+        return
+    for axis, (low, high) in zip("xy", extent[:2], strict=True):
+        margin = extent[2]
+        if log_scale_if_decades(ax, axis, (low, high)):
+            factor = (high / low) ** margin
+            low, high = low / factor, high * factor
+        else:
+            low, high = low - margin * (high - low), high + margin * (high - low)
+        if high > low:
+            getattr(ax, f"set_{axis}lim")(float(low), float(high))
+
+
+def _map_extent(boundary: Boundary | None, grid: LinearGrid | None):
+    """((x low, x high), (y low, y high), margin): the grid's extent (no margin), else the
+    loci's (the polygons' if no loci; :data:`_LIMIT_MARGIN`); None: nothing to bound."""
     if grid is not None and len(grid.x) and len(grid.y):
-        ax.set_xlim(float(np.min(grid.x)), float(np.max(grid.x)))
-        ax.set_ylim(float(np.min(grid.y)), float(np.max(grid.y)))
-        return
+        return ((float(np.min(grid.x)), float(np.max(grid.x))),
+                (float(np.min(grid.y)), float(np.max(grid.y))), 0.0)
     if boundary is None:
-        return
+        return None
     curves = [np.asarray(c, dtype=float) for kind, c in boundary.loci.values()
               if kind in _LOCUS_KINDS]
     if not any(c.ndim == 2 and len(c) >= 2 for c in curves):
         curves = [np.asarray(p, dtype=float) for p in boundary.polygons]
     points = [c for c in curves if c.ndim == 2 and c.shape[1] == 2 and len(c)]
     if not points:
-        return
+        return None
     xy = np.concatenate(points)
     xy = xy[np.isfinite(xy).all(axis=1)]
     if not len(xy):
-        return
-    for setter, low, high in ((ax.set_xlim, xy[:, 0].min(), xy[:, 0].max()),
-                              (ax.set_ylim, xy[:, 1].min(), xy[:, 1].max())):
-        pad = _LIMIT_MARGIN * (high - low)
-        if pad > 0:
-            setter(float(low - pad), float(high + pad))
+        return None
+    return ((xy[:, 0].min(), xy[:, 0].max()), (xy[:, 1].min(), xy[:, 1].max()), _LIMIT_MARGIN)
 
 
 def _draw_cases(ax: Axes, cases: Sequence[float], labels: Sequence[str] = ()) -> None:
