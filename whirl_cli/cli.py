@@ -336,7 +336,7 @@ def check(result_file: Path) -> None:
     from .study import stored_study
 
     result = api.read(result_file)
-    study = stored_study(result.attributes, result_file.name)
+    study = stored_study(result.provenance, result_file.name)
     model, parameters, names = study.variant(), study.parameter_values(), study.names()
 
     def compared(x) -> str:  # what expected and simulated are (results.CrossCheck)
@@ -503,20 +503,8 @@ def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None,
 
 
 def _stored_plot_state(result) -> str | None:
-    """The ``plot_state`` of the study stored with ``result`` (None if unset, or if that study
-    no longer validates)."""
-    study = _stored_study(result)
-    return None if study is None else study.plot_state
-
-
-def _stored_study(result):
-    """The study stored with ``result`` (None if that study no longer validates)."""
-    from .study import stored_study
-
-    try:
-        return stored_study(result.attributes)
-    except WhirlError:
-        return None
+    """The ``plot_state`` of the study that made ``result`` (None if unset)."""
+    return result.provenance.plot_state or None
 
 
 # ------------------------------------------------------------------------------------ doctor

@@ -119,12 +119,13 @@ def test_linear_plot_tells_the_flutter_mode_apart_and_marks_its_onset():
 
 
 def test_laws_side_by_side_with_the_linear_spring():
+    from whirl_cli.output.provenance import law_curve
     from whirl_cli.study import load_study
 
     entries = []
     for name in ("hardening_case2", "softening_case2", "combined_case2"):
         study = load_study(ROOT / "studies" / "thesis_ch3" / f"{name}.yaml")
-        entries.append((study.variant(), study.parameter_values(), "theta", name))
+        entries.append((law_curve(study.variant(), study.parameter_values(), "theta"), name))
     ax = _new_figure().add_subplot()
     laws_plot(entries, ax=ax)
     lines = {line.get_label(): line for line in ax.lines}

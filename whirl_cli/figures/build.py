@@ -151,7 +151,8 @@ def _about(results) -> dict[str, str]:
     names = {"whirl_version": "whirl", "git_describe": "commit", "auto_version": "engine"}
     about = {}
     for key, name in names.items():
-        values = sorted({str(r.attributes[key]) for r in results if r.attributes.get(key)})
+        values = sorted({getattr(r.provenance, key) for r in results
+                         if getattr(r.provenance, key)})
         if values:
             about[name] = ", ".join(values)
     about.setdefault("whirl", __version__)

@@ -145,7 +145,7 @@ def different_models(a: StudyResult, b: StudyResult) -> str:
     file of other content (its ``model_key``); "" if from the same."""
     if a.model != b.model:
         return f"{a.model} vs {b.model}"
-    keys = [r.attributes.get("model_key", "") for r in (a, b)]
+    keys = [r.provenance.model_key for r in (a, b)]
     if keys[0] != keys[1]:
         return f"{a.model} from model files that declare different equations or values"
     return ""
@@ -196,8 +196,9 @@ def _compare_named(prefix: str, a: dict, b: dict, compare) -> list[Difference]:
 def _compare_root(a: StudyResult, b: StudyResult, skip: frozenset[str]) -> list[Difference]:
     found = []
     pairs = {"study_name": (a.study_name, b.study_name), "model": (a.model, b.model)}
-    for key in sorted((set(a.attributes) | set(b.attributes)) - skip):
-        pairs[key] = (a.attributes.get(key, "<missing>"), b.attributes.get(key, "<missing>"))
+    root_a, root_b = a.root_attributes(), b.root_attributes()
+    for key in sorted((set(root_a) | set(root_b)) - skip):
+        pairs[key] = (root_a.get(key, "<missing>"), root_b.get(key, "<missing>"))
     for key, (x, y) in pairs.items():
         if str(x) != str(y):
             shown = _first_different_line(x, y) if key == "study_yaml" and isinstance(

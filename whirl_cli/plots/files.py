@@ -79,13 +79,8 @@ def missing_data(result: StudyResult, kind: str) -> str:
 
 
 def _datums(result: StudyResult) -> dict[str, float]:
-    """The datum of every parameter, for files whose sweeps do not store theirs: from the
-    file's parameter set, else (schema 1 files) from the model of the study stored with it."""
-    if result.parameters:
-        return {p.name: p.datum for p in result.parameters}
-    if not result.linear_sweeps:
-        return {}
-    return captions(result).datums
+    """The datum of every parameter (for files whose sweeps do not store theirs)."""
+    return {p.name: p.datum for p in result.parameters}
 
 
 def _multiple_sweeps(result: StudyResult) -> list:
@@ -156,8 +151,8 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
     Each file is rendered in memory and published complete or not at all (an existing file
     of the same name is replaced if it is a PNG image, and nothing is written if one is not,
     or if a whirl result file other than ``result_file`` beside it records it as its plot:
-    :func:`whirl_cli.output.study_files.check_plot`). ``whirl run`` and ``whirl sweep`` publish a
-    study's plots together with its HDF5 file instead (:mod:`whirl_cli.output.study_files`).
+    :func:`whirl_cli.output.owners.check_plot`). ``whirl run`` and ``whirl sweep`` publish a
+    study's plots together with its HDF5 file instead (:mod:`whirl_cli.publish`).
     """
     out_dir = Path(out_dir)
     rendered = render_study_plots(result, kinds, stem, state, dpi, view, formats=formats)
@@ -167,7 +162,7 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
         raise OutputError(f"cannot create plot directory {out_dir}: {exc}") from exc
     from ..output.atomic import publish
     from ..output.guard import check
-    from ..output.study_files import check_plot
+    from ..output.owners import check_plot
 
     for name, _ in rendered:  # a PNG is replaced, never a link, directory, device, FIFO
         if name.endswith(".png"):
@@ -321,9 +316,8 @@ def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str,
                 jobs.append((f"{stem}_{continuation.name}_amplitude.png",
                              lambda c=continuation: amplitude_diagram(c)))
     if "law" in kinds:
-        for model, values, dof in nonlinear_laws(result):
-            jobs.append((f"{stem}_law_{dof}.png",
-                         lambda m=model, v=values, d=dof: law_plot(m, v, d)))
+        for curve in nonlinear_laws(result):
+            jobs.append((f"{stem}_law_{curve.dof}.png", lambda c=curve: law_plot(c)))
     for kind, draw in (("time_history", time_history), ("hub_path", hub_path)):
         if kind in kinds:
             for found in result.simulations:

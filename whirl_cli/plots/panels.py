@@ -207,12 +207,11 @@ def _law_panel(result: StudyResult, ax: Axes, choice: PanelChoice, caption=None
     """The ``law`` kind: the nonlinear law on the dof ``choice.state`` (None: the first)."""
     from .laws import law_plot, nonlinear_laws
 
-    found = [(m, v, d) for m, v, d in nonlinear_laws(result) if choice.state in (None, d)]
+    found = [c for c in nonlinear_laws(result) if choice.state in (None, c.dof)]
     if not found:
         raise WhirlError(f"{result.study_name}: no nonlinear stiffness law"
                          + (f" on {choice.state!r}" if choice.state else ""))
-    model, values, dof = found[0]
-    law_plot(model, values, dof, ax=ax, title=choice.title)
+    law_plot(found[0], ax=ax, title=choice.title)
     return [ax]
 
 
@@ -440,11 +439,11 @@ def _overlay_laws(results: Sequence[StudyResult], names: Sequence[str], ax: Axes
 
     chosen = []
     for result, name in zip(results, names, strict=True):
-        found = [(m, v, d) for m, v, d in nonlinear_laws(result) if choice.state in (None, d)]
+        found = [c for c in nonlinear_laws(result) if choice.state in (None, c.dof)]
         if not found:
             raise WhirlError(f"{result.study_name}: no nonlinear stiffness law"
                              + (f" on {choice.state!r}" if choice.state else ""))
-        chosen.append((*found[0], name))
+        chosen.append((found[0], name))
     laws_plot(chosen, ax=ax, title=title)
     return [ax]
 

@@ -104,13 +104,14 @@ def validate_text(text: str, filename: str = "<study>",
     return _validate(text, filename, filename, Path.cwd(), model_file)
 
 
-def stored_study(attributes: dict, filename: str = "<stored study>") -> Study:
-    """The study stored in a result's root ``attributes`` (``study_yaml``), with the model
-    file stored beside it where it names one; StudyError if it does not validate."""
+def stored_study(provenance, filename: str = "<stored study>") -> Study:
+    """The study stored with a result (its :class:`~whirl_cli.results.Provenance`:
+    ``study_yaml``, and the model file beside it where it names one), validated against
+    today's schema; StudyError if it does not validate."""
     stored = None
-    if attributes.get("model_file_yaml"):
-        stored = (str(attributes.get("model_file", "")), str(attributes["model_file_yaml"]))
-    return validate_text(str(attributes.get("study_yaml", "")), filename, stored)
+    if provenance.model_file_yaml:
+        stored = (provenance.model_file, provenance.model_file_yaml)
+    return validate_text(provenance.study_yaml, filename, stored)
 
 
 def _model_reference(tree: _Tree, name: str, folder: Path,
