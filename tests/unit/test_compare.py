@@ -21,6 +21,7 @@ from whirl_cli.output.compare import (
 )
 from whirl_cli.results import (
     PointType,
+    Provenance,
     SpecialPoint,
     StudyResult,
 )
@@ -311,13 +312,12 @@ def test_cli_prints_at_most_the_limit(tmp_path):
 
 
 @pytest.mark.parametrize("changes", [{"model": "gimballed_poly"},
-                                     {"attributes": {"model_key": "another"}}])
+                                     {"provenance": Provenance(model_key="another")}])
 def test_results_of_different_models_are_not_compared(tmp_path, changes):
     """Another model variant, or a model file declaring other equations or values (its
     stored model_key): one line saying so, exit 1, no list of differences."""
     base = make_result()
-    other = replace(base, **{k: ({**base.attributes, **v} if k == "attributes" else v)
-                             for k, v in changes.items()})
+    other = replace(base, **changes)
     a, b = store.write(base, tmp_path / "a.h5"), store.write(other, tmp_path / "b.h5")
     result = CliRunner().invoke(cli, ["compare", str(a), str(b)])
     assert result.exit_code == 1
