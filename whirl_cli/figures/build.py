@@ -88,10 +88,10 @@ def load_sheets(paths: Sequence[str | os.PathLike[str]]) -> tuple[list[Sheet], l
 def _figure_and_caption(path: Path) -> tuple[str, str]:
     """The figure number and caption of a sheet that is not valid, as far as they can be read
     (else its file name and no caption)."""
-    from ..study.source import _compose, _read_text, _Tree
+    from ..study import read_yaml_data
 
     try:
-        data = _Tree(_compose(_read_text(path, path.name, "sheet"), path.name, "sheet")).data
+        data = read_yaml_data(path, "sheet")
     except StudyError:
         data = {}
     figure, caption = data.get("figure"), data.get("caption")

@@ -47,9 +47,10 @@ from __future__ import annotations
 
 import hashlib
 import os
+from collections.abc import Callable
 from pathlib import Path
 
-from pydantic import ValidationError
+from pydantic import BaseModel, ValidationError
 
 from ..errors import StudyError
 from ..models import is_model_file, load_model_file, register_model_text
@@ -81,6 +82,8 @@ __all__ = [
     "Study",
     "TwoParameterContinuation",
     "load_study",
+    "load_yaml_file",
+    "read_yaml_data",
     "schema_reference",
     "stored_study",
     "validate_text",
@@ -102,6 +105,34 @@ def validate_text(text: str, filename: str = "<study>",
     read relative to the working directory, or is ``model_file`` = (reference, text) where
     given (the model stored with a result)."""
     return _validate(text, filename, filename, Path.cwd(), model_file)
+
+
+def load_yaml_file(path: Path, model: type[BaseModel], what: str,
+                   checks: Callable[[BaseModel], list[Problem]] | None = None) -> BaseModel:
+    """Another YAML file read as studies are (``what``: its kind, e.g. "sheet"): the same
+    limits and YAML rules, validated as the pydantic ``model``, then ``checks`` (key path,
+    reason) on the valid object; StudyError lists every problem as ``<path>:<line>: <key>:
+    <reason>``."""
+    label = str(path)
+    tree = _Tree(_compose(_read_text(Path(path), label, what), label, what))
+    problems = list(tree.problems)
+    found = None
+    try:
+        found = model.model_validate(tree.data)
+    except ValidationError as error:
+        problems += [_translate(e, tree, model) for e in error.errors(include_url=False)]
+    if found is not None and checks is not None:
+        problems += checks(found)
+    if problems:
+        raise StudyError(_report(problems, tree, label))
+    return found
+
+
+def read_yaml_data(path: Path, what: str = "study") -> dict:
+    """The data of a YAML file read as studies are, not validated (StudyError where it is
+    not readable YAML of a mapping)."""
+    return _Tree(_compose(_read_text(Path(path), Path(path).name, what), Path(path).name,
+                          what)).data
 
 
 def stored_study(provenance, filename: str = "<stored study>") -> Study:
