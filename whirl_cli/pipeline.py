@@ -32,6 +32,8 @@ from .results import (
     SeedOutcome,
     Simulation,
     StudyResult,
+    on_slice,
+    slice_branch,
 )
 from .runtime import Standby, forked_map, preload, preloaded, thread_map
 from .study import Study
@@ -354,7 +356,7 @@ def slice_seeds(model, overrides: dict[str, float], spec, jobs: int = 1
                                          spec.start, spec.seeds, jobs)
         per_slice.append(starts)
         outcomes += [replace(o, index=len(outcomes) + n + 1,
-                             branch=o.branch and f"slice_{k}.{o.branch}")
+                             branch=o.branch and slice_branch(k, o.branch))
                      for n, o in enumerate(found)]
     return tuple(per_slice), tuple(outcomes)
 
@@ -371,7 +373,7 @@ def _two_parameter(engine: Engine, study: Study, spec, parameters: dict[str, flo
                                          numerics, slice_orbits=orbits,
                                          snaking_folds=spec.snaking_folds)
     continuation = replace(continuation, seeds=outcomes)
-    per_slice = [tuple(b for b in continuation.branches if b.name.startswith(f"slice_{k}."))
+    per_slice = [tuple(b for b in continuation.branches if on_slice(b.name, k) is not None)
                  for k in range(len(spec.slices))]
     found = boundaries.boundary(spec.name, model, parameters, pair, bounds, spec.method,
                                 spec.slice_values, spec.resolution, curves, per_slice)

@@ -286,6 +286,19 @@ class Branch:
         return dataset(branch_table(self))
 
 
+def slice_branch(k: int, name: str) -> str:
+    """The name in its two-parameter continuation of branch ``name`` of slice ``k`` (from
+    0): ``slice_<k>.<name>``; :func:`on_slice` reads it back."""
+    return f"slice_{k}.{name}"
+
+
+def on_slice(name: str, k: int) -> str | None:
+    """The name on slice ``k`` of the branch ``name`` (made by :func:`slice_branch`); None if
+    it is not a branch of that slice (another slice's, a locus)."""
+    head, dot, rest = name.partition(".")
+    return rest if dot and head == f"slice_{k}" else None
+
+
 #: :attr:`SpecialPoint.status` of a point AUTO labelled that its own check says is not of
 #: that type (e.g. a TR point without a pair of Floquet multipliers on the unit circle).
 REJECTED = "rejected"

@@ -115,3 +115,12 @@ def test_plots_import_neither_the_study_schema_nor_the_models():
     banned = ("..study", "..models", "whirl_cli.study", "whirl_cli.models")
     for path in sorted((ROOT / "whirl_cli" / "plots").glob("*.py")):
         assert not [m for m in imported(path) if m.startswith(banned)], path.name
+
+
+def test_slice_membership_is_read_back_from_the_name_it_was_given():
+    from whirl_cli.results import on_slice, slice_branch
+
+    assert on_slice(slice_branch(1, "periodic_2.0"), 1) == "periodic_2.0"
+    assert on_slice(slice_branch(10, "main_down"), 1) is None  # not slice 1's
+    assert on_slice(slice_branch(1, "main_down"), 10) is None
+    assert on_slice("hopf_0a", 0) is None  # a locus is on no slice

@@ -12,7 +12,15 @@ import numpy as np
 from ..auto import runner
 from ..auto.constants import TORUS_ANGLE_INDEX, par_layout
 from ..models import Model
-from ..results import STEP_LIMIT, Branch, BranchKind, ContinuationResult, PointType, SpecialPoint
+from ..results import (
+    STEP_LIMIT,
+    Branch,
+    BranchKind,
+    ContinuationResult,
+    PointType,
+    SpecialPoint,
+    slice_branch,
+)
 from ..runtime import thread_map
 from .branches import _same_point, head, join, special_points, typical_amplitudes
 from .engine import Engine, Numerics, RunSpec, _read
@@ -98,9 +106,9 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
     for k, (value, result) in enumerate(zip(slices, results, strict=True)):
         runs = {b.name: b.run for b in result.branches}
         for branch in result.branches:
-            branches.append(replace(branch, name=f"slice_{k}.{branch.name}"))
+            branches.append(replace(branch, name=slice_branch(k, branch.name)))
         for point in result.special_points:
-            named = replace(point, branch=f"slice_{k}.{point.branch}", parameter_names=pair,
+            named = replace(point, branch=slice_branch(k, point.branch), parameter_names=pair,
                             parameters=np.array([point.parameters[0], value]))
             points.append(named)
             width = bounds[first][1] - bounds[first][0]
