@@ -329,15 +329,13 @@ def export(result_file: Path, output: Path, branches: bool, overwrite: bool) -> 
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 def check(result_file: Path) -> None:
     """Check the stable orbits and equilibria of a result file by time simulation."""
-    from dataclasses import replace
-
     from . import api
     from .analysis import simulate
     from .study import stored_study
 
     result = api.read(result_file)
     study = stored_study(result.provenance, result_file.name)
-    model, parameters, names = study.variant(), study.parameter_values(), study.names()
+    model, parameters = study.variant(), study.parameter_values()
 
     def compared(x) -> str:  # what expected and simulated are (results.CrossCheck)
         if x.kind == "equilibrium":
@@ -350,10 +348,7 @@ def check(result_file: Path) -> None:
 
     wrong = 0
     for continuation in result.continuations:
-        # files of older whirl may name parameters by the study's aliases (K1): canonical here
-        branches = tuple(replace(b, parameter_names=tuple(names.canonical(p)
-                                                          for p in b.parameter_names))
-                         for b in continuation.branches)
+        branches = continuation.branches  # canonical names, older files too (store.read)
         for x in simulate.cross_check(model, parameters, branches):
             mark = "ok  " if x.passed else "FAIL"
             click.echo(f"{mark} {continuation.name}/{x.branch}[{x.index}] {x.kind:<11} "

@@ -19,7 +19,14 @@ import numpy as np
 
 from .. import __version__
 from ..models import file_key
-from ..results import FixedParameter, LawCurve, ParameterValue, Provenance, SliceLabel
+from ..results import (
+    FixedParameter,
+    LawCurve,
+    ParameterValue,
+    Provenance,
+    SliceLabel,
+    StudyResult,
+)
 
 PACKAGE = Path(__file__).resolve().parent.parent
 #: A law with breakpoints is drawn over +-4 times its outermost breakpoint, else an angle
@@ -118,18 +125,40 @@ def resolved_parameters(model, overrides: dict[str, float]) -> tuple[ParameterVa
                  for p, v in zip(model.parameters, values, strict=True))
 
 
-def upgraded(found: Provenance, parameters: tuple[ParameterValue, ...]
-             ) -> tuple[Provenance, tuple[ParameterValue, ...]]:
-    """The provenance and parameter set of a file written before whirl stored what its study
-    sets: read off the study stored with it (the parameter set too where the file has none);
-    as they are if that study no longer validates."""
+def upgraded(result: StudyResult) -> StudyResult:
+    """``result`` as read from a file written before whirl stored its provenance group, with
+    what newer files hold read off the study stored with it: the provenance's fixed
+    parameters, slice labels and laws, the parameter set (schema 1 files have none),
+    canonical parameter names (older files may use the study's aliases, K1 for K_theta) and
+    each linear sweep's datum. As it is if that study no longer validates."""
     from ..errors import WhirlError
     from ..study import stored_study
 
     try:
-        study = stored_study(found)
+        study = stored_study(result.provenance)
     except WhirlError:
-        return found, parameters
-    if not parameters:
-        parameters = resolved_parameters(study.variant(), study.parameter_values())
-    return study_parts(found, study), parameters
+        return result
+    names = study.names()
+    parameters = result.parameters or resolved_parameters(study.variant(),
+                                                          study.parameter_values())
+    datums = {p.name: p.datum for p in parameters}
+    canonical = _canonical_names(names)
+    return replace(
+        result, provenance=study_parts(result.provenance, study), parameters=parameters,
+        continuations=tuple(replace(
+            c, branches=tuple(replace(b, parameter_names=canonical(b.parameter_names))
+                              for b in c.branches),
+            special_points=tuple(replace(p, parameter_names=canonical(p.parameter_names))
+                                 for p in c.special_points))
+            for c in result.continuations),
+        linear_sweeps=tuple(replace(s, parameter=canonical((s.parameter,))[0],
+                                    datum=s.datum if s.datum is not None
+                                    else datums.get(canonical((s.parameter,))[0]))
+                            for s in result.linear_sweeps))
+
+
+def _canonical_names(names):
+    """A function from parameter names to their canonical names under the study's ``names``
+    (a name it does not know kept as it is)."""
+    known = set(names.known_parameter_names())
+    return lambda found: tuple(names.canonical(n) if n in known else n for n in found)

@@ -631,14 +631,15 @@ def read(path: Path) -> StudyResult:
         parameters = read_table(member(handle, "parameters"), ParameterValue, PARAMETER) \
             if schema >= 2 else ()
         found = _read_provenance(handle)
-        if "provenance" not in handle:  # a file of an older whirl
-            from .provenance import upgraded
-
-            found, parameters = upgraded(found, parameters)
         simulations = tuple(Simulation(name=name, **read_record(group, SIMULATION),
                                        first_order=found.first_order)
                             for name, group in handle.get("simulations", {}).items())
-        return StudyResult(text(attribute(handle, "study_name")),
-                           text(attribute(handle, "model")),
-                           continuations, sweeps, runs, attributes, boundaries, grid,
-                           parameters, simulations, found)
+        result = StudyResult(text(attribute(handle, "study_name")),
+                             text(attribute(handle, "model")),
+                             continuations, sweeps, runs, attributes, boundaries, grid,
+                             parameters, simulations, found)
+        if "provenance" in handle:
+            return result
+    from .provenance import upgraded  # a file of an older whirl: the one place it is upgraded
+
+    return upgraded(result)
