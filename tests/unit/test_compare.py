@@ -60,10 +60,11 @@ def test_different_sampling_of_the_same_curves_agrees():
 
 def test_provenance_that_changes_legitimately_is_ignored():
     other = make_result()
-    other.attributes.update(created="2027-01-01T00:00:00Z", whirl_version="9.9",
-                            auto_version="1.0", git_describe="abc-dirty")
+    other = replace(other, provenance=replace(
+        other.provenance, created="2027-01-01T00:00:00Z", whirl_version="9.9",
+        auto_version="1.0", git_describe="abc-dirty"))
     assert compare_results(make_result(), other) == []
-    other.attributes["study_sha256"] = "def"
+    other = replace(other, provenance=replace(other.provenance, study_sha256="def"))
     assert compare_results(make_result(), other) == []  # provenance: a note, not drift
     assert paths(compare_results(make_result(), other, strict=True)) == ["/@study_sha256"]
 
@@ -299,8 +300,8 @@ def test_cli_refuses_tolerances_that_are_not_finite_and_non_negative(files, opti
 def test_cli_prints_at_most_the_limit(tmp_path):
     base = make_result()
     sweep = base.linear_sweeps[0]
-    other = replace(base, attributes={**base.attributes, "study_sha256": "zzz",
-                                      "study_yaml": "other"}, study_name="y",
+    other = replace(base, provenance=replace(base.provenance, study_sha256="zzz",
+                                             study_yaml="other"), study_name="y",
                     linear_sweeps=(replace(sweep, values=sweep.values + 1,
                                            eigenvalues=sweep.eigenvalues + 1,
                                            damping_ratio=sweep.damping_ratio + 1,
