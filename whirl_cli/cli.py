@@ -331,11 +331,11 @@ def check(result_file: Path) -> None:
     """Check the stable orbits and equilibria of a result file by time simulation."""
     from . import api
     from .analysis import simulate
-    from .study import stored_study
+    from .output.provenance import stored_model
 
     result = api.read(result_file)
-    study = stored_study(result.provenance, result_file.name)
-    model, parameters = study.variant(), study.parameter_values()
+    model = stored_model(result, result_file.name)
+    parameters = {p.name: p.value for p in result.parameters}
 
     def compared(x) -> str:  # what expected and simulated are (results.CrossCheck)
         if x.kind == "equilibrium":

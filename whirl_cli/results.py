@@ -715,7 +715,8 @@ class Provenance:
     The text fields are the file's root attributes (``""``: not recorded). ``fixed``: the
     parameters the study sets, in the order written; ``slice_labels``: the labels of the
     slices of its two-parameter continuations; ``laws``: the law on every dof;
-    ``plot_state``: the study's ``plot_state`` (""); ``dofs``: the model's dofs."""
+    ``plot_state``: the study's ``plot_state`` (""); ``dofs``: the model's dofs; ``family``:
+    the model the study names (with ``laws``, the model variant that ran)."""
 
     whirl_version: str = ""
     whirl_code_sha256: str = ""
@@ -734,6 +735,7 @@ class Provenance:
     laws: tuple[LawCurve, ...] = ()
     plot_state: str = ""
     dofs: tuple[str, ...] = ()
+    family: str = ""  # the study's ``model``: a built-in family, or the model file's reference
 
     __repr__ = _brief_repr
 

@@ -85,7 +85,24 @@ def study_parts(found: Provenance, study) -> Provenance:
                    if c.type == "two-parameter" for k, label in enumerate(c.slice_labels))
     laws = tuple(law_curve(model, values, dof) for dof in model.family.dof_names)
     return replace(found, fixed=fixed, slices=slices, laws=laws,
-                   plot_state=study.plot_state or "", dofs=tuple(model.family.dof_names))
+                   plot_state=study.plot_state or "", dofs=tuple(model.family.dof_names),
+                   family=study.model)
+
+
+def stored_model(result: StudyResult, label: str = "<stored model>"):
+    """The model variant that made ``result``, from its provenance: the family it names (the
+    model file stored with it for a model file; messages name it ``label``) with the law of
+    each dof. WhirlError if the provenance does not record them."""
+    from ..errors import WhirlError
+    from ..models import get_model, is_known, register_model_text
+
+    found = result.provenance
+    if not found.laws or not found.family:
+        raise WhirlError(f"{label}: the result records no model (a file of an older whirl "
+                         "whose stored study no longer validates)")
+    if found.model_file_yaml and not is_known(found.family):
+        register_model_text(found.family, found.model_file_yaml, label)
+    return get_model(found.family, tuple(law.law for law in found.laws))
 
 
 def law_curve(model, values: dict[str, float], dof: str) -> LawCurve:

@@ -223,6 +223,7 @@ PROVENANCE_ROOT = tuple(Field(name, "attribute", "text", default="") for name in
 #: stored with them, :func:`whirl_cli.output.provenance.upgraded`).
 PROVENANCE = (
     Field("plot_state", "attribute", "text"), Field("dofs", "attribute", "text"),
+    Field("family", "attribute", "text", default=""),  # not recorded: read off the study
 )
 #: The :class:`FixedParameter` table of ``provenance/fixed``.
 FIXED_PARAMETER = (
