@@ -125,7 +125,7 @@ def law_curve(model, values: dict[str, float], dof: str) -> LawCurve:
         x = np.linspace(-span, span, CURVE_POINTS)
         if breakpoints:
             x = np.unique(np.concatenate([x, breakpoints]))  # the corners drawn exactly
-        force = np.asarray(law.force(x, k, coefficients), dtype=float) * np.ones_like(x)
+        force = np.asarray(law.force(x, k, coefficients), dtype=float)
         if law.exact is not None:
             exact = np.asarray(law.exact_force(x, k, coefficients), dtype=float)
     return LawCurve(dof, law.name, tuple(coefficients), tuple(map(float,

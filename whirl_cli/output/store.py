@@ -1,5 +1,9 @@
 """HDF5 output: the one writer and the one reader of whirl's result files (schema 2; reads 1).
 
+:func:`read` is the one place files of an older whirl are upgraded: a file without the
+``provenance`` group gets what newer files hold from the study stored with it
+(:func:`whirl_cli.output.provenance.upgraded`); nothing else reading a result knows its age.
+
 The layout, group by group, is described in ``docs/hdf5-layout.md`` (a test checks that it
 names every field declared below).
 
@@ -606,8 +610,9 @@ def _open_failure(error: OSError) -> str:
 
 
 def read(path: Path) -> StudyResult:
-    """The :class:`StudyResult` stored in a whirl HDF5 file; :class:`OutputError` (one line
-    naming the file) for a file that is not HDF5, not a whirl file, truncated or damaged."""
+    """The :class:`StudyResult` stored in a whirl HDF5 file, upgraded if an older whirl wrote
+    it (module doc); :class:`OutputError` (one line naming the file) for a file that is not
+    HDF5, not a whirl file, truncated or damaged."""
     with opened(path) as handle:
         if "whirl_schema" not in handle.attrs:
             raise OutputError(f"{path}: an HDF5 file but not a whirl result file (no "

@@ -77,7 +77,6 @@ def captions(result: StudyResult) -> Captions:
     records no parameters or slices)."""
     found = result.provenance
     fixed = tuple(Fixed(p.name, p.value, p.unit) for p in found.fixed)
-    labels: dict[str, tuple[str, ...]] = {}
-    for piece in found.slices:
-        labels[piece.continuation] = found.slice_labels(piece.continuation)
+    labels = {name: found.slice_labels(name)
+              for name in dict.fromkeys(s.continuation for s in found.slices)}
     return Captions(result.study_name, fixed, labels)
