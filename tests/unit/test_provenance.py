@@ -81,6 +81,25 @@ def test_an_older_file_reads_with_its_provenance_recovered():
                                rtol=1e-12)
 
 
+def test_an_older_file_reads_with_canonical_parameter_names():
+    """The legacy file stores the thesis's alias K1 (the pitch stiffness, K_theta, of the
+    study's one law): read, its branches and points name K_theta, and whirl check runs."""
+    from click.testing import CliRunner
+
+    from whirl_cli.cli import cli
+
+    legacy = ROOT / "tests" / "data" / "legacy_hardening_case2.h5"
+    with store.opened(legacy) as handle:
+        stored = handle["continuations/k1/branches/main_down/parameters"].attrs["names"]
+        assert [str(n) for n in stored] == ["K1"]
+    result = store.read(legacy)
+    assert {b.parameter_names for c in result for b in c} == {("K_theta",)}
+    assert {p.parameter_names for c in result for p in c.special_points} == {("K_theta",)}
+    run = CliRunner().invoke(cli, ["check", str(legacy)])
+    assert run.exit_code == 0, run.output
+    assert "K_theta = " in run.output
+
+
 def test_a_file_without_a_valid_stored_study_still_reads(tmp_path):
     """An older file whose study today's schema rejects reads with the provenance it has."""
     old = store.read(OLD)
