@@ -326,3 +326,20 @@ def test_results_of_different_models_are_not_compared(tmp_path, changes):
         f"{a} and {b} are results of different models "
         f"({different_models(base, other)}): not compared"]
     assert different_models(base, base) == ""
+
+
+def test_a_file_with_a_linear_grid_agrees_with_its_copy(tmp_path):
+    """The grid's x and y are dimension scales: their links to the datasets are object
+    references, which differ between two files of the same content."""
+    import shutil
+
+    from whirl_cli.results import LinearGrid
+
+    x, y = np.linspace(0.0, 1.0, 4), np.linspace(0.0, 2.0, 3)
+    grid = LinearGrid("K_theta", "K_psi", "N m/rad", "N m/rad", x, y,
+                      np.subtract.outer(y, x), np.ones((3, 4), dtype=bool), (), ())
+    path = store.write(replace(make_result(), linear_grid=grid), tmp_path / "a.h5")
+    shutil.copy(path, tmp_path / "b.h5")
+    result = CliRunner().invoke(cli, ["compare", str(path), str(tmp_path / "b.h5")])
+    assert result.exit_code == 0, result.output
+    assert "agree" in result.output

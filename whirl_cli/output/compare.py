@@ -736,6 +736,10 @@ def _compare_arrays(path: str, x: np.ndarray, y: np.ndarray, rtol: float) -> lis
 #: Attributes schema 2 added to the datasets of those groups: absent from a schema-1 file,
 #: which is no drift.
 SCHEMA_2_ATTRIBUTES = ("/@names", "/@units")
+#: Attributes of HDF5 dimension scales that hold object references (which dataset a scale
+#: is attached to): equal files hold different references, and the datasets themselves are
+#: compared.
+SCALE_LINKS = frozenset({"REFERENCE_LIST", "DIMENSION_LIST"})
 #: Groups compared dataset by dataset with h5py (their layout is not needed here).
 GENERIC_GROUPS = ("boundaries", "linear/grid")
 
@@ -789,7 +793,7 @@ def _datasets(path: Path, roots: tuple[str, ...]) -> dict[str, np.ndarray]:
                 if isinstance(item, h5py.Dataset):
                     found[where] = decoded(item[()])
                 for key, value in item.attrs.items():
-                    if key not in store.CONTENTS:
+                    if key not in store.CONTENTS | SCALE_LINKS:
                         found[f"{where}/@{key}"] = decoded(value)
 
             for key, value in handle[root].attrs.items():
