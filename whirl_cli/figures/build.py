@@ -148,13 +148,13 @@ def _about(results) -> dict[str, str]:
     distinct value once; this whirl's version when no result was read)."""
     from .. import __version__
 
-    names = {"whirl_version": "whirl", "git_describe": "commit", "auto_version": "engine"}
+    records = [r.provenance for r in results]
     about = {}
-    for key, name in names.items():
-        values = sorted({getattr(r.provenance, key) for r in results
-                         if getattr(r.provenance, key)})
-        if values:
-            about[name] = ", ".join(values)
+    for name, values in (("whirl", [p.whirl_version for p in records]),
+                         ("commit", [p.git_describe for p in records]),
+                         ("engine", [p.auto_version for p in records])):
+        if any(values):
+            about[name] = ", ".join(sorted(set(filter(None, values))))
     about.setdefault("whirl", __version__)
     return about
 
