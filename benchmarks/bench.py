@@ -358,7 +358,7 @@ def study_figures(path: Path, scratch: Path, env: dict[str, str]) -> StudyFigure
 #: What ``whirl run --no-plots`` of a linear-only study imports, ending as ``whirl`` does
 #: (without the interpreter's teardown: :func:`whirl_cli.entry.leave`).
 RUN_IMPORTS = ("import whirl_cli.cli, whirl_cli.study, whirl_cli.api, whirl_cli.pipeline, "
-               "whirl_cli.output.study_files, whirl_cli.output.summary, whirl_cli.verdict; "
+               "whirl_cli.publish, whirl_cli.output.summary, whirl_cli.verdict; "
                "import os; os._exit(0)")
 
 

@@ -13,13 +13,13 @@ import h5py
 import pytest
 
 from whirl_cli.output import store
-from whirl_cli.results import StudyResult
+from whirl_cli.results import Provenance, StudyResult
 
 
 def small_result(name: str = "mine", plots: tuple[str, ...] = ()) -> StudyResult:
     return StudyResult(study_name=name, model="m", continuations=(), linear_sweeps=(),
-                       runs=(), attributes={"study_yaml": f"name: {name}\n",
-                                            "plots": list(plots)})
+                       runs=(), attributes={"plots": list(plots)},
+                       provenance=Provenance(study_yaml=f"name: {name}\n"))
 
 
 def fingerprint(path: Path) -> tuple:

@@ -40,7 +40,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
 
     from .models import Model
-    from .output.study_files import Published
+    from .publish import Published
 
 __all__ = ["draw", "export", "load", "load_model", "read", "run", "run_and_save", "save",
            "special_points"]
@@ -96,7 +96,7 @@ def save(result: StudyResult, path: str | os.PathLike[str], plots: Sequence[str]
     """Write ``result`` to the HDF5 file ``path`` and its ``plots`` (kinds of
     :data:`whirl_cli.plots.files.PLOT_KINDS`, drawn in ``jobs`` processes, None: one per CPU)
     next to it, as one unit (all or nothing)."""
-    from .output.study_files import publish_study
+    from .publish import publish_study
 
     return publish_study(result, Path(path), tuple(plots), overwrite, state=state,
                          jobs=jobs_or_default(jobs))
@@ -114,8 +114,8 @@ def run_and_save(study: Study | str | os.PathLike[str], path: str | os.PathLike[
     the plots drawn while the cross-checks run (:func:`whirl_cli.pipeline.run_and_draw`):
     what ``whirl run`` does."""
     from .output.guard import ready
-    from .output.study_files import drawn_plots, publish_study
     from .pipeline import run_and_draw
+    from .publish import drawn_plots, publish_study
 
     study = study if isinstance(study, Study) else load_study(study)
     path, kinds, jobs = Path(path), tuple(plots), jobs_or_default(jobs)

@@ -330,15 +330,13 @@ def export(result_file: Path, output: Path, branches: bool, overwrite: bool) -> 
 @click.argument("result_file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 def check(result_file: Path) -> None:
     """Check the stable orbits and equilibria of a result file by time simulation."""
-    from dataclasses import replace
-
     from . import api
     from .analysis import simulate
-    from .study import stored_study
+    from .output.provenance import stored_model
 
     result = api.read(result_file)
-    study = stored_study(result.attributes, result_file.name)
-    model, parameters, names = study.variant(), study.parameter_values(), study.names()
+    model = stored_model(result, result_file.name)
+    parameters = {p.name: p.value for p in result.parameters}
 
     def compared(x) -> str:  # what expected and simulated are (results.CrossCheck)
         if x.kind == CheckKind.EQUILIBRIUM:
@@ -351,10 +349,7 @@ def check(result_file: Path) -> None:
 
     wrong = 0
     for continuation in result.continuations:
-        # files of older whirl may name parameters by the study's aliases (K1): canonical here
-        branches = tuple(replace(b, parameter_names=tuple(names.canonical(p)
-                                                          for p in b.parameter_names))
-                         for b in continuation.branches)
+        branches = continuation.branches  # canonical names, older files too (store.read)
         for x in simulate.cross_check(model, parameters, branches):
             mark = "ok  " if x.passed else "FAIL"
             click.echo(f"{mark} {continuation.name}/{x.branch}[{x.index}] {x.kind:<11} "
@@ -504,20 +499,8 @@ def plot(result_file: Path, kinds: tuple[str, ...], output_dir: Path | None,
 
 
 def _stored_plot_state(result) -> str | None:
-    """The ``plot_state`` of the study stored with ``result`` (None if unset, or if that study
-    no longer validates)."""
-    study = _stored_study(result)
-    return None if study is None else study.plot_state
-
-
-def _stored_study(result):
-    """The study stored with ``result`` (None if that study no longer validates)."""
-    from .study import stored_study
-
-    try:
-        return stored_study(result.attributes)
-    except WhirlError:
-        return None
+    """The ``plot_state`` of the study that made ``result`` (None if unset)."""
+    return result.provenance.plot_state or None
 
 
 # ------------------------------------------------------------------------------------ doctor

@@ -24,7 +24,7 @@ from .continuation.engine import Engine, Numerics
 from .continuation.loci import two_parameter
 from .continuation.one_parameter import one_parameter
 from .continuation.periodic import OrbitStart
-from .output.provenance import provenance
+from .output.provenance import provenance, resolved_parameters
 from .results import (
     Boundary,
     ContinuationKind,
@@ -32,11 +32,12 @@ from .results import (
     Exploration,
     MotionKind,
     Origin,
-    ParameterValue,
     SeedKind,
     SeedOutcome,
     Simulation,
     StudyResult,
+    on_slice,
+    slice_branch,
 )
 from .runtime import Standby, forked_map, preload, preloaded, thread_map
 from .study import Study
@@ -78,7 +79,7 @@ def run_and_draw(study: Study, workroot: Path, draw: Callable[[StudyResult], T] 
                  ) -> tuple[StudyResult, T | None]:
     """:func:`run_study`, and ``draw(result)`` (None without ``draw``): work that needs
     everything but the cross-checks, such as rendering the plots
-    (:func:`whirl_cli.output.study_files.drawn_plots`). With ``jobs`` > 1 the cross-checks do
+    (:func:`whirl_cli.publish.drawn_plots`). With ``jobs`` > 1 the cross-checks do
     not hold it up: a worker forked before AUTO starts (:class:`whirl_cli.runtime.Standby`)
     imports scipy's integrators meanwhile, on another core (in a short study that import,
     behind matplotlib's in one background thread, was the last thing to end), and checks the
@@ -172,7 +173,7 @@ def _stages(study: Study, model, parameters: dict[str, float], workroot: Path, j
     result = StudyResult(
         study_name=study.name, model=model.name, continuations=tuple(continuations),
         linear_sweeps=tuple(sweeps), runs=engine.records() if engine else (),
-        attributes=provenance(study), boundaries=tuple(found_boundaries), linear_grid=grid,
+        provenance=provenance(study), boundaries=tuple(found_boundaries), linear_grid=grid,
         parameters=resolved_parameters(model, parameters),
         simulations=tuple(simulations(study, model, jobs)))
     drawn = draw(result) if draw is not None else None
@@ -359,17 +360,9 @@ def slice_seeds(model, overrides: dict[str, float], spec, jobs: int = 1
                                          spec.start, spec.seeds, jobs)
         per_slice.append(starts)
         outcomes += [replace(o, index=len(outcomes) + n + 1,
-                             branch=o.branch and f"slice_{k}.{o.branch}")
+                             branch=o.branch and slice_branch(k, o.branch))
                      for n, o in enumerate(found)]
     return tuple(per_slice), tuple(outcomes)
-
-
-def resolved_parameters(model, overrides: dict[str, float]) -> tuple[ParameterValue, ...]:
-    """Every parameter of ``model`` as the study runs it: its value (``overrides``, by any
-    spelling, else the datum), datum and unit."""
-    values = model.parameter_vector(overrides)
-    return tuple(ParameterValue(p.name, float(v), float(p.default), p.unit)
-                 for p, v in zip(model.parameters, values, strict=True))
 
 
 def _two_parameter(engine: Engine, study: Study, spec, parameters: dict[str, float],
@@ -384,7 +377,7 @@ def _two_parameter(engine: Engine, study: Study, spec, parameters: dict[str, flo
                                          numerics, slice_orbits=orbits,
                                          snaking_folds=spec.snaking_folds)
     continuation = replace(continuation, seeds=outcomes)
-    per_slice = [tuple(b for b in continuation.branches if b.name.startswith(f"slice_{k}."))
+    per_slice = [tuple(b for b in continuation.branches if on_slice(b.name, k) is not None)
                  for k in range(len(spec.slices))]
     found = boundaries.boundary(spec.name, model, parameters, pair, bounds, spec.method,
                                 spec.slice_values, spec.resolution, curves, per_slice)

@@ -337,6 +337,19 @@ class Branch:
         return dataset(branch_table(self))
 
 
+def slice_branch(k: int, name: str) -> str:
+    """The name in its two-parameter continuation of branch ``name`` of slice ``k`` (from
+    0): ``slice_<k>.<name>``; :func:`on_slice` reads it back."""
+    return f"slice_{k}.{name}"
+
+
+def on_slice(name: str, k: int) -> str | None:
+    """The name on slice ``k`` of the branch ``name`` (made by :func:`slice_branch`); None if
+    it is not a branch of that slice (another slice's, a locus)."""
+    head, dot, rest = name.partition(".")
+    return rest if dot and head == f"slice_{k}" else None
+
+
 @dataclass(frozen=True)
 class SpecialPoint:
     """A bifurcation or notable end on a branch.
@@ -688,11 +701,117 @@ class Simulation:
         return positions(self.state_names, self.first_order)
 
 
-def first_order_states(attributes: dict) -> tuple[str, ...]:
-    """The first-order states named by a result file's root attribute ``first_order_states``
-    (comma-separated; absent for a second-order model)."""
-    names = str(attributes.get("first_order_states", ""))
-    return tuple(names.split(",")) if names else ()
+@dataclass(frozen=True)
+class FixedParameter:
+    """A parameter a study sets: canonical name, value and unit (SI)."""
+
+    name: str
+    value: float
+    unit: str
+
+
+@dataclass(frozen=True)
+class SliceLabel:
+    """The label of slice ``index`` (from 0) of the two-parameter continuation
+    ``continuation`` ("" where the study gives none)."""
+
+    continuation: str
+    index: int
+    label: str
+
+
+@dataclass(frozen=True)
+class LawCurve:
+    """The stiffness law on ``dof`` as a study ran it, drawn once when the result was made.
+
+    ``law``: its name; ``coefficient_names``/``coefficient_values``: its coefficients (study
+    keys, values in their units); ``linear``: the law is K x at these values. ``stiffness``:
+    the dof's linear stiffness parameter, ``stiffness_value`` its value, ``force_unit`` the
+    unit of the restoring force (the stiffness's times the dof's), ``dof_unit`` the dof's.
+    ``breakpoints``: where the pieces of a piecewise law meet (none for a smooth law).
+    ``x`` (K,) in the dof's unit, ``force`` (K,) the law as AUTO continues it, ``exact`` (K,)
+    its exact piecewise form (None: the law is exact as it is); empty for a linear law.
+    """
+
+    dof: str
+    law: str
+    coefficient_names: tuple[str, ...]
+    coefficient_values: tuple[float, ...]
+    linear: bool
+    stiffness: str
+    stiffness_value: float
+    force_unit: str
+    dof_unit: str
+    breakpoints: tuple[float, ...]
+    x: np.ndarray
+    force: np.ndarray
+    exact: np.ndarray | None = None
+
+    __repr__ = _brief_repr
+
+    @property
+    def coefficients(self) -> dict[str, float]:
+        return dict(zip(self.coefficient_names, self.coefficient_values, strict=True))
+
+
+@dataclass(frozen=True)
+class Provenance:
+    """Where a result came from: which whirl and AUTO, which study text and model file, and
+    what of the study its figures name (fixed parameters, slice labels, laws).
+
+    The text fields are the file's root attributes (``""``: not recorded). ``fixed``: the
+    parameters the study sets, in the order written; ``slice_labels``: the labels of the
+    slices of its two-parameter continuations; ``laws``: the law on every dof;
+    ``plot_state``: the study's ``plot_state`` (""); ``dofs``: the model's dofs; ``family``:
+    the model the study names (with ``laws``, the model variant that ran)."""
+
+    whirl_version: str = ""
+    whirl_code_sha256: str = ""
+    git_describe: str = ""
+    auto_version: str = ""
+    created: str = ""
+    study_yaml: str = ""
+    study_sha256: str = ""
+    model_file: str = ""
+    model_file_yaml: str = ""
+    model_file_sha256: str = ""
+    model_key: str = ""
+    first_order_states: str = ""  # comma-separated, as the file stores it
+    fixed: tuple[FixedParameter, ...] = ()
+    slices: tuple[SliceLabel, ...] = ()
+    laws: tuple[LawCurve, ...] = ()
+    plot_state: str = ""
+    dofs: tuple[str, ...] = ()
+    family: str = ""  # the study's ``model``: a built-in family, or the model file's reference
+
+    __repr__ = _brief_repr
+
+    @property
+    def first_order(self) -> tuple[str, ...]:
+        """The model's first-order states (none for a second-order model)."""
+        return tuple(self.first_order_states.split(",")) if self.first_order_states else ()
+
+    def slice_labels(self, continuation: str) -> tuple[str, ...]:
+        """The labels of the slices of ``continuation``, in order (empty: none recorded)."""
+        found = sorted((s.index, s.label) for s in self.slices
+                       if s.continuation == continuation)
+        return tuple(label for _, label in found)
+
+    @property
+    def nonlinear_laws(self) -> tuple[LawCurve, ...]:
+        """The laws that are not a linear spring at the study's values."""
+        return tuple(law for law in self.laws if not law.linear)
+
+    def root_attributes(self) -> dict[str, str]:
+        """The text fields that are recorded, by their root attribute's name."""
+        return {f.name: getattr(self, f.name) for f in fields(self)
+                if f.name in ROOT_FIELDS and getattr(self, f.name)}
+
+
+#: The :class:`Provenance` fields stored as root attributes of a result file.
+ROOT_FIELDS = ("whirl_version", "whirl_code_sha256", "git_describe", "auto_version", "created",
+               "study_yaml", "study_sha256", "model_file", "model_file_yaml",
+               "model_file_sha256", "model_key", "first_order_states")
 
 
 def positions(state_names: tuple[str, ...], first_order: tuple[str, ...] = ()
@@ -712,11 +831,12 @@ class StudyResult:
     continuations: tuple[ContinuationResult, ...]
     linear_sweeps: tuple[LinearSweep, ...]
     runs: tuple[RunRecord, ...]
-    attributes: dict = field(default_factory=dict)  # provenance (versions, study text, hash)
+    attributes: dict = field(default_factory=dict)  # other root attributes (e.g. plots)
     boundaries: tuple[Boundary, ...] = ()
     linear_grid: LinearGrid | None = None
-    parameters: tuple[ParameterValue, ...] = ()  # the resolved set; () in schema-1 files
+    parameters: tuple[ParameterValue, ...] = ()  # the resolved set
     simulations: tuple[Simulation, ...] = ()  # the study's ``simulations:``; () in older files
+    provenance: Provenance = field(default_factory=Provenance)
 
     def continuation(self, name: str) -> ContinuationResult:
         """The continuation called ``name`` (KeyError, listing them, if none is)."""
@@ -753,4 +873,9 @@ class StudyResult:
     @property
     def first_order(self) -> tuple[str, ...]:
         """The model's first-order states (the last states; none for a second-order model)."""
-        return first_order_states(self.attributes)
+        return self.provenance.first_order
+
+    def root_attributes(self) -> dict:
+        """The root attributes of its file besides its name and model: the text fields of its
+        provenance and :attr:`attributes`."""
+        return {**self.attributes, **self.provenance.root_attributes()}

@@ -82,7 +82,7 @@ def test_engine_gives_softening_case2_reference_numbers(engine, tmp_path, monkey
         assert side != 0 and side == np.sign(k1[i] - k1[i + 3]), fold
         extreme = side * (side * k1[i - 3:i + 4]).max()
         assert k1[i] == pytest.approx(extreme, rel=2e-4), fold
-    assert result.attributes["auto_version"] == toolchain.auto_version(engine)
+    assert result.provenance.auto_version == toolchain.auto_version(engine)
 
 
 def test_engines_agree_on_combined_case2(tmp_path, monkeypatch):
@@ -127,7 +127,7 @@ def test_without_debians_auto_whirl_runs_on_bifpy(tmp_path):
     with h5py.File(tmp_path / "b.h5") as handle:
         assert handle.attrs["auto_version"].startswith("bifpy ")
     debian = run_study(load_study(study), tmp_path / "work", jobs=2)
-    assert debian.attributes["auto_version"] == toolchain.auto_version("debian")
+    assert debian.provenance.auto_version == toolchain.auto_version("debian")
     on_bifpy = store.read(tmp_path / "b.h5")
     assert _points(on_bifpy, PointType.HB) == pytest.approx(_points(debian, PointType.HB),
                                                             abs=1e-9)

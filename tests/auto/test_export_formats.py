@@ -69,10 +69,10 @@ def test_a_model_copy_is_computed_and_stored_as_the_study_that_ran(tmp_path):
     api.save(api.run(changed, jobs=2), tmp_path / "changed.h5")
     api.save(api.run(study, jobs=2), tmp_path / "file.h5")
     back = api.read(tmp_path / "changed.h5")
-    stored = stored_study(back.attributes)
+    stored = stored_study(back.provenance)
     assert stored.parameters == {"K_psi": 0.35}
     assert {p.name: p.value for p in back.parameters}["K_psi"] == 0.35  # what was computed
-    original = api.read(tmp_path / "file.h5").attributes
-    assert back.attributes["study_sha256"] != original["study_sha256"]
-    assert original["study_yaml"] == (STUDIES / "linear_case2.yaml").read_text()
+    original = api.read(tmp_path / "file.h5").provenance
+    assert back.provenance.study_sha256 != original.study_sha256
+    assert original.study_yaml == (STUDIES / "linear_case2.yaml").read_text()
     assert list(_hopf(tmp_path / "changed.h5")) != list(_hopf(tmp_path / "file.h5"))

@@ -9,8 +9,9 @@ import stat
 import pytest
 from click.testing import CliRunner
 
+from whirl_cli import publish
 from whirl_cli.cli import cli
-from whirl_cli.output import store, study_files
+from whirl_cli.output import store
 
 from ..conftest import STUDIES
 from ..foreign_paths import KINDS, fingerprint, make, tmpfs
@@ -121,5 +122,5 @@ def test_plots_keep_the_output_stem(tmp_path):
     assert run(AIRSPEED, "-o", output).exit_code == 0
     assert sorted(os.listdir(output.parent)) == [
         "résultat 1.h5", "résultat 1_airspeed_bifurcation.png", "résultat 1_linear_V.png"]
-    assert study_files.recorded_plots(output) == ("résultat 1_airspeed_bifurcation.png",
+    assert publish.recorded_plots(output) == ("résultat 1_airspeed_bifurcation.png",
                                                   "résultat 1_linear_V.png")

@@ -19,13 +19,13 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from whirl_cli import models
+from whirl_cli import models, publish
 from whirl_cli.analysis.simulate import integrate
 from whirl_cli.auto import toolchain
 from whirl_cli.auto.codegen import fortran_source, source_key
 from whirl_cli.cli import cli
 from whirl_cli.models import BUILTIN
-from whirl_cli.output import store, study_files
+from whirl_cli.output import store
 from whirl_cli.pipeline import run_study
 from whirl_cli.plots import files
 from whirl_cli.plots.diagrams import bifurcation_diagram, phase_plane, projections_figure
@@ -105,7 +105,7 @@ def cli_run(tmp_path_factory):
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(files, "_png", recording)
         patch.setattr(files, "render_tasks", render)
-        patch.setattr(study_files, "forked_map", in_turn)
+        patch.setattr(publish, "forked_map", in_turn)
         done = CliRunner().invoke(cli, ["run", str(folder / "oscillators.yaml"), "-o",
                                         str(output), "--jobs", "2"])
     assert done.exit_code == 0, done.output

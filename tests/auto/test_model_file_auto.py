@@ -64,9 +64,9 @@ def test_results_carry_the_model_file(tmp_path):
     result = api.run(load_study(study))
     api.save(result, tmp_path / "s.h5")
     (tmp_path / MODEL.name).unlink()
-    stored = api.read(tmp_path / "s.h5").attributes
-    assert stored["model_file_yaml"] == MODEL.read_text()
-    assert len(stored["model_file_sha256"]) == 64
+    stored = api.read(tmp_path / "s.h5").provenance
+    assert stored.model_file_yaml == MODEL.read_text()
+    assert len(stored.model_file_sha256) == 64
     from whirl_cli.study import stored_study
 
     assert stored_study(stored).variant().family.name == "classical_file"

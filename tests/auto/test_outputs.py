@@ -10,9 +10,10 @@ import h5py
 import pytest
 from click.testing import CliRunner
 
+from whirl_cli import publish
 from whirl_cli.cli import cli
 from whirl_cli.errors import OutputError
-from whirl_cli.output import atomic, store, study_files
+from whirl_cli.output import atomic, store
 from whirl_cli.sweep.plan import PLOT, SKIP, plan
 
 from ..conftest import STUDIES
@@ -40,7 +41,7 @@ def airspeed(tmp_path_factory):
 def test_the_hdf5_file_records_its_plots(airspeed):
     directory, result = airspeed
     assert names(directory) == ["r.h5", "r_airspeed_bifurcation.png", "r_linear_V.png"]
-    assert study_files.recorded_plots(directory / "r.h5") == ("r_airspeed_bifurcation.png",
+    assert publish.recorded_plots(directory / "r.h5") == ("r_airspeed_bifurcation.png",
                                                           "r_linear_V.png")
 
 
@@ -65,7 +66,7 @@ def test_overwrite_removes_the_plots_of_the_old_result(tmp_path):
     again = run(fewer, "-o", tmp_path / "r.h5", "--overwrite")
     assert again.exit_code == 0, again.output
     assert names(tmp_path) == ["fewer.yaml", "r.h5", "r_linear_V.png"]
-    assert study_files.recorded_plots(tmp_path / "r.h5") == ("r_linear_V.png",)
+    assert publish.recorded_plots(tmp_path / "r.h5") == ("r_linear_V.png",)
 
 
 def test_an_interrupt_while_publishing_is_held_until_the_set_is_complete(
@@ -83,7 +84,7 @@ def test_an_interrupt_while_publishing_is_held_until_the_set_is_complete(
 
     monkeypatch.setattr(atomic, "publish", publish_and_interrupt)
     with pytest.raises(KeyboardInterrupt):
-        study_files.publish_study(result, tmp_path / "r.h5", ("bifurcation", "linear"))
+        publish.publish_study(result, tmp_path / "r.h5", ("bifurcation", "linear"))
     assert sent and names(tmp_path) == ["r.h5", "r_airspeed_bifurcation.png", "r_linear_V.png"]
     assert store.read(tmp_path / "r.h5").study_name == result.study_name
 
@@ -105,7 +106,7 @@ def test_a_file_appearing_meanwhile_leaves_no_plots_behind(airspeed, tmp_path, m
 
     monkeypatch.setattr(store, "write", appear_first)
     with pytest.raises(OutputError, match="output exists"):
-        study_files.publish_study(result, tmp_path / "r.h5", ("bifurcation", "linear"))
+        publish.publish_study(result, tmp_path / "r.h5", ("bifurcation", "linear"))
     assert names(tmp_path) == ["r.h5"] and (tmp_path / "r.h5").read_bytes() == another_run
 
 
@@ -121,7 +122,7 @@ def test_a_drawing_error_keeps_the_result_and_is_a_problem(tmp_path, monkeypatch
     assert failed.exit_code == 1
     assert "plots: ZeroDivisionError: a bug in a plot" in failed.output
     assert names(tmp_path) == ["r.h5"]
-    assert study_files.recorded_plots(tmp_path / "r.h5") == ()
+    assert publish.recorded_plots(tmp_path / "r.h5") == ()
 
 
 def test_a_drawing_worker_that_dies_keeps_the_result_and_is_a_problem(tmp_path, monkeypatch):

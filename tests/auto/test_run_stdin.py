@@ -19,6 +19,6 @@ def test_run_reads_the_study_from_standard_input(tmp_path):
     assert done.returncode == 0, done.stderr
     assert "whirl " in done.stderr and ": <stdin> -> linear-case2.h5" in done.stderr
     result = api.read(tmp_path / "linear-case2.h5")
-    assert result.attributes["study_yaml"] == text
-    assert stored_study(result.attributes).name == "linear-case2"
+    assert result.provenance.study_yaml == text
+    assert stored_study(result.provenance).name == "linear-case2"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["linear-case2.h5"]

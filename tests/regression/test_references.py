@@ -38,7 +38,7 @@ def test_fresh_run_matches_reference(name, tmp_path):
     reference = REFERENCES / f"{name}.h5"
     study = load_study(STUDIES / f"{name}.yaml")
     stored = store.read(reference)
-    assert stored.attributes["study_sha256"] == study.sha256, (
+    assert stored.provenance.study_sha256 == study.sha256, (
         f"studies/thesis_ch3/{name}.yaml changed since the reference was made: check the "
         "change, then run `make references`")
     fresh = store.write(run_study(study, tmp_path / "work", jobs=2), tmp_path / f"{name}.h5")

@@ -27,7 +27,7 @@ from whirl_cli import pipeline
 from whirl_cli.cli import cli
 from whirl_cli.errors import OutputError
 from whirl_cli.output import atomic, guard, store
-from whirl_cli.results import StudyResult
+from whirl_cli.results import Provenance, StudyResult
 
 from .helpers import STUDIES, WHIRL, auto_processes, environment
 
@@ -118,7 +118,8 @@ def test_sigkill_at_random_moments_never_leaves_a_partial_file(tmp_path):
 # ------------------------------------------------------------------------------ the writer
 def small_result(name: str = "s") -> StudyResult:
     return StudyResult(study_name=name, model="m", continuations=(), linear_sweeps=(), runs=(),
-                       attributes={"study_yaml": f"name: {name}\n", "note": "x" * 100_000})
+                       attributes={"note": "x" * 100_000},
+                       provenance=Provenance(study_yaml=f"name: {name}\n"))
 
 
 def whirl_file(path: Path, name: str = "old") -> bytes:

@@ -15,7 +15,7 @@ import pytest
 
 from whirl_cli.errors import OutputError
 from whirl_cli.output import atomic, store
-from whirl_cli.results import StudyResult
+from whirl_cli.results import Provenance, StudyResult
 
 CHILD = textwrap.dedent("""
     import os, signal, sys
@@ -79,7 +79,7 @@ def test_sigkill_before_any_step_of_an_overwrite_leaves_old_new_or_nothing(tmp_p
 
 def small_result(name: str = "mine") -> StudyResult:
     return StudyResult(study_name=name, model="m", continuations=(), linear_sweeps=(),
-                       runs=(), attributes={"study_yaml": f"name: {name}\n"})
+                       runs=(), provenance=Provenance(study_yaml=f"name: {name}\n"))
 
 
 def test_an_overwrite_replaces_a_file_another_writer_links_in_between(tmp_path, monkeypatch):

@@ -12,6 +12,7 @@ from whirl_cli.results import (
     ContinuationResult,
     LinearSweep,
     PointType,
+    Provenance,
     RunRecord,
     SpecialPoint,
     StudyResult,
@@ -65,9 +66,9 @@ def make_result(main_points: int = 201, periodic_points: int = 161, **changes) -
     eigenvalues = np.column_stack([-1 + values * 0.1 + 2j, -1 + values * 0.1 - 2j])
     sweep = LinearSweep("V", "m/s", values, eigenvalues, -eigenvalues.real / 2.2,
                         np.abs(eigenvalues.imag), np.array([["FW", "BW"]] * 11))
-    attributes = {"study_sha256": "abc", "study_yaml": "name: x\n", "whirl_version": "0.1.0",
-                  "created": "2026-01-01T00:00:00Z", "auto_version": "0.9.2"}
+    found = Provenance(study_sha256="abc", study_yaml="name: x\n", whirl_version="0.1.0",
+                       created="2026-01-01T00:00:00Z", auto_version="0.9.2")
     result = StudyResult("x", "classical_poly_theta", (continuation,), (sweep,),
                          (RunRecord("k1.main_down", "ok", "ok", "", 0, 0.1, main_points),),
-                         attributes)
+                         provenance=found)
     return replace(result, **changes)

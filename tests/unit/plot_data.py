@@ -10,8 +10,10 @@ from whirl_cli.results import (
     ContinuationResult,
     LinearSweep,
     Origin,
+    ParameterValue,
     PointType,
     SpecialPoint,
+    StudyResult,
 )
 
 STATES = ("theta", "psi", "dtheta", "dpsi")
@@ -74,3 +76,41 @@ def make_sweep() -> LinearSweep:
     whirl = np.array([["BW", "BW", "FW", "FW"]] * 5)
     return LinearSweep("K1", "N m/rad", values, eigenvalues, -eigenvalues.real / modulus,
                        np.abs(eigenvalues.imag), whirl)
+
+
+#: A minimal study text of the classical model (sheet tests write it as a study file).
+STUDY = "name: s\nmodel: classical\n"
+
+
+def result_with(continuation, k2: float, name: str = "study") -> StudyResult:
+    """A classical result holding ``continuation`` and a linear sweep, at K2_theta = ``k2``."""
+    parameters = (ParameterValue("K_psi", 0.3, 0.4, "N m/rad"),
+                  ParameterValue("K2_theta", k2, 0.0, "N m/rad^3"))
+    return StudyResult(name, "classical", (continuation,), (make_sweep(),), (),
+                       parameters=parameters)
+
+
+ASYMPTOTE, SCALE, OFFSET = -0.08, 0.02, 0.3
+
+
+def blowup_family() -> tuple[np.ndarray, np.ndarray]:
+    """A family leaving its Hopf point, turning at a fold (p = -0.04 then back to -0.03),
+    then approaching p = -0.08 with T = 0.3 + 0.02 / (p + 0.08) - 0.35 (a period jump at the
+    fold, so the growth run starts there)."""
+    first = np.linspace(0.3, -0.04, 40)
+    back = np.linspace(-0.04, -0.03, 6)[1:]
+    run = -0.08 + np.geomspace(0.05, 1e-4, 40)
+    period = np.concatenate([0.26 + 0.001 * np.arange(40), 0.30 + 0.01 * np.arange(1, 6),
+                             OFFSET + SCALE / (run - ASYMPTOTE)])
+    return np.concatenate([first, back, run]), period
+
+
+def blowup_continuation() -> ContinuationResult:
+    parameter, period = blowup_family()
+    family = make_branch("periodic_1", BranchKind.PERIODIC, parameter, 0.1 + 0 * parameter,
+                         np.arange(len(parameter)) < 60)
+    family = family.__class__(**{**family.__dict__, "period": period})
+    homoclinic = make_point("periodic_1", PointType.HOMOCLINIC, -0.0801, 0.0)
+    fold = make_point("periodic_1", PointType.LPC, -0.04, 0.0)
+    return ContinuationResult("k1", "one-parameter", (family,),
+                              (homoclinic, fold.__class__(**{**fold.__dict__, "index": 39})))

@@ -21,6 +21,7 @@ from whirl_cli.output.compare import (
 )
 from whirl_cli.results import (
     PointType,
+    Provenance,
     SpecialPoint,
     StudyResult,
 )
@@ -59,10 +60,11 @@ def test_different_sampling_of_the_same_curves_agrees():
 
 def test_provenance_that_changes_legitimately_is_ignored():
     other = make_result()
-    other.attributes.update(created="2027-01-01T00:00:00Z", whirl_version="9.9",
-                            auto_version="1.0", git_describe="abc-dirty")
+    other = replace(other, provenance=replace(
+        other.provenance, created="2027-01-01T00:00:00Z", whirl_version="9.9",
+        auto_version="1.0", git_describe="abc-dirty"))
     assert compare_results(make_result(), other) == []
-    other.attributes["study_sha256"] = "def"
+    other = replace(other, provenance=replace(other.provenance, study_sha256="def"))
     assert compare_results(make_result(), other) == []  # provenance: a note, not drift
     assert paths(compare_results(make_result(), other, strict=True)) == ["/@study_sha256"]
 
@@ -298,8 +300,8 @@ def test_cli_refuses_tolerances_that_are_not_finite_and_non_negative(files, opti
 def test_cli_prints_at_most_the_limit(tmp_path):
     base = make_result()
     sweep = base.linear_sweeps[0]
-    other = replace(base, attributes={**base.attributes, "study_sha256": "zzz",
-                                      "study_yaml": "other"}, study_name="y",
+    other = replace(base, provenance=replace(base.provenance, study_sha256="zzz",
+                                             study_yaml="other"), study_name="y",
                     linear_sweeps=(replace(sweep, values=sweep.values + 1,
                                            eigenvalues=sweep.eigenvalues + 1,
                                            damping_ratio=sweep.damping_ratio + 1,
@@ -311,13 +313,12 @@ def test_cli_prints_at_most_the_limit(tmp_path):
 
 
 @pytest.mark.parametrize("changes", [{"model": "gimballed_poly"},
-                                     {"attributes": {"model_key": "another"}}])
+                                     {"provenance": Provenance(model_key="another")}])
 def test_results_of_different_models_are_not_compared(tmp_path, changes):
     """Another model variant, or a model file declaring other equations or values (its
     stored model_key): one line saying so, exit 1, no list of differences."""
     base = make_result()
-    other = replace(base, **{k: ({**base.attributes, **v} if k == "attributes" else v)
-                             for k, v in changes.items()})
+    other = replace(base, **changes)
     a, b = store.write(base, tmp_path / "a.h5"), store.write(other, tmp_path / "b.h5")
     result = CliRunner().invoke(cli, ["compare", str(a), str(b)])
     assert result.exit_code == 1
@@ -325,3 +326,20 @@ def test_results_of_different_models_are_not_compared(tmp_path, changes):
         f"{a} and {b} are results of different models "
         f"({different_models(base, other)}): not compared"]
     assert different_models(base, base) == ""
+
+
+def test_a_file_with_a_linear_grid_agrees_with_its_copy(tmp_path):
+    """The grid's x and y are dimension scales: their links to the datasets are object
+    references, which differ between two files of the same content."""
+    import shutil
+
+    from whirl_cli.results import LinearGrid
+
+    x, y = np.linspace(0.0, 1.0, 4), np.linspace(0.0, 2.0, 3)
+    grid = LinearGrid("K_theta", "K_psi", "N m/rad", "N m/rad", x, y,
+                      np.subtract.outer(y, x), np.ones((3, 4), dtype=bool), (), ())
+    path = store.write(replace(make_result(), linear_grid=grid), tmp_path / "a.h5")
+    shutil.copy(path, tmp_path / "b.h5")
+    result = CliRunner().invoke(cli, ["compare", str(path), str(tmp_path / "b.h5")])
+    assert result.exit_code == 0, result.output
+    assert "agree" in result.output

@@ -76,13 +76,15 @@ def test_stored_values_are_multiples_times_the_datum(tmp_path):
 
 
 def test_an_older_file_reads_and_draws_against_its_parameter_set(tmp_path):
-    """The reference written before sweeps stored a datum (schema 1, no parameter set): none
-    read, not multiples, and damping_multiples divides by the datum of its stored study's
-    model (V: 6.7 m/s)."""
+    """The reference written before sweeps stored a datum (schema 1, no parameter set): it
+    reads with the datum of its stored study's model (V: 6.7 m/s), not multiples, and
+    damping_multiples divides by it."""
     reference = ROOT / "tests" / "regression" / "references" / "linear_datum_airspeed.h5"
     result = store.read(reference)
     (sweep,) = result.linear_sweeps
-    assert sweep.datum is None and sweep.multiples is False
+    with store.opened(reference) as handle:
+        assert "datum" not in handle["linear/sweeps/V"]
+    assert sweep.datum == 6.7 and sweep.multiples is False
     assert missing_data(result, "damping_multiples") == ""
     ((name, figure),) = list(study_figures(result, ("damping_multiples",), "old"))
     assert name == "old_damping_multiples.png"

@@ -38,7 +38,8 @@ def test_hdf5_layout_doc_names_every_declared_field():
     words = set(re.findall(r"\w+", doc))
     tables = [getattr(store, name) for name in ("BRANCH", "ORBIT", "SPECIAL_POINT", "PARAMETER",
               "CROSS_CHECK", "SEED", "EXPLORATION", "FREEPLAY", "LINEAR_SWEEP", "LINEAR_GRID",
-              "BOUNDARY", "UNSAFE_INTERVAL", "SIMULATION", "RUN")]
+              "BOUNDARY", "UNSAFE_INTERVAL", "SIMULATION", "RUN", "PROVENANCE_ROOT",
+              "PROVENANCE", "FIXED_PARAMETER", "SLICE_LABEL", "LAW_CURVE")]
     keys = {field.hdf5_key(kind).rsplit("/", 1)[-1] for table in tables for field in table
             for kind in (BranchKind.EQUILIBRIUM, BranchKind.PERIODIC)}
     assert keys - words == set()

@@ -10,8 +10,10 @@ import numpy as np
 import pytest
 
 from whirl_cli.models import get_model
+from whirl_cli.output.provenance import law_curve, provenance
 from whirl_cli.plots.laws import law_plot, nonlinear_laws
 from whirl_cli.results import StudyResult
+from whirl_cli.study import validate_text
 
 DELTA, EPSILON, K_OUT, K_IN = math.radians(1.0), math.radians(0.05), 0.4, 0.05
 
@@ -25,7 +27,7 @@ def test_freeplay_law_smoothed_exact_and_their_largest_difference():
     model = get_model("classical", ("freeplay", "polynomial"))
     values = {"K_theta": K_OUT, "delta_theta": DELTA, "epsilon_theta": EPSILON,
               "K_in_theta": K_IN}
-    figure = law_plot(model, values, "theta")
+    figure = law_plot(law_curve(model, values, "theta"))
     lines = lines_by_label(figure)
     smoothed, exact = lines["as continued (smoothed)"], lines["exact"]
     x = np.radians(smoothed.get_xdata())  # drawn in degrees
@@ -59,14 +61,15 @@ def test_numeric_smoothed_law_is_the_symbolic_one():
 def test_polynomial_law_and_which_laws_a_result_draws():
     model = get_model("classical")
     values = {"K_theta": 0.2, "K2_theta": 10.0, "K3_theta": 350.0}
-    lines = lines_by_label(law_plot(model, values, "theta"))
+    lines = lines_by_label(law_plot(law_curve(model, values, "theta")))
     x = np.radians(lines["law"].get_xdata())
     np.testing.assert_allclose(lines["law"].get_ydata(), 0.2 * x + 10 * x**3 + 350 * x**5,
                                rtol=1e-12)
     np.testing.assert_allclose(lines["linear spring (K_theta = 0.2)"].get_ydata(), 0.2 * x)
     study = ("name: s\nmodel: classical\nnonlinearity: {type: polynomial, dof: psi, K2: 5}\n")
-    result = StudyResult("s", "classical_poly", (), (), (), attributes={"study_yaml": study})
-    assert [dof for _, _, dof in nonlinear_laws(result)] == ["psi"]
+    result = StudyResult("s", "classical_poly", (), (), (),
+                         provenance=provenance(validate_text(study)))
+    assert [curve.dof for curve in nonlinear_laws(result)] == ["psi"]
     linear = StudyResult("s", "classical_poly", (), (), (),
-                         attributes={"study_yaml": "name: s\nmodel: classical\n"})
-    assert nonlinear_laws(linear) == []
+                         provenance=provenance(validate_text("name: s\nmodel: classical\n")))
+    assert nonlinear_laws(linear) == ()

@@ -8,8 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.unit.plot_data import make_branch
-from tests.unit.test_thesis_figures import blowup_continuation
+from tests.unit.plot_data import blowup_continuation, make_branch
 from whirl_cli.plots.blowup import blowup_plot
 from whirl_cli.plots.freeplay import amplitude_diagram
 from whirl_cli.plots.key import DECADES, spans_decades

@@ -15,10 +15,10 @@ from pathlib import Path
 
 import pytest
 
-from whirl_cli import api
+from whirl_cli import api, publish
 from whirl_cli.errors import OutputError
 from whirl_cli.figures.build import stored_key
-from whirl_cli.output import atomic, guard, store, study_files
+from whirl_cli.output import atomic, guard, store
 from whirl_cli.plots.files import plot_names, save_study_plots
 
 from ..conftest import ROOT
@@ -56,8 +56,8 @@ def test_a_plot_is_written_only_over_a_png(tmp_path, kind):
     for write in (lambda: save_study_plots(result, ("bifurcation",), tmp_path, "r"),
                   lambda: atomic.publish(b"\x89PNG\r\n\x1a\n", target, True, own=guard.IMAGE),
                   lambda: atomic.publish(b"<!DOCTYPE html>", target, True, own=guard.PAGE),
-                  lambda: study_files.publish_study(small_result(), tmp_path / "r.h5", (),
-                                                    True, drawn=study_files.Drawn(
+                  lambda: publish.publish_study(small_result(), tmp_path / "r.h5", (),
+                                                    True, drawn=publish.Drawn(
                                                         ((name, b"\x89PNG\r\n\x1a\n"),)))):
         with pytest.raises(OutputError, match="whirl never replaces it"):
             write()
@@ -97,7 +97,7 @@ def test_recorded_plots_outside_the_folder_are_never_removed(tmp_path):
     victim.write_bytes(b"\x89PNG\r\n\x1a\nsomeone's")
     (out / "notes.png").write_text("not a PNG")
     store.write(small_result("old", ("../victim.png", str(victim), "notes.png")), out / "r.h5")
-    study_files.publish_study(small_result("new"), out / "r.h5", (), overwrite=True)
+    publish.publish_study(small_result("new"), out / "r.h5", (), overwrite=True)
     assert victim.read_bytes() == b"\x89PNG\r\n\x1a\nsomeone's"
     assert (out / "notes.png").read_text() == "not a PNG"
     assert store.read(out / "r.h5").study_name == "new"
@@ -160,9 +160,9 @@ def test_the_output_directory_is_made_only_when_published(tmp_path, monkeypatch)
     with monkeypatch.context() as patch:
         patch.setattr(store, "write", full)
         with pytest.raises(OutputError, match="disk full"):  # nothing left behind
-            study_files.publish_study(small_result(), out, ())
+            publish.publish_study(small_result(), out, ())
     assert os.listdir(tmp_path) == []
-    study_files.publish_study(small_result(), out, ())
+    publish.publish_study(small_result(), out, ())
     assert store.read(out).study_name == "mine"
 
 
@@ -201,11 +201,11 @@ def test_an_unknown_engine_makes_nothing(tmp_path, monkeypatch):
 PUBLISHER = textwrap.dedent("""
     import sys, time
     from pathlib import Path
-    from whirl_cli.output import study_files
+    from whirl_cli import publish
     from whirl_cli.results import StudyResult
 
     output, name, pause = Path(sys.argv[1]), sys.argv[2], sys.argv[3] == "pause"
-    real = study_files.recorded_plots
+    real = publish.recorded_plots
 
     def recorded_then_wait(path):  # the old file's plots are known: wait for the test
         found = real(path)
@@ -215,10 +215,10 @@ PUBLISHER = textwrap.dedent("""
         return found
 
     if pause:
-        study_files.recorded_plots = recorded_then_wait
+        publish.recorded_plots = recorded_then_wait
     result = StudyResult(study_name=name, model="m", continuations=(), linear_sweeps=(),
                          runs=(), attributes={"study_yaml": f"name: {name}\\n"})
-    study_files.publish_study(result, output, (), overwrite=True, drawn=study_files.Drawn(
+    publish.publish_study(result, output, (), overwrite=True, drawn=publish.Drawn(
         ((f"r_{name}.png", b"\\x89PNG\\r\\n\\x1a\\n" + name.encode()),)))
 """)
 
@@ -236,7 +236,7 @@ def test_two_overwriting_publishers_leave_one_consistent_set(tmp_path):
     result. Now the one published last removes the plots of the result it replaced."""
     out = tmp_path / "out"
     out.mkdir()
-    study_files.publish_study(small_result("old"), out / "r.h5", (), drawn=study_files.Drawn(
+    publish.publish_study(small_result("old"), out / "r.h5", (), drawn=publish.Drawn(
         (("r_old.png", b"\x89PNG\r\n\x1a\nold"),)))
     first = subprocess.Popen([sys.executable, "-c", PUBLISHER, str(out / "r.h5"), "a",
                               "pause"])
@@ -254,7 +254,7 @@ def test_two_overwriting_publishers_leave_one_consistent_set(tmp_path):
         (tmp_path / "go").touch()
     assert first.wait(60) == 0 and second.wait(60) == 0
     plots = sorted(p.name for p in out.glob("*.png"))
-    assert plots == list(study_files.recorded_plots(out / "r.h5")), plots
+    assert plots == list(publish.recorded_plots(out / "r.h5")), plots
 
 
 @pytest.mark.parametrize("kind", ["text", "fifo", "directory"])
@@ -300,13 +300,13 @@ def test_a_plot_another_result_recorded_is_never_replaced(tmp_path, order):
     without --overwrite), the first one's plot and files are left as they were."""
     name = "a_b_c_bifurcation.png"
     first, second = ("a", "a_b") if order == "shorter stem first" else ("a_b", "a")
-    study_files.publish_study(small_result(first), tmp_path / f"{first}.h5", (),
-                              drawn=study_files.Drawn(((name, PNG + b"first"),)))
+    publish.publish_study(small_result(first), tmp_path / f"{first}.h5", (),
+                              drawn=publish.Drawn(((name, PNG + b"first"),)))
     before = sorted(os.listdir(tmp_path)), (tmp_path / name).read_bytes()
     for overwrite in (False, True):
         with pytest.raises(OutputError) as refused:
-            study_files.publish_study(small_result(second), tmp_path / f"{second}.h5", (),
-                                      overwrite, drawn=study_files.Drawn(
+            publish.publish_study(small_result(second), tmp_path / f"{second}.h5", (),
+                                      overwrite, drawn=publish.Drawn(
                                           ((name, PNG + b"second"),)))
         assert str(refused.value) == (f"{tmp_path / name}: a plot of {tmp_path / first}.h5, "
                                       f"not of {tmp_path / second}.h5; whirl never "
@@ -320,8 +320,8 @@ def test_whirl_plot_does_not_replace_a_plot_another_result_recorded(tmp_path):
     result = tmp_path / "x.h5"
     result.write_bytes(LEGACY.read_bytes())
     name = "x_k1_bifurcation.png"
-    study_files.publish_study(small_result("other"), tmp_path / "x_k1.h5", (),
-                              drawn=study_files.Drawn(((name, PNG + b"other"),)))
+    publish.publish_study(small_result("other"), tmp_path / "x_k1.h5", (),
+                              drawn=publish.Drawn(((name, PNG + b"other"),)))
     with pytest.raises(OutputError, match=f"a plot of {tmp_path / 'x_k1.h5'}"):
         save_study_plots(store.read(result), ("bifurcation",), tmp_path, "x",
                          result_file=result)

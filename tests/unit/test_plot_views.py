@@ -6,7 +6,6 @@ it lacks the data for."""
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import h5py
 import numpy as np
@@ -16,8 +15,10 @@ from click.testing import CliRunner
 
 from whirl_cli.cli import cli
 from whirl_cli.output import store
+from whirl_cli.output.provenance import study_parts
 from whirl_cli.plots.files import PLOT_KINDS, View, study_figures
-from whirl_cli.results import Boundary, StudyResult, UnsafeInterval
+from whirl_cli.results import Boundary, Provenance, StudyResult, UnsafeInterval
+from whirl_cli.study import validate_text
 
 from ..conftest import ROOT, STUDIES
 
@@ -36,7 +37,7 @@ def figures(result, kinds, **view):
 
 
 def test_titles_name_the_study_and_its_fixed_parameters(hardening):
-    study = yaml.safe_load(hardening.attributes["study_yaml"])
+    study = yaml.safe_load(hardening.provenance.study_yaml)
     assert study["parameters"] == {"K_psi": 0.3}  # what the title must say, in N m/rad
     want = f"{study['name']}: $K_{{\\psi}}$ = 0.3 N m/rad"
     drawn = figures(hardening, ("bifurcation", "projections", "period", "phase"))
@@ -117,8 +118,8 @@ def labelled_boundary_result() -> StudyResult:
                         {"hopf_0a": ("hopf", np.array([[0.1, 0.0], [0.2, 0.5]]))},
                         (UnsafeInterval(0.3, 0.1, 0.2, "flutter"),), (),
                         (0.4, 0.3, 0.2, 0.05, 0.037))
-    return StudyResult("boundary-linear", "classical_poly", (), (), (),
-                       {"study_yaml": text}, (boundary,))
+    return StudyResult("boundary-linear", "classical_poly", (), (), (), boundaries=(boundary,),
+                       provenance=study_parts(Provenance(study_yaml=text), validate_text(text)))
 
 
 def test_slices_are_labelled_by_the_study():
@@ -134,10 +135,16 @@ def test_slices_are_labelled_by_the_study():
         "boundary-linear\ncase 1: $K_{\\psi}$ = 0.4 N m/rad"
 
 
-def test_without_a_valid_stored_study_titles_are_the_study_name(hardening):
-    broken = replace(hardening, attributes={**hardening.attributes, "study_yaml": "name: ["})
-    figure = figures(broken, ("bifurcation",))["x_k1_bifurcation.png"]
-    assert figure.axes[0].get_title() == "hardening-case2"
+def test_titles_do_not_depend_on_todays_schema(hardening, tmp_path):
+    """A stored study today's schema rejects (a key it no longer knows) changes no title: the
+    fixed parameters come from the provenance stored with the result."""
+    path = store.write(hardening, tmp_path / "r.h5")
+    with h5py.File(path, "r+") as handle:
+        handle.attrs["study_yaml"] = hardening.provenance.study_yaml + "retired_key: 1\n"
+    stored = store.read(path)
+    assert "retired_key" in stored.provenance.study_yaml
+    figure = figures(stored, ("bifurcation",))["x_k1_bifurcation.png"]
+    assert figure.axes[0].get_title() == "hardening-case2: $K_{\\psi}$ = 0.3 N m/rad"
 
 
 # -- whirl plot: every kind the file has; a missing kind is an error --------------------------

@@ -10,29 +10,19 @@ import numpy as np
 import pytest
 from matplotlib.colors import to_hex
 
-from tests.unit.plot_data import STATES, branch_lines, make_sweep
+from tests.unit.plot_data import STATES, STUDY, branch_lines, make_sweep, result_with
 from whirl_cli.errors import StudyError, WhirlError
 from whirl_cli.figures.draw import draw_sheet
 from whirl_cli.figures.index import Entry, index_html
 from whirl_cli.figures.sheet import load_sheet
 from whirl_cli.plots.key import _new_figure
 from whirl_cli.plots.panels import PANEL_KINDS, PanelChoice, differing_labels, draw, draw_overlay
-from whirl_cli.results import ParameterValue, StudyResult
-
-STUDY = "name: s\nmodel: classical\n"
 
 
 def write(folder: Path, name: str, text: str) -> Path:
     path = folder / name
     path.write_text(text)
     return path
-
-
-def result_with(continuation, k2: float, name: str = "study") -> StudyResult:  # noqa: F811
-    parameters = (ParameterValue("K_psi", 0.3, 0.4, "N m/rad"),
-                  ParameterValue("K2_theta", k2, 0.0, "N m/rad^3"))
-    return StudyResult(name, "classical", (continuation,), (make_sweep(),), (),
-                       parameters=parameters)
 
 
 # -- sheet files ---------------------------------------------------------------------------------

@@ -8,6 +8,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+import yaml
 
 from whirl_cli import results
 from whirl_cli.output import store
@@ -176,8 +177,8 @@ def test_every_branch_says_how_it_ends():
                                   "regression/references/linear_datum_airspeed"])
 def test_a_schema_1_file_still_reads_and_plots(tmp_path, name):
     """Files written in schema 1 (no units on special points, no parameter set; a committed
-    reference and an older result): they read, with what they lack left empty, and every plot
-    kind draws."""
+    reference and an older result): they read, the parameter set read off the study stored
+    with them, the units they lack left empty, and every plot kind draws."""
     from click.testing import CliRunner
 
     from whirl_cli.cli import cli
@@ -188,7 +189,10 @@ def test_a_schema_1_file_still_reads_and_plots(tmp_path, name):
     with store.opened(path) as handle:
         assert handle.attrs["whirl_schema"] == 1
     result = store.read(path)
-    assert result.parameters == ()
+    written = yaml.safe_load(result.provenance.study_yaml).get("parameters", {})
+    values = {p.name: p.value for p in result.parameters}
+    assert result.parameters
+    assert all(values[name] == value for name, value in written.items())
     assert all(p.parameter_units == () for c in result.continuations for p in c.special_points)
     run = CliRunner().invoke(cli, ["plot", str(path), "-o", str(tmp_path)])
     assert run.exit_code == 0, run.output

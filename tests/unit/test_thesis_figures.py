@@ -8,7 +8,13 @@ import numpy as np
 import pytest
 from matplotlib.colors import to_hex
 
-from tests.unit.plot_data import make_branch, make_point
+from tests.unit.plot_data import (
+    ASYMPTOTE,
+    OFFSET,
+    SCALE,
+    blowup_continuation,
+    blowup_family,
+)
 from whirl_cli.plots.blowup import approach, blowup_plot, fit_blowup
 from whirl_cli.plots.key import _new_figure
 from whirl_cli.plots.laws import laws_plot
@@ -18,23 +24,9 @@ from whirl_cli.plots.linear import (
     linear_sweep_plot,
     zero_crossings,
 )
-from whirl_cli.results import BranchKind, ContinuationResult, LinearSweep, PointType
+from whirl_cli.results import LinearSweep
 
 from ..conftest import ROOT
-
-ASYMPTOTE, SCALE, OFFSET = -0.08, 0.02, 0.3
-
-
-def blowup_family() -> tuple[np.ndarray, np.ndarray]:
-    """A family leaving its Hopf point, turning at a fold (p = -0.04 then back to -0.03),
-    then approaching p = -0.08 with T = 0.3 + 0.02 / (p + 0.08) - 0.35 (a period jump at the
-    fold, so the growth run starts there)."""
-    first = np.linspace(0.3, -0.04, 40)
-    back = np.linspace(-0.04, -0.03, 6)[1:]
-    run = -0.08 + np.geomspace(0.05, 1e-4, 40)
-    period = np.concatenate([0.26 + 0.001 * np.arange(40), 0.30 + 0.01 * np.arange(1, 6),
-                             OFFSET + SCALE / (run - ASYMPTOTE)])
-    return np.concatenate([first, back, run]), period
 
 
 def test_fit_blowup_recovers_the_asymptote_of_a_1_over_x_approach():
@@ -50,17 +42,6 @@ def test_fit_blowup_recovers_the_asymptote_of_a_1_over_x_approach():
 def test_fit_needs_a_run_over_which_the_period_grows():
     with pytest.raises(ValueError, match="period grows"):
         approach(np.linspace(0.0, 1.0, 20), np.linspace(1.0, 0.5, 20))
-
-
-def blowup_continuation() -> ContinuationResult:
-    parameter, period = blowup_family()
-    family = make_branch("periodic_1", BranchKind.PERIODIC, parameter, 0.1 + 0 * parameter,
-                         np.arange(len(parameter)) < 60)
-    family = family.__class__(**{**family.__dict__, "period": period})
-    homoclinic = make_point("periodic_1", PointType.HOMOCLINIC, -0.0801, 0.0)
-    fold = make_point("periodic_1", PointType.LPC, -0.04, 0.0)
-    return ContinuationResult("k1", "one-parameter", (family,),
-                              (homoclinic, fold.__class__(**{**fold.__dict__, "index": 39})))
 
 
 def test_blowup_plot_draws_the_family_its_points_fit_and_asymptote():
@@ -119,12 +100,13 @@ def test_linear_plot_tells_the_flutter_mode_apart_and_marks_its_onset():
 
 
 def test_laws_side_by_side_with_the_linear_spring():
+    from whirl_cli.output.provenance import law_curve
     from whirl_cli.study import load_study
 
     entries = []
     for name in ("hardening_case2", "softening_case2", "combined_case2"):
         study = load_study(ROOT / "studies" / "thesis_ch3" / f"{name}.yaml")
-        entries.append((study.variant(), study.parameter_values(), "theta", name))
+        entries.append((law_curve(study.variant(), study.parameter_values(), "theta"), name))
     ax = _new_figure().add_subplot()
     laws_plot(entries, ax=ax)
     lines = {line.get_label(): line for line in ax.lines}

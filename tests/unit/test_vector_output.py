@@ -92,10 +92,9 @@ def text_sizes(pdf: bytes) -> list[float]:
 @pytest.mark.parametrize("column, width", [("single", 3.5), ("double", 7.2)])
 def test_a_sheet_set_in_a_journal_column_is_that_wide_with_legible_text(
         tmp_path, continuation, column, width):  # noqa: F811
+    from tests.unit.plot_data import STUDY, result_with
     from whirl_cli.figures.draw import sheet_files
     from whirl_cli.figures.sheet import load_sheet
-
-    from .test_sheets import STUDY, result_with
 
     (tmp_path / "a.yaml").write_text(STUDY)
     (tmp_path / "f.yaml").write_text(

@@ -24,6 +24,7 @@ from ..results import (
     PointType,
     RunStatus,
     SpecialPoint,
+    slice_branch,
 )
 from ..runtime import thread_map
 from .branches import _same_point, head, join, special_points, typical_amplitudes
@@ -110,9 +111,9 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
     for k, (value, result) in enumerate(zip(slices, results, strict=True)):
         runs = {b.name: b.runs for b in result.branches}
         for branch in result.branches:
-            branches.append(replace(branch, name=f"slice_{k}.{branch.name}"))
+            branches.append(replace(branch, name=slice_branch(k, branch.name)))
         for point in result.special_points:
-            named = replace(point, branch=f"slice_{k}.{point.branch}", parameter_names=pair,
+            named = replace(point, branch=slice_branch(k, point.branch), parameter_names=pair,
                             parameters=np.array([point.parameters[0], value]))
             points.append(named)
             width = bounds[first][1] - bounds[first][0]

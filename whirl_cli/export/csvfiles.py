@@ -14,7 +14,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import WhirlError
 from ..output.summary import render as summary
 from ..results import Branch, StudyResult
 from .tables import branch_table, flat_columns
@@ -42,14 +41,9 @@ def _encoded(branch: Branch) -> bytes:
 
 
 def _dofs(result: StudyResult):
-    """The dofs of the study stored with ``result`` (None if it no longer validates), as
-    ``whirl summary`` shows them."""
-    from ..study import stored_study
-
-    try:
-        return stored_study(result.attributes).variant().family.dof_names
-    except WhirlError:
-        return None
+    """The dofs of the model of ``result`` (None if not recorded), as ``whirl summary`` shows
+    them."""
+    return result.provenance.dofs or None
 
 
 def branch_csv(branch: Branch) -> str:

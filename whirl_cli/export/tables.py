@@ -228,7 +228,7 @@ def root_attributes(result: StudyResult) -> dict[str, object]:
     """The HDF5 file's root attributes: study name, model and provenance (texts and
     numbers; lists joined by ", ")."""
     found: dict[str, object] = {"study_name": result.study_name, "model": result.model}
-    for key, value in sorted(result.attributes.items()):
+    for key, value in sorted(result.root_attributes().items()):
         if isinstance(value, str | int | float):
             found[key] = value
         elif isinstance(value, list | tuple | np.ndarray):

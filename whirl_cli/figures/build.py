@@ -92,10 +92,10 @@ def load_sheets(paths: Sequence[str | os.PathLike[str]]) -> tuple[list[Sheet], l
 def _figure_and_caption(path: Path) -> tuple[str, str]:
     """The figure number and caption of a sheet that is not valid, as far as they can be read
     (else its file name and no caption)."""
-    from ..study.source import _compose, _read_text, _Tree
+    from ..study import read_yaml_data
 
     try:
-        data = _Tree(_compose(_read_text(path, path.name, "sheet"), path.name, "sheet")).data
+        data = read_yaml_data(path, "sheet")
     except StudyError:
         data = {}
     figure, caption = data.get("figure"), data.get("caption")
@@ -167,12 +167,13 @@ def _about(results) -> dict[str, str]:
     distinct value once; this whirl's version when no result was read)."""
     from .. import __version__
 
-    names = {"whirl_version": "whirl", "git_describe": "commit", "auto_version": "engine"}
+    records = [r.provenance for r in results]
     about = {}
-    for key, name in names.items():
-        values = sorted({str(r.attributes[key]) for r in results if r.attributes.get(key)})
-        if values:
-            about[name] = ", ".join(values)
+    for name, values in (("whirl", [p.whirl_version for p in records]),
+                         ("commit", [p.git_describe for p in records]),
+                         ("engine", [p.auto_version for p in records])):
+        if any(values):
+            about[name] = ", ".join(sorted(set(filter(None, values))))
     about.setdefault("whirl", __version__)
     return about
 

@@ -25,13 +25,11 @@ from pydantic import (
     BeforeValidator,
     Field,
     PrivateAttr,
-    ValidationError,
     model_validator,
 )
 
-from ..errors import StudyError
 from ..plots.kinds import overlay_kinds, panel_kinds
-from ..study.messages import _report, _translate
+from ..study import load_yaml_file
 from ..study.schema import (
     Boolean,
     Integer,
@@ -44,7 +42,6 @@ from ..study.schema import (
     _fail,
     _Strict,
 )
-from ..study.source import _compose, _read_text, _Tree
 from .numbers import POINTS
 
 PanelKind = Literal[panel_kinds()]  # the kinds plots.panels.draw draws
@@ -261,26 +258,18 @@ class Sheet(_Strict):
 def load_sheet(path: str | os.PathLike[str]) -> Sheet:
     """Read and check the sheet at ``path``; a StudyError lists every problem."""
     path = Path(path)
-    label = str(path)
-    tree = _Tree(_compose(_read_text(path, label, "sheet"), label, "sheet"))
-    problems = list(tree.problems)
-    sheet = None
-    try:
-        sheet = Sheet.model_validate(tree.data)
-    except ValidationError as error:
-        problems += [_translate(e, tree, Sheet) for e in error.errors(include_url=False)]
-    if sheet is not None:
+
+    def checks(sheet: Sheet) -> list:
         sheet._path = path
-        problems += _missing_studies(sheet)
+        problems = _missing_studies(sheet)
         problems += _foreign_thesis_studies(sheet)
         rows, columns = sheet.shape
         if len(sheet.panels) > rows * columns:
             problems.append((("layout",), f"{len(sheet.panels)} panels do not fit a {rows} x "
                                           f"{columns} layout"))
-        problems += _default_size_problems(sheet)
-    if problems:
-        raise StudyError(_report(problems, tree, label))
-    return sheet
+        return problems + _default_size_problems(sheet)
+
+    return load_yaml_file(path, Sheet, "sheet", checks)
 
 
 def _default_size_problems(sheet: Sheet) -> list:

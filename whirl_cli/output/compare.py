@@ -145,7 +145,7 @@ def different_models(a: StudyResult, b: StudyResult) -> str:
     file of other content (its ``model_key``); "" if from the same."""
     if a.model != b.model:
         return f"{a.model} vs {b.model}"
-    keys = [r.attributes.get("model_key", "") for r in (a, b)]
+    keys = [r.provenance.model_key for r in (a, b)]
     if keys[0] != keys[1]:
         return f"{a.model} from model files that declare different equations or values"
     return ""
@@ -196,8 +196,9 @@ def _compare_named(prefix: str, a: dict, b: dict, compare) -> list[Difference]:
 def _compare_root(a: StudyResult, b: StudyResult, skip: frozenset[str]) -> list[Difference]:
     found = []
     pairs = {"study_name": (a.study_name, b.study_name), "model": (a.model, b.model)}
-    for key in sorted((set(a.attributes) | set(b.attributes)) - skip):
-        pairs[key] = (a.attributes.get(key, "<missing>"), b.attributes.get(key, "<missing>"))
+    root_a, root_b = a.root_attributes(), b.root_attributes()
+    for key in sorted((set(root_a) | set(root_b)) - skip):
+        pairs[key] = (root_a.get(key, "<missing>"), root_b.get(key, "<missing>"))
     for key, (x, y) in pairs.items():
         if str(x) != str(y):
             shown = _first_different_line(x, y) if key == "study_yaml" and isinstance(
@@ -735,6 +736,10 @@ def _compare_arrays(path: str, x: np.ndarray, y: np.ndarray, rtol: float) -> lis
 #: Attributes schema 2 added to the datasets of those groups: absent from a schema-1 file,
 #: which is no drift.
 SCHEMA_2_ATTRIBUTES = ("/@names", "/@units")
+#: Attributes of HDF5 dimension scales that hold object references (which dataset a scale
+#: is attached to): equal files hold different references, and the datasets themselves are
+#: compared.
+SCALE_LINKS = frozenset({"REFERENCE_LIST", "DIMENSION_LIST"})
 #: Groups compared dataset by dataset with h5py (their layout is not needed here).
 GENERIC_GROUPS = ("boundaries", "linear/grid")
 
@@ -788,7 +793,7 @@ def _datasets(path: Path, roots: tuple[str, ...]) -> dict[str, np.ndarray]:
                 if isinstance(item, h5py.Dataset):
                     found[where] = decoded(item[()])
                 for key, value in item.attrs.items():
-                    if key not in store.CONTENTS:
+                    if key not in store.CONTENTS | SCALE_LINKS:
                         found[f"{where}/@{key}"] = decoded(value)
 
             for key, value in handle[root].attrs.items():

@@ -1,5 +1,9 @@
 """HDF5 output: the one writer and the one reader of whirl's result files (schema 2; reads 1).
 
+:func:`read` is the one place files of an older whirl are upgraded: a file without the
+``provenance`` group gets what newer files hold from the study stored with it
+(:func:`whirl_cli.output.provenance.upgraded`); nothing else reading a result knows its age.
+
 The layout, group by group, is described in ``docs/hdf5-layout.md`` (a test checks that it
 names every field declared below).
 
@@ -26,6 +30,7 @@ import os
 import re
 from collections.abc import Iterator
 from contextlib import contextmanager
+from dataclasses import replace
 from pathlib import Path
 
 import h5py
@@ -33,6 +38,7 @@ import numpy as np
 
 from ..errors import OutputError
 from ..results import (
+    ROOT_FIELDS,
     Boundary,
     Branch,
     BranchKind,
@@ -42,7 +48,9 @@ from ..results import (
     Criticality,
     CrossCheck,
     Exploration,
+    FixedParameter,
     FreeplayAmplitudes,
+    LawCurve,
     LinearGrid,
     LinearSweep,
     LocateStatus,
@@ -51,16 +59,17 @@ from ..results import (
     Origin,
     ParameterValue,
     PointType,
+    Provenance,
     RunRecord,
     RunStatus,
     SeedKind,
     SeedOutcome,
     Simulation,
     SimulationLaw,
+    SliceLabel,
     SpecialPoint,
     StudyResult,
     UnsafeInterval,
-    first_order_states,
 )
 from .atomic import publish
 from .guard import RESULT, check
@@ -235,6 +244,35 @@ SIMULATION = (
 )
 #: A :class:`ContinuationResult`'s own attributes in ``continuations/<name>``.
 CONTINUATION = (Field("kind", "attribute", "text", vocabulary=ContinuationKind),)
+#: The text fields of :class:`Provenance`: root attributes of the file, each written only
+#: where recorded (not "").
+PROVENANCE_ROOT = tuple(Field(name, "attribute", "text", default="") for name in ROOT_FIELDS)
+#: The rest of :class:`Provenance`, in ``provenance/`` (files before it: read off the study
+#: stored with them, :func:`whirl_cli.output.provenance.upgraded`).
+PROVENANCE = (
+    Field("plot_state", "attribute", "text"), Field("dofs", "attribute", "text"),
+    Field("family", "attribute", "text", default=""),  # not recorded: read off the study
+)
+#: The :class:`FixedParameter` table of ``provenance/fixed``.
+FIXED_PARAMETER = (
+    Field("name", kind="text"), Field("value", kind="float"), Field("unit", kind="text"),
+)
+#: The :class:`SliceLabel` table of ``provenance/slice_labels``.
+SLICE_LABEL = (
+    Field("continuation", kind="text"), Field("index", kind="int"), Field("label", kind="text"),
+)
+#: A :class:`LawCurve` in ``provenance/laws/<dof>`` (its dof is the group's name).
+LAW_CURVE = (
+    Field("law", "attribute", "text"), Field("linear", "attribute", "bool"),
+    Field("coefficient_names", "attribute", "text"),
+    Field("coefficient_values", "attribute", "float"),
+    Field("stiffness", "attribute", "text"), Field("stiffness_value", "attribute", "float"),
+    Field("force_unit", "attribute", "text"), Field("dof_unit", "attribute", "text"),
+    Field("breakpoints", "attribute", "float"),
+    Field("x", unit_field="dof_unit", shape=("samples",)),
+    Field("force", unit_field="force_unit", shape=("samples",)),
+    Field("exact", unit_field="force_unit", default=None, shape=("samples",)),
+)
 #: A :class:`RunRecord` in ``runs/<name>``.
 RUN = (
     Field("status", "attribute", "text", vocabulary=RunStatus),
@@ -339,6 +377,32 @@ def _write_boundary(group: h5py.Group, boundary: Boundary) -> None:
                             "upper": {"units": first}})
 
 
+def _write_provenance(group: h5py.Group, found: Provenance) -> None:
+    write_record(group, found, PROVENANCE)
+    write_table(group.create_group("fixed"), found.fixed, FIXED_PARAMETER,
+                attributes={"value": {"units": [p.unit for p in found.fixed]}})
+    write_table(group.create_group("slice_labels"), found.slices, SLICE_LABEL)
+    laws = _collection(group, "laws")
+    for law in found.laws:
+        write_record(laws.create_group(law.dof), law, LAW_CURVE)
+
+
+def _read_provenance(handle: h5py.File) -> Provenance:
+    """The provenance of a file: its root attributes, and ``provenance/`` where the file has
+    it (else empty there: :func:`read` upgrades it)."""
+    found = Provenance(**read_record(handle, PROVENANCE_ROOT))
+    if "provenance" not in handle:
+        return found
+    group = handle["provenance"]
+    laws = group.get("laws", {})
+    return replace(
+        found, **read_record(group, PROVENANCE),
+        fixed=read_table(member(group, "fixed"), FixedParameter, FIXED_PARAMETER),
+        slices=read_table(member(group, "slice_labels"), SliceLabel, SLICE_LABEL),
+        laws=tuple(LawCurve(dof=dof, **read_record(laws[dof], LAW_CURVE))
+                   for dof in _members(laws)))
+
+
 def _write_grid(group: h5py.Group, grid: LinearGrid) -> None:
     write_record(group, grid, LINEAR_GRID)
     for kind in ("flutter", "divergence"):
@@ -372,8 +436,9 @@ def _image(result: StudyResult) -> bytes:
     with h5py.File(f"whirl-{os.getpid()}-{id(result)}.h5", "w", driver="core",
                    backing_store=False) as handle:
         handle.attrs["whirl_schema"] = SCHEMA
-        for key, value in sorted(result.attributes.items()):
+        for key, value in sorted(result.root_attributes().items()):
             handle.attrs[key] = value
+        _write_provenance(handle.create_group("provenance"), result.provenance)
         handle.attrs["study_name"] = result.study_name
         handle.attrs["model"] = result.model
         for continuation in result.continuations:
@@ -570,8 +635,9 @@ def _open_failure(error: OSError) -> str:
 
 
 def read(path: Path) -> StudyResult:
-    """The :class:`StudyResult` stored in a whirl HDF5 file; :class:`OutputError` (one line
-    naming the file) for a file that is not HDF5, not a whirl file, truncated or damaged."""
+    """The :class:`StudyResult` stored in a whirl HDF5 file, upgraded if an older whirl wrote
+    it (module doc); :class:`OutputError` (one line naming the file) for a file that is not
+    HDF5, not a whirl file, truncated or damaged."""
     with opened(path) as handle:
         if "whirl_schema" not in handle.attrs:
             raise OutputError(f"{path}: an HDF5 file but not a whirl result file (no "
@@ -590,15 +656,21 @@ def read(path: Path) -> StudyResult:
         grid = _read_grid(handle["linear/grid"]) if "linear/grid" in handle else None
         boundaries = tuple(_read_boundary(name, group)
                            for name, group in handle.get("boundaries", {}).items())
-        skip = {"whirl_schema", "study_name", "model", PARTS}
+        skip = {"whirl_schema", "study_name", "model", PARTS, *ROOT_FIELDS}
         attributes = {k: (text(v) if isinstance(v, bytes | str) else v)
                       for k, v in handle.attrs.items() if k not in skip}
         parameters = read_table(member(handle, "parameters"), ParameterValue, PARAMETER) \
             if schema >= 2 else ()
+        found = _read_provenance(handle)
         simulations = tuple(Simulation(name=name, **read_record(group, SIMULATION),
-                                       first_order=first_order_states(attributes))
+                                       first_order=found.first_order)
                             for name, group in handle.get("simulations", {}).items())
-        return StudyResult(text(attribute(handle, "study_name")),
-                           text(attribute(handle, "model")),
-                           continuations, sweeps, runs, attributes, boundaries, grid,
-                           parameters, simulations)
+        result = StudyResult(text(attribute(handle, "study_name")),
+                             text(attribute(handle, "model")),
+                             continuations, sweeps, runs, attributes, boundaries, grid,
+                             parameters, simulations, found)
+        if "provenance" in handle:
+            return result
+    from .provenance import upgraded  # a file of an older whirl: the one place it is upgraded
+
+    return upgraded(result)

@@ -1,9 +1,6 @@
 """What a study's figures are called: titles naming the study and its fixed parameters
 ("combined-case2: K_psi = 0.3 N m/rad"), and the labels of the slices of its two-parameter
-continuations ("case 2"), read from the study text stored with a result.
-
-No matplotlib; imports :mod:`whirl_cli.study` (inside :func:`captions`) to read the stored
-study with canonical parameter names and units.
+continuations ("case 2"), from the provenance stored with a result (no matplotlib).
 """
 
 from __future__ import annotations
@@ -11,7 +8,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
-from ..results import Boundary, ContinuationKind, Simulation, SimulationLaw, StudyResult
+from ..results import Boundary, Simulation, SimulationLaw, StudyResult
 
 
 @dataclass(frozen=True)
@@ -32,16 +29,13 @@ class Fixed:
 @dataclass(frozen=True)
 class Captions:
     """The study's name, the parameters it overrides (in the order written), per
-    two-parameter continuation one label per slice (empty: none given), and the datum of
-    every parameter of its model (canonical names, SI; empty if the study does not
-    validate): what a file without a parameter set (schema 1) divides sweeps by. ``named``:
+    two-parameter continuation one label per slice (empty: none given). ``named``:
     titles start with the study's name (a study's own plot files; a figure of several
     panels names what it shows in its caption instead)."""
 
     study: str
     fixed: tuple[Fixed, ...] = ()
     slice_labels: dict[str, tuple[str, ...]] = field(default_factory=dict)
-    datums: dict[str, float] = field(default_factory=dict)
     named: bool = True
 
     def title(self, varied: Iterable[str] = ()) -> str:
@@ -79,18 +73,10 @@ class Captions:
 
 
 def captions(result: StudyResult) -> Captions:
-    """The captions of ``result`` from the study stored with it (``study_yaml``); if that does
-    not validate (e.g. a file of an older whirl), the study's name alone."""
-    from ..errors import WhirlError
-    from ..study import stored_study
-
-    try:
-        study = stored_study(result.attributes)
-    except WhirlError:
-        return Captions(result.study_name)
-    names = study.names()
-    fixed = tuple(Fixed(names.canonical(key), float(value), names.parameter(key).unit)
-                  for key, value in study.parameters.items())
-    labels = {c.name: tuple(c.slice_labels) for c in study.continuations
-              if c.type == ContinuationKind.TWO_PARAMETER}
-    return Captions(study.name, fixed, labels, dict(names.defaults()))
+    """The captions of ``result`` from its provenance (the study's name alone where that
+    records no parameters or slices)."""
+    found = result.provenance
+    fixed = tuple(Fixed(p.name, p.value, p.unit) for p in found.fixed)
+    labels = {name: found.slice_labels(name)
+              for name in dict.fromkeys(s.continuation for s in found.slices)}
+    return Captions(result.study_name, fixed, labels)

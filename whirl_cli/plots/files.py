@@ -75,8 +75,8 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
     Each file is rendered in memory and published complete or not at all (an existing file
     of the same name is replaced if it is a PNG image, and nothing is written if one is not,
     or if a whirl result file other than ``result_file`` beside it records it as its plot:
-    :func:`whirl_cli.output.study_files.check_plot`). ``whirl run`` and ``whirl sweep`` publish a
-    study's plots together with its HDF5 file instead (:mod:`whirl_cli.output.study_files`).
+    :func:`whirl_cli.output.owners.check_plot`). ``whirl run`` and ``whirl sweep`` publish a
+    study's plots together with its HDF5 file instead (:mod:`whirl_cli.publish`).
     """
     out_dir = Path(out_dir)
     rendered = render_study_plots(result, kinds, stem, state, dpi, view, formats=formats)
@@ -86,7 +86,7 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
         raise OutputError(f"cannot create plot directory {out_dir}: {exc}") from exc
     from ..output.atomic import publish
     from ..output.guard import check
-    from ..output.study_files import check_plot
+    from ..output.owners import check_plot
 
     for name, _ in rendered:  # a PNG is replaced, never a link, directory, device, FIFO
         if name.endswith(".png"):

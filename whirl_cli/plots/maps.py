@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import WhirlError
-from ..results import Boundary, ContinuationKind, ContinuationResult, LinearGrid
+from ..results import Boundary, ContinuationKind, ContinuationResult, LinearGrid, on_slice
 from .diagrams import _checked_branches, _draw_bifurcation
 from .key import (
     _BLACK,
@@ -254,16 +254,15 @@ def _draw_cases(ax: Axes, cases: Sequence[float], labels: Sequence[str] = ()) ->
 def slice_continuation(continuation: ContinuationResult, index: int) -> ContinuationResult:
     """The one-parameter continuation of slice ``index`` of a two-parameter continuation.
 
-    Its branches are those named ``slice_<index>.<branch>``, renamed ``<branch>``, and its
-    special points those on them (branch renamed likewise). Named
+    Its branches are those of that slice (:func:`~whirl_cli.results.on_slice`), named as on
+    the slice, and its special points those on them (branch renamed likewise). Named
     ``<continuation>.slice_<index>``, kind "one-parameter"."""
-    prefix = f"slice_{index}."
-    branches = tuple(replace(b, name=b.name[len(prefix):]) for b in continuation.branches
-                     if b.name.startswith(prefix))
-    points = tuple(replace(p, branch=p.branch[len(prefix):]) for p in continuation.special_points
-                   if p.branch.startswith(prefix))
-    return ContinuationResult(f"{continuation.name}.slice_{index}",
-                              ContinuationKind.ONE_PARAMETER, branches,
+    branches = tuple(replace(b, name=on_slice(b.name, index)) for b in continuation.branches
+                     if on_slice(b.name, index) is not None)
+    points = tuple(replace(p, branch=on_slice(p.branch, index))
+                   for p in continuation.special_points if on_slice(p.branch, index) is not None)
+    return ContinuationResult(f"{continuation.name}.slice_{index}", ContinuationKind.ONE_PARAMETER,
+                              branches,
                               points)
 
 

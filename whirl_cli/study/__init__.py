@@ -47,9 +47,10 @@ from __future__ import annotations
 
 import hashlib
 import os
+from collections.abc import Callable
 from pathlib import Path
 
-from pydantic import ValidationError
+from pydantic import BaseModel, ValidationError
 
 from ..errors import StudyError
 from ..models import is_model_file, load_model_file, register_model_text
@@ -81,6 +82,8 @@ __all__ = [
     "Study",
     "TwoParameterContinuation",
     "load_study",
+    "load_yaml_file",
+    "read_yaml_data",
     "schema_reference",
     "stored_study",
     "validate_text",
@@ -104,13 +107,42 @@ def validate_text(text: str, filename: str = "<study>",
     return _validate(text, filename, filename, Path.cwd(), model_file)
 
 
-def stored_study(attributes: dict, filename: str = "<stored study>") -> Study:
-    """The study stored in a result's root ``attributes`` (``study_yaml``), with the model
-    file stored beside it where it names one; StudyError if it does not validate."""
+def load_yaml_file(path: Path, model: type[BaseModel], what: str,
+                   checks: Callable[[BaseModel], list[Problem]] | None = None) -> BaseModel:
+    """Another YAML file read as studies are (``what``: its kind, e.g. "sheet"): the same
+    limits and YAML rules, validated as the pydantic ``model``, then ``checks`` (key path,
+    reason) on the valid object; StudyError lists every problem as ``<path>:<line>: <key>:
+    <reason>``."""
+    label = str(path)
+    tree = _Tree(_compose(_read_text(Path(path), label, what), label, what))
+    problems = list(tree.problems)
+    found = None
+    try:
+        found = model.model_validate(tree.data)
+    except ValidationError as error:
+        problems += [_translate(e, tree, model) for e in error.errors(include_url=False)]
+    if found is not None and checks is not None:
+        problems += checks(found)
+    if problems:
+        raise StudyError(_report(problems, tree, label))
+    return found
+
+
+def read_yaml_data(path: Path, what: str = "study") -> dict:
+    """The data of a YAML file read as studies are, not validated (StudyError where it is
+    not readable YAML of a mapping)."""
+    return _Tree(_compose(_read_text(Path(path), Path(path).name, what), Path(path).name,
+                          what)).data
+
+
+def stored_study(provenance, filename: str = "<stored study>") -> Study:
+    """The study stored with a result (its :class:`~whirl_cli.results.Provenance`:
+    ``study_yaml``, and the model file beside it where it names one), validated against
+    today's schema; StudyError if it does not validate."""
     stored = None
-    if attributes.get("model_file_yaml"):
-        stored = (str(attributes.get("model_file", "")), str(attributes["model_file_yaml"]))
-    return validate_text(str(attributes.get("study_yaml", "")), filename, stored)
+    if provenance.model_file_yaml:
+        stored = (provenance.model_file, provenance.model_file_yaml)
+    return validate_text(provenance.study_yaml, filename, stored)
 
 
 def _model_reference(tree: _Tree, name: str, folder: Path,

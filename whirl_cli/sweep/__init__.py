@@ -9,12 +9,12 @@
 * :func:`~whirl_cli.sweep.execute.execute`: submits the planned studies to any
   ``concurrent.futures.Executor`` (a local process pool, or Dask's ``Client.get_executor()``)
   and, as each finishes, writes its HDF5 file and plots as one unit
-  (:func:`whirl_cli.output.study_files.publish_study`) **in the parent process only**.
+  (:func:`whirl_cli.publish.publish_study`) **in the parent process only**.
 
 Interrupting (Ctrl-C) cancels the studies not started yet, interrupts the running ones (their
 AUTO processes are killed and their working directories removed) and keeps every output
 already written; a study's outputs are never half a set (see
-:mod:`whirl_cli.output.study_files`).
+:mod:`whirl_cli.publish`).
 
 Modules, lowest first:
 

@@ -7,7 +7,7 @@
   module global).
 * :func:`execute`: submits the planned studies to any ``concurrent.futures.Executor`` (a local
   process pool, or Dask's ``Client.get_executor()``) and, as each finishes, writes its HDF5
-  file and plots as one unit (:func:`whirl_cli.output.study_files.publish_study`) **in the
+  file and plots as one unit (:func:`whirl_cli.publish.publish_study`) **in the
   parent process only**.
 """
 
@@ -27,7 +27,7 @@ from pathlib import Path
 
 from ..errors import WhirlError
 from ..kinds import ContinuationKind, LocusKind, SweepStatus
-from ..output.study_files import publish_plots, publish_study
+from ..publish import publish_plots, publish_study
 from ..results import StudyResult
 from ..runtime import catching, held_signals, quiet_worker
 from ..study import Study

@@ -26,7 +26,7 @@ from ..models import MODEL_SUFFIX, file_key
 from ..output.mapping import word
 from ..output.provenance import code_sha256
 from ..output.store import check_contents
-from ..output.study_files import missing_plots
+from ..publish import missing_plots
 from ..study import Study, load_study
 from ..verdict import is_problem
 

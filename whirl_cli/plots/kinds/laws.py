@@ -24,18 +24,16 @@ def _no_law(result: StudyResult) -> str:
 def _law_files(figures: Figures) -> list[FigureJob]:
     from ..laws import law_plot, nonlinear_laws
 
-    return [(f"{figures.stem}_law_{dof}.png",
-             lambda m=model, v=values, d=dof: law_plot(m, v, d))
-            for model, values, dof in nonlinear_laws(figures.result)]
+    return [(f"{figures.stem}_law_{curve.dof}.png", lambda c=curve: law_plot(c))
+            for curve in nonlinear_laws(figures.result)]
 
 
 def _chosen_law(result: StudyResult, choice: PanelChoice):
-    """(model, values, dof) of the nonlinear law on the dof ``choice.state`` (None: the
-    first)."""
+    """The stored curve of the nonlinear law on the dof ``choice.state`` (None: the first)."""
     from ...errors import WhirlError
     from ..laws import nonlinear_laws
 
-    found = [(m, v, d) for m, v, d in nonlinear_laws(result) if choice.state in (None, d)]
+    found = [c for c in nonlinear_laws(result) if choice.state in (None, c.dof)]
     if not found:
         raise WhirlError(f"{result.study_name}: no nonlinear stiffness law"
                          + (f" on {choice.state!r}" if choice.state else ""))
@@ -45,8 +43,7 @@ def _chosen_law(result: StudyResult, choice: PanelChoice):
 def _law_panel(result, ax, choice, caption=None) -> list[Axes]:
     from ..laws import law_plot
 
-    model, values, dof = _chosen_law(result, choice)
-    law_plot(model, values, dof, ax=ax, title=choice.title)
+    law_plot(_chosen_law(result, choice), ax=ax, title=choice.title)
     return [ax]
 
 
@@ -56,7 +53,7 @@ def _overlay_laws(results: Sequence[StudyResult], names: Sequence[str], ax: Axes
     beside the linear spring (:func:`~whirl_cli.plots.laws.laws_plot`)."""
     from ..laws import laws_plot
 
-    chosen = [(*_chosen_law(result, choice), name)
+    chosen = [(_chosen_law(result, choice), name)
               for result, name in zip(results, names, strict=True)]
     laws_plot(chosen, ax=ax, title=title)
     return [ax]

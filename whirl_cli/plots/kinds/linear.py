@@ -65,15 +65,8 @@ ROOT_LOCUS = PlotKind("root_locus", 30, _root_locus_panel, missing=_no_sweep,
 
 
 def datums(result: StudyResult) -> dict[str, float]:
-    """The datum of every parameter, for files whose sweeps do not store theirs: from the
-    file's parameter set, else (schema 1 files) from the model of the study stored with it."""
-    if result.parameters:
-        return {p.name: p.datum for p in result.parameters}
-    if not result.linear_sweeps:
-        return {}
-    from ..captions import captions
-
-    return captions(result).datums
+    """The datum of every parameter (for files whose sweeps do not store theirs)."""
+    return {p.name: p.datum for p in result.parameters}
 
 
 def multiple_sweeps(result: StudyResult) -> list:

@@ -1,4 +1,6 @@
-"""A study's outputs as one unit: its HDF5 file and its plots appear together or not at all.
+"""A study's outputs as one unit: its HDF5 file and its plots appear together or not at all
+(a stage above :mod:`whirl_cli.output` and :mod:`whirl_cli.plots`, which it imports inside its
+functions).
 
 :func:`publish_study` is how ``whirl run`` and ``whirl sweep`` write a finished study:
 
@@ -32,14 +34,12 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from ..errors import OutputError
-from ..results import StudyResult
-from ..runtime import forked_map, held_signals
-from . import atomic, store
-from .guard import IMAGE, RESULT, check, plot_stem, refusal
-
-#: Root attribute of the HDF5 file: names of the plot files published with it.
-PLOTS_ATTRIBUTE = "plots"
+from .errors import OutputError
+from .output import atomic, store
+from .output.guard import IMAGE, RESULT, check, refusal
+from .output.owners import PLOTS_ATTRIBUTE, check_plot, owner, recorded_plots
+from .results import StudyResult
+from .runtime import forked_map, held_signals
 
 
 @dataclass(frozen=True)
@@ -70,7 +70,7 @@ def drawn_plots(result: StudyResult, kinds: Sequence[str], stem: str,
     interrupt."""
     if not kinds:
         return Drawn()
-    from ..plots.files import render_tasks
+    from .plots.files import render_tasks
 
     try:
         tasks = render_tasks(result, tuple(kinds), stem, state)
@@ -175,7 +175,7 @@ def publish_plots(output: Path, kinds: Sequence[str], state: str | None = None
     """Draw the plots of ``kinds`` of the existing result ``output`` next to it (replacing
     files of the same names if they are PNG images; ``state`` as for :func:`publish_study`):
     how a sweep completes an up-to-date study's plots."""
-    from ..plots.files import render_study_plots
+    from .plots.files import render_study_plots
 
     rendered = render_study_plots(store.read(output), tuple(kinds), Path(output).stem, state)
     targets = [Path(output).parent / name for name, _ in rendered]
@@ -186,57 +186,6 @@ def publish_plots(output: Path, kinds: Sequence[str], state: str | None = None
                      for (_, data), path in zip(rendered, targets, strict=True))
 
 
-def check_plot(path: Path, output: Path, overwrite: bool) -> None:
-    """Raise :class:`OutputError` unless the plot ``path`` of the result file ``output`` may
-    be written: :func:`whirl_cli.output.guard.check` (a PNG image, with ``overwrite``), and
-    no other whirl result file beside it records ``path`` as its plot (two results' plot
-    names can meet: ``a`` with continuation ``b_c`` and ``a_b`` with ``c``)."""
-    other = owner(path, output)
-    if other is not None:
-        raise OutputError(f"{path}: a plot of {other}, not of {output}; whirl never "
-                          "replaces it")
-    check(path, IMAGE, overwrite)
-
-
-def owner(path: Path, output: Path) -> Path | None:
-    """The whirl result file beside the existing file ``path``, other than ``output``, that
-    records it as one of its plots (None if none does). Only results whose stem begins
-    ``path``'s name can: few are opened."""
-    if not os.path.lexists(path):
-        return None
-    directory = Path(path).parent
-    for name in sorted(os.listdir(directory)):
-        other = directory / name
-        if not Path(path).name.startswith(plot_stem(other.stem) + "_") or \
-                _same_file(other, output) or refusal(other, RESULT):
-            continue
-        if Path(path).name in recorded_plots(other):
-            return other
-    return None
-
-
-def _same_file(a: Path, b: Path) -> bool:
-    try:
-        return os.path.samefile(a, b)
-    except OSError:
-        return False
-
-
-def recorded_plots(output: Path) -> tuple[str, ...]:
-    """The plot file names an existing result file records (empty if it records none, is
-    absent or unreadable)."""
-    if not os.path.isfile(output):  # absent, or nothing to open (a FIFO would block)
-        return ()
-    try:
-        import h5py
-
-        with h5py.File(output, "r") as handle:
-            names = handle.attrs.get(PLOTS_ATTRIBUTE, ())
-            return tuple(n.decode() if isinstance(n, bytes) else str(n) for n in names)
-    except (OSError, ValueError, TypeError):
-        return ()
-
-
 def missing_plots(output: Path, kinds: Sequence[str]) -> list[str]:
     """Plot files of ``kinds`` that should stand beside the existing result ``output`` and do
     not: the ones it records, or, if it records none (written with ``--no-plots`` or by an
@@ -245,7 +194,7 @@ def missing_plots(output: Path, kinds: Sequence[str]) -> list[str]:
         return []
     names = recorded_plots(output)
     if not names:
-        from ..plots.files import plot_names
+        from .plots.files import plot_names
 
         names = tuple(plot_names(store.read(output), tuple(kinds), Path(output).stem))
     return [name for name in names if not (Path(output).parent / name).exists()]
