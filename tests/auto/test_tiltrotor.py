@@ -27,7 +27,7 @@ from ..gimballed_exact import matrices
 pytestmark = pytest.mark.auto
 
 STUDY = ROOT / "studies" / "gimballed" / "tiltrotor_gimbal_combined_airspeed.yaml"
-VALUES = {"K_theta": 0.4, "K_psi": 0.3, "K_beta": 0.008446}
+VALUES = {"K_theta": 0.4, "K_psi": 0.3, "K_beta": 0.008446}  # K_theta: the datum
 K2, K3 = -0.21, 7.4  # on beta_y and beta_z
 #: whirl's (thesis) frame to the derivation frame of gimballed_exact: psi, beta_z negated
 FRAME = np.array([1, -1, 1, -1, 1, -1, 1, -1], dtype=float)
@@ -177,15 +177,15 @@ def test_stable_cycles_exist_below_the_linear_onset():
 
 
 def test_floquet_multipliers_are_the_monodromy_matrix_eigenvalues():
-    """At two stored orbits (a stable and an unstable one) the eigenvalues of the monodromy
-    matrix, integrated with scipy over AUTO's orbit, are AUTO's multipliers (1e-3)."""
+    """At every stored orbit but the folds' (among them, at V = 0.92 m/s, the unstable cycle
+    between the fold and the onset) the eigenvalues of the monodromy matrix, integrated with
+    scipy over AUTO's orbit, are AUTO's multipliers (1e-3)."""
     (continuation,) = computed().continuations
     branch = next(b for b in continuation.branches if b.name.startswith("periodic"))
-    checked = {True: 0, False: 0}
+    largest = []
     for orbit in branch.orbits:
-        stable = bool(branch.stable[orbit.index])
-        if checked[stable] or not np.isfinite(orbit.period):
-            continue
+        if orbit.point_type == PointType.LPC:
+            continue  # a Jordan block at 1: its eigenvalues move by the root of the error
         f, jac = _field(float(orbit.parameters[0]))
 
         def variational(t, z, f=f, jac=jac):
@@ -194,12 +194,40 @@ def test_floquet_multipliers_are_the_monodromy_matrix_eigenvalues():
         y0 = orbit.states[0] * FRAME
         sol = solve_ivp(variational, (0, orbit.period), np.concatenate([y0, np.eye(8).ravel()]),
                         method="DOP853", rtol=1e-11, atol=1e-12)
-        mono = sol.y[8:, -1].reshape(8, 8)
-        ours = np.sort_complex(np.linalg.eigvals(mono))
+        ours = np.linalg.eigvals(sol.y[8:, -1].reshape(8, 8))
         auto = branch.eigenvalues[orbit.index]
-        print(f"\n  V = {orbit.parameters[0]:.4f} stable={stable}: |mu| ours "
-              f"{np.round(np.sort(np.abs(ours)), 4)}, AUTO {np.round(np.sort(np.abs(auto)), 4)}")
+        print(f"\n  V = {orbit.parameters[0]:.4f}: |mu| ours {np.round(np.sort(np.abs(ours)), 4)}, "
+              f"AUTO {np.round(np.sort(np.abs(auto)), 4)}")
         for mu in auto[np.isfinite(auto)]:
             assert np.min(np.abs(ours - mu)) < 1e-3 * max(1.0, abs(mu))
-        checked[stable] += 1
-    assert checked[True] and checked[False]
+        largest.append(np.abs(ours).max())
+    assert max(largest) > 1.05 and min(largest) < 1 + 1e-3
+
+
+LINEAR_STUDY = ROOT / "studies" / "gimballed" / "tiltrotor_linear_onset.yaml"
+
+
+@cache
+def linear_computed():
+    return run_study(load_study(LINEAR_STUDY), Path(tempfile.mkdtemp(prefix="whirl-test-")),
+                     jobs=2)
+
+
+def test_the_hopf_locus_is_the_numpy_onset_across_tiltrotor_gimbals():
+    """Every point of the Hopf locus in (V, K_beta) over 1.02-1.10/rev is where the numpy
+    eigenvalues' largest real part crosses zero at its K_beta (1e-4), and the locus spans the
+    whole K_beta range (0.61 m/s at 1.02/rev to 1.36 m/s at 1.10/rev)."""
+    (continuation,) = linear_computed().continuations
+    loci = [b for b in continuation.branches if b.name.startswith("hopf")]
+    k_beta = np.concatenate([b.parameters[:, 1] for b in loci])
+    assert k_beta.min() == pytest.approx(0.0033, abs=1e-6)
+    assert k_beta.max() == pytest.approx(0.0173, abs=1e-6)
+    checked = 0
+    for branch in loci:
+        for v, kb in branch.parameters[::3, :2]:
+            values = {**VALUES, "K_psi": 0.3, "K_beta": float(kb)}
+            onset = brentq(lambda x, values=values: np.linalg.eigvals(
+                _linear(x, values)).real.max(), 0.2, 2.5, xtol=1e-10)
+            assert v == pytest.approx(onset, rel=1e-4)
+            checked += 1
+    assert checked > 10
