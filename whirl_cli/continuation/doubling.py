@@ -54,13 +54,13 @@ def doubled_families(engine: Engine, name: str, parameter: str, bounds: tuple[fl
 def _starts(engine: Engine, name: str, parameter: str, bounds: tuple[float, float],
             numerics: Numerics, families: list[Branch], points: list[SpecialPoint]
             ) -> list[_Family]:
-    """One family to continue from each PD point of ``points`` on one of ``families``."""
+    """One family to continue from each of the PD ``points`` on one of ``families``."""
     by_name = {b.name: b for b in families}
     starts: list[_Family] = []
     count: dict[str, int] = {}
     for point in points:
         branch = by_name.get(point.branch)
-        if branch is None or point.point_type != PointType.PD:
+        if branch is None:
             continue
         count[branch.name] = count.get(branch.name, 0) + 1
         family = f"{branch.name}_pd{count[branch.name]}"
