@@ -315,9 +315,15 @@ def test_at_5_m_s_the_motion_settles_on_the_cycle_auto_continues():
     assert np.all(np.abs(freq / base - np.round(freq / base)) * base < 2 / 60.0)
 
 
-@pytest.mark.xfail(strict=True, reason="explore samples at T_w / 40 with T_w the origin's "
-                   "whirl period (1.75 s here), too coarse for this 3.9 Hz cycle and its "
-                   "harmonics (aliasing): it calls the cycle quasi-periodic")
 def test_explore_calls_the_cycle_at_5_m_s_periodic():
-    """The explore's class at V = 5 m/s is the simulation's above: periodic."""
-    assert _explored(5.0)[1].kind == "periodic"
+    """The explore's class at V = 5 m/s is the simulation's above: periodic at AUTO's
+    frequency (1 %). Its first window, sampled at the origin's whirl period / 40 (1.75 s / 40),
+    is too coarse for this 3.9 Hz cycle and its harmonics: it is sampled again finer (the
+    aliased lines read as a second frequency: quasi-periodic)."""
+    continuation, found = _explored(5.0)
+    family = next(b for b in continuation.branches if b.name == "periodic_1")
+    row = int(np.argmin(np.abs(family.parameters[:, 0] - 5.0)))
+    print(f"\n  V = 5: {found.evidence}")
+    assert found.kind == "periodic"
+    assert found.frequencies[0] == pytest.approx(1 / family.period[row], rel=0.01)
+    assert "finer" in found.evidence
