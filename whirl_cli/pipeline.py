@@ -138,6 +138,7 @@ def _stages(study: Study, model, parameters: dict[str, float], workroot: Path, j
                 engine, name, spec.parameter, spec.start, tuple(spec.range), values,
                 numerics, branch_points=spec.branch_points, periodic=spec.periodic,
                 orbits_at=spec.orbits_at, start_orbits=starts,
+                period_doubling=spec.period_doubling,
                 start_state=None if spec.start_state is None
                 else seeds.seed_state(model, spec.start_state), resting=rests)
 

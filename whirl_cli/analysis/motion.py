@@ -44,6 +44,10 @@ The class (:class:`MotionClass`), in this order:
    frequencies -> ``quasi-periodic``; else (a cloud, a broadband spectrum) -> ``chaotic``
    (weakly: lambda not resolved from zero; the evidence says so).
 
+**The window, sampled finer.** A window whose spectrum reaches its Nyquist frequency (more
+than ALIASED_POWER of its power above 3/4 of it) holds a motion faster than its sampling, whose
+aliased lines would read as frequencies of their own: it is integrated again from its end
+(state and tangent vector) RESAMPLE times finer, at most MAX_RESAMPLES times.
 **The window, doubled once.** Where the section does not repeat but the spectrum reads one
 fundamental (rule 4's spectrum-only ``periodic``), or lambda is not resolved and the section
 is a cloud (weakly ``chaotic``), section and spectrum disagree: near a resonance p:q of a
@@ -79,6 +83,12 @@ MAX_MULTIPLICITY = 8
 CURVE_DIMENSION = 1.5
 #: Spectral peaks kept, down to this fraction of the largest (power).
 PEAK_FLOOR = 1e-4
+#: A window whose spectrum holds more than this fraction of its power above 3/4 of the Nyquist
+#: frequency is sampled too coarsely for its motion (aliased lines would read as frequencies
+#: of their own): it is sampled again, RESAMPLE times finer, at most MAX_RESAMPLES times.
+ALIASED_POWER = 1e-3
+RESAMPLE = 4
+MAX_RESAMPLES = 2
 #: The evidence of a cycle read from the spectrum alone, and of chaos not resolved by lambda.
 SPECTRUM_ONLY = ("the spectrum is one fundamental and its harmonics, though the section did "
                  "not repeat")
@@ -286,8 +296,18 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
     run = tangent_run(f, jac, y0, transient, duration, dt, renormalise=renormalise, rtol=rtol,
                       atol=atol, bound=bound, method=method, scale=scale, seed=seed,
                       at_rest=amplitude_tolerance)
+    finer = 0
+    while finer < MAX_RESAMPLES and _aliased(run, scale):
+        # a motion faster than ``dt`` resolves: the window again, from its end, finer
+        dt, finer = dt / RESAMPLE, finer + 1
+        run = tangent_run(f, jac, run.states[-1], 0.0, duration, dt, rtol=rtol, atol=atol,
+                          bound=bound, method=method, scale=scale, renormalise=renormalise,
+                          tangent=run.tangent)
     motion = _classified(run, scale, amplitude_tolerance, section_state, section_tolerance,
                          lyapunov_tolerance)
+    if finer:
+        motion = replace(motion, evidence=f"{motion.evidence}; sampled {RESAMPLE ** finer}x "
+                         "finer (the first window's spectrum reached its Nyquist frequency)")
     if np.isfinite(run.settled):
         motion = replace(motion, evidence=f"{motion.evidence}; the transient ended at t = "
                          f"{run.settled:.4g} s, at rest at a linearly stable point")
@@ -310,6 +330,17 @@ def classify(f, jac, y0, *, transient: float, duration: float, dt: float,
                          f"{run.time[-1]:.4g} s (before: {first}, the section and the spectrum "
                          "disagreeing)")
     return motion
+
+
+def _aliased(run: TangentRun, scale: np.ndarray) -> bool:
+    """True if the window's spectrum holds more than ALIASED_POWER of its power above 3/4 of
+    its Nyquist frequency (a window that diverged, came to rest or is too short: False)."""
+    if run.diverged or run.tangent is None or len(run.time) < 16 or np.isfinite(run.settled):
+        return False
+    frequency, power = spectrum(run.time, run.states, scale)
+    total = power[1:].sum()
+    return bool(total > 0 and power[frequency > 0.75 * frequency[-1]].sum() > ALIASED_POWER
+                * total)
 
 
 def _undecided(motion: MotionClass) -> bool:

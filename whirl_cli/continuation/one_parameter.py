@@ -1,5 +1,6 @@
 """The one-parameter recipe: equilibria with branch switching, the criticality of their Hopf
-points and, when asked, the periodic family of every Hopf point and of every given orbit.
+points and, when asked, the periodic family of every Hopf point and of every given orbit, and
+the period-doubled family of every period-doubling point on them.
 """
 
 from __future__ import annotations
@@ -10,6 +11,7 @@ import numpy as np
 
 from ..results import ContinuationKind, ContinuationResult
 from .criticality import _with_criticality, with_lyapunov
+from .doubling import doubled_families
 from .engine import Engine, Numerics
 from .equilibria import equilibria, is_linear
 from .periodic import OrbitStart, orbit_families, periodic_families
@@ -21,14 +23,16 @@ def one_parameter(engine: Engine, name: str, parameter: str, start: float,
                   periodic: bool = False, orbits_at: tuple[float, ...] = (),
                   start_orbits: tuple[OrbitStart, ...] = (),
                   start_state: np.ndarray | None = None,
-                  resting: tuple[np.ndarray, ...] = ()) -> ContinuationResult:
+                  resting: tuple[np.ndarray, ...] = (),
+                  period_doubling: bool = False) -> ContinuationResult:
     """Equilibria of ``parameter`` over ``bounds`` from ``start`` (from the equilibrium found
     by Newton's method from ``start_state``, SI, default zero), with branch switching, and
     (``periodic``) the periodic families of every Hopf point, and those through each of
     ``start_orbits`` (e.g. orbits settled by time simulation). ``orbits_at``: parameter values
     where every branch stores a labelled solution (orbit profiles); ``resting``: states (SI)
     at ``start`` near equilibria (e.g. where seeds came to rest), each starting a branch if
-    it is on none (see :func:`.equilibria.equilibria`)."""
+    it is on none (see :func:`.equilibria.equilibria`); ``period_doubling``: the families
+    doubled at the PD points of the periodic ones (:mod:`.doubling`)."""
     numerics = replace(numerics, orbits_at=tuple(orbits_at))
     branches, points = equilibria(engine, name, parameter, start, bounds, parameters, numerics,
                                   branch_points, start_state, tuple(resting))
@@ -46,6 +50,13 @@ def one_parameter(engine: Engine, name: str, parameter: str, start: float,
         steady = [b for b in branches if not b.is_periodic]
         families, family_points = orbit_families(engine, name, parameter, bounds, numerics,
                                                  list(start_orbits), steady, points, parameters)
+        branches += families
+        points += family_points
+    if period_doubling:
+        steady = [b for b in branches if not b.is_periodic]
+        families, family_points = doubled_families(
+            engine, name, parameter, bounds, numerics, [b for b in branches if b.is_periodic],
+            points, steady, parameters)
         branches += families
         points += family_points
     return ContinuationResult(name, ContinuationKind.ONE_PARAMETER, tuple(branches), tuple(points))

@@ -424,12 +424,12 @@ def _next_segment(family: _Family, model: Model, hopfs: list[SpecialPoint],
 def _segment_constants(family: _Family, **changes) -> dict:
     """Constants of a run that continues ``family`` from a labelled point of its last piece:
     its first run's (the sign of DS with them: AUTO goes on in the direction the restart
-    point was reached), to the next fold of cycles, without a Hopf start's amplitude stop or
-    an orbit start's parameter values and first label (they would replace the restart
-    point's)."""
+    point was reached), to the next fold of cycles, without a Hopf start's amplitude stop, an
+    orbit start's parameter values and first label (they would replace the restart point's)
+    or a branch switch (ISW=1: the restart point is a regular one)."""
     constants = {key: value for key, value in family.spec.constants.items()
                  if key not in ("PAR", "LAB")}
-    constants.update(STOP=["LP1"], **changes)
+    constants.update(STOP=["LP1"], ISW=1, **changes)
     constants["UZSTOP"] = {k: v for k, v in constants["UZSTOP"].items() if k != AMPLITUDE}
     return constants
 

@@ -292,6 +292,11 @@ class OneParameterContinuation(_Strict):
     branch_points: Boolean = Field(
         True, description="Switch at branch points (pitchforks) to follow secondary equilibria."
     )
+    period_doubling: Boolean = Field(
+        False, description="Follow the period-doubled family from every period-doubling (PD) "
+        "point of a periodic family (AUTO's branch switching at PD, the period doubled), and "
+        "from theirs, up to 3 doublings; stored as branches `<family>_pd<k>`."
+    )
     start_state: Annotated[dict[str, float] | None, BeforeValidator(_as_state)] = Field(
         None,
         description="Where Newton's method seeks the starting equilibrium at `start` when the "
