@@ -30,8 +30,8 @@ if TYPE_CHECKING:
 
 #: The default initial state of ``explore``: the first dof displaced by this (deg for angles).
 EXPLORE_OFFSET = 2.0
-#: Whirl periods an ``explore`` simulation discards before it classifies (classify_model's 15
-#: left a weakly attracting cycle of hardening case 2 still growing, its frequency 5 % off).
+#: Whirl periods an ``explore`` simulation discards before it classifies (a weakly attracting
+#: cycle needs many to settle).
 EXPLORE_TRANSIENT = 60.0
 
 
@@ -125,10 +125,6 @@ def _cost(spec: OneParameterContinuation, study: Study) -> int:
     return 1 + 2 * spec.periodic + 2 * spec.periodic * bool(study.cross_check)
 
 
-def _resolved(item: dict, names: Names, values: dict[str, float] | None) -> Any:
-    return resolved_parameter(item, names, values)
-
-
 def _problems(loc, item: dict, names: Names, family: str, values: dict[str, float]) -> list:
     from ..checks import single_problems
 
@@ -136,4 +132,4 @@ def _problems(loc, item: dict, names: Names, family: str, values: dict[str, floa
 
 
 ONE_PARAMETER = ContinuationType(ContinuationKind.ONE_PARAMETER, 10, OneParameterContinuation,
-                                 _recipe, _cost, _resolved, _problems, repeated=True)
+                                 _recipe, _cost, resolved_parameter, _problems, repeated=True)

@@ -140,10 +140,6 @@ def _cost(spec: TwoParameterContinuation, study) -> int:
                                + 6 * (Locus.FOLD_OF_CYCLES in spec.loci))
 
 
-def _resolved(item: dict, names: Names, values: dict[str, float] | None) -> Any:
-    return resolved_pair(item, names, values)
-
-
 def _problems(loc, item: dict, names: Names, family: str, values: dict[str, float]) -> list:
     from ..checks import pair_problems
 
@@ -151,4 +147,4 @@ def _problems(loc, item: dict, names: Names, family: str, values: dict[str, floa
 
 
 TWO_PARAMETER = ContinuationType(ContinuationKind.TWO_PARAMETER, 20, TwoParameterContinuation,
-                                 _recipe, _cost, _resolved, _problems)
+                                 _recipe, _cost, resolved_pair, _problems)
