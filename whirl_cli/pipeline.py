@@ -13,7 +13,7 @@ from contextlib import ExitStack
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
-from typing import TypeVar
+from typing import Any, NamedTuple, TypeVar
 
 import numpy as np
 
@@ -27,7 +27,6 @@ from .continuation.periodic import OrbitStart
 from .output.provenance import provenance, resolved_parameters
 from .results import (
     Boundary,
-    ContinuationKind,
     ContinuationResult,
     Exploration,
     MotionKind,
@@ -41,8 +40,24 @@ from .results import (
 )
 from .runtime import Standby, forked_map, preload, preloaded, thread_map
 from .study import Study
+from .study import continuations as continuation_types
 
 T = TypeVar("T")
+
+
+class Stage(NamedTuple):
+    """What a continuation type's recipe runs with: the engine (AUTO; None in a study without
+    continuations), the study, its model variant and parameter values, AUTO's numerics, the
+    jobs, and the modules to import in the background once its AUTO runs start
+    (``preload(*later)``)."""
+
+    engine: Engine | None
+    study: Study
+    model: Any
+    parameters: dict[str, float]
+    numerics: Numerics
+    jobs: int
+    later: tuple[str, ...]
 
 
 def run_study(study: Study, workroot: Path, jobs: int = 1,
@@ -118,41 +133,13 @@ def _stages(study: Study, model, parameters: dict[str, float], workroot: Path, j
     engine = None
     if study.continuations:
         engine = new_engine(model, workroot, timeout=numerics.timeout)
+    stage = Stage(engine, study, model, parameters, numerics, jobs, later)
     found_boundaries = []
     for spec in study.continuations:
-        assert engine is not None
-        if spec.type == ContinuationKind.TWO_PARAMETER:
-            preload(*later)  # imported while AUTO runs
-            continuation, boundary = _two_parameter(engine, study, spec, parameters,
-                                                    numerics)
-            continuations.append(continuation)
-            found_boundaries.append(boundary)
-            continue
-        starts, rests, outcomes = seeded_orbits(model, parameters, spec.parameter,
-                                                spec.start, spec.seeds, jobs)
-        preload(*later)  # imported while AUTO runs (after the seeds' fork)
-
-        def continued(name: str, values: dict[str, float], spec=spec, starts=starts,
-                      rests=rests):
-            return one_parameter(
-                engine, name, spec.parameter, spec.start, tuple(spec.range), values,
-                numerics, branch_points=spec.branch_points, periodic=spec.periodic,
-                orbits_at=spec.orbits_at, start_orbits=starts,
-                period_doubling=spec.period_doubling,
-                start_state=None if spec.start_state is None
-                else seeds.seed_state(model, spec.start_state), resting=rests)
-
-        continuation = replace(continued(spec.name, parameters), seeds=outcomes)
-        if model.smoothing_parameters:
-            continuation = persisted(engine, continuation, continued, spec, parameters,
-                                     numerics)
-        if freeplay.freeplay_dofs(model):  # amplitudes / delta, describing function
-            continuation = replace(continuation, freeplay=freeplay.freeplay_amplitudes(
-                model, parameters, continuation, tuple(spec.range)))
-        if spec.explore:
-            continuation = replace(continuation, explorations=explorations(
-                model, parameters, spec, jobs))
+        continuation, boundary = continuation_types.of(spec).recipe(stage, spec)
         continuations.append(continuation)
+        if boundary is not None:
+            found_boundaries.append(boundary)
     preloaded()  # the stages below import scipy and draw: not beside a background import
     branches = tuple(c.branches for c in continuations)
     if checker is not None:  # checked while the stages below run
@@ -271,15 +258,16 @@ def explorations(model, overrides: dict[str, float], spec,
     """The settled motion at each ``explore`` value of a one-parameter continuation, by
     simulation (:func:`whirl_cli.analysis.motion.classify_model`) at the study's parameters
     with the continuation parameter at that value, from ``explore_initial`` (default: the
-    first dof at :data:`whirl_cli.study.schema.EXPLORE_OFFSET`, deg for an angle), after
-    ``explore_transient`` whirl periods, on the section where ``explore_section`` (default:
-    the first dof's rate, i.e. at that dof's minima) crosses its mean upwards.
+    first dof at :data:`whirl_cli.study.continuations.one_parameter.EXPLORE_OFFSET`, deg
+    for an angle), after ``explore_transient`` whirl periods, on the section where
+    ``explore_section`` (default: the first dof's rate, i.e. at that dof's minima) crosses
+    its mean upwards.
 
     ``jobs`` values at a time in forked processes (:func:`whirl_cli.runtime.forked_map`:
     each value's simulation is independent of the others, so the results are identical for
     any ``jobs``, in the order of ``explore``). A failure is the result ``diverged`` with its
     message, never raised."""
-    from .study.schema import EXPLORE_OFFSET
+    from .study.continuations.one_parameter import EXPLORE_OFFSET
 
     parameter = model.parameter(model.canonical(spec.parameter))
     first = model.state_names[model.positions[0]]  # the first dof (or first-order state)
@@ -366,9 +354,13 @@ def slice_seeds(model, overrides: dict[str, float], spec, jobs: int = 1
     return tuple(per_slice), tuple(outcomes)
 
 
-def _two_parameter(engine: Engine, study: Study, spec, parameters: dict[str, float],
-                   numerics: Numerics) -> tuple[ContinuationResult, Boundary]:
-    """Loci and the unsafe region of a two-parameter continuation."""
+def continue_two_parameter(stage: Stage, spec) -> tuple[ContinuationResult, Boundary]:
+    """Loci and the unsafe region of a two-parameter continuation (the two-parameter type's
+    recipe)."""
+    engine, study, parameters, numerics = stage.engine, stage.study, stage.parameters, \
+        stage.numerics
+    assert engine is not None
+    preload(*stage.later)  # imported while AUTO runs
     model = engine.model
     pair = tuple(spec.parameters)
     bounds = spec.bounds(study.names())
@@ -383,3 +375,35 @@ def _two_parameter(engine: Engine, study: Study, spec, parameters: dict[str, flo
     found = boundaries.boundary(spec.name, model, parameters, pair, bounds, spec.method,
                                 spec.slice_values, spec.resolution, curves, per_slice)
     return continuation, found
+
+
+def continue_one_parameter(stage: Stage, spec) -> tuple[ContinuationResult, None]:
+    """Equilibria in one parameter and what hangs off them (the one-parameter type's recipe):
+    seeds simulated first, special points recomputed as a smoothing shrinks, freeplay
+    amplitudes, explored values."""
+    engine, model, parameters, numerics = stage.engine, stage.model, stage.parameters, \
+        stage.numerics
+    assert engine is not None
+    starts, rests, outcomes = seeded_orbits(model, parameters, spec.parameter, spec.start,
+                                            spec.seeds, stage.jobs)
+    preload(*stage.later)  # imported while AUTO runs (after the seeds' fork)
+
+    def continued(name: str, values: dict[str, float]) -> ContinuationResult:
+        return one_parameter(
+            engine, name, spec.parameter, spec.start, tuple(spec.range), values, numerics,
+            branch_points=spec.branch_points, periodic=spec.periodic,
+            orbits_at=spec.orbits_at, start_orbits=starts,
+            period_doubling=spec.period_doubling,
+            start_state=None if spec.start_state is None
+            else seeds.seed_state(model, spec.start_state), resting=rests)
+
+    continuation = replace(continued(spec.name, parameters), seeds=outcomes)
+    if model.smoothing_parameters:
+        continuation = persisted(engine, continuation, continued, spec, parameters, numerics)
+    if freeplay.freeplay_dofs(model):  # amplitudes / delta, describing function
+        continuation = replace(continuation, freeplay=freeplay.freeplay_amplitudes(
+            model, parameters, continuation, tuple(spec.range)))
+    if spec.explore:
+        continuation = replace(continuation, explorations=explorations(
+            model, parameters, spec, stage.jobs))
+    return continuation, None

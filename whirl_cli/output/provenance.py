@@ -20,7 +20,6 @@ import numpy as np
 from .. import __version__
 from ..models import file_key
 from ..results import (
-    ContinuationKind,
     FixedParameter,
     LawCurve,
     ParameterValue,
@@ -83,7 +82,6 @@ def study_parts(found: Provenance, study) -> Provenance:
     fixed = tuple(FixedParameter(names.canonical(key), float(value), names.parameter(key).unit)
                   for key, value in study.parameters.items())
     slices = tuple(SliceLabel(c.name, k, label) for c in study.continuations
-                   if c.type == ContinuationKind.TWO_PARAMETER
                    for k, label in enumerate(c.slice_labels))
     laws = tuple(law_curve(model, values, dof) for dof in model.family.dof_names)
     return replace(found, fixed=fixed, slices=slices, laws=laws,

@@ -20,8 +20,9 @@ import re
 from collections.abc import Iterator
 from typing import Any
 
-from ..kinds import ContinuationKind, SimulationLaw
+from ..kinds import SimulationLaw
 from ..models import family_of, is_known
+from . import continuations
 from .messages import _choice_reason, _dotted
 from .resolve import (
     Names,
@@ -133,7 +134,7 @@ def _continuation_name_problems(items: Any, names: Names) -> list[Problem]:
         for _, other, kind in named:
             if name.startswith(other + "."):
                 reason = f"its runs are named {other}.<run>"
-            elif smoothed and kind == ContinuationKind.ONE_PARAMETER and re.fullmatch(
+            elif smoothed and _repeated(kind) and re.fullmatch(
                     re.escape(other) + r"_eps\d+", name):
                 reason = (f"with a smoothed law its repetitions are named {other}_eps<k>")
             else:
@@ -143,6 +144,12 @@ def _continuation_name_problems(items: Any, names: Names) -> list[Problem]:
                              "name"))
             break
     return problems
+
+
+def _repeated(kind: Any) -> bool:
+    """Whether a smoothed law repeats a continuation of type ``kind`` as ``<name>_eps<k>``."""
+    found = continuations.get(kind)
+    return found is not None and found.repeated
 
 
 def _simulation_problems(items: Any, names: Names, family: str,
@@ -409,34 +416,46 @@ def _continuation_problems(
     taken: set[str] = set()
     for i, item in _dict_items(items):
         loc = ("continuations", i)
-        name, parameter = item.get("name"), item.get("parameter")
+        name = item.get("name")
         if isinstance(name, str) and name in taken:
             problems.append((loc + ("name",), f"duplicate continuation name {name!r}"))
         if isinstance(name, str):
             taken.add(name)
-        if item.get("type") == ContinuationKind.TWO_PARAMETER:
-            problems += _pair_problems(loc, item, names, family, values)
-            problems += _seed_problems(loc, item.get("seeds"), family)
-            continue
-        found = _parameter_problems(loc + ("parameter",), parameter, names, family)
-        if not found and isinstance(parameter, str):
-            canonical = names.canonical(parameter)
-            found = _range_problems(loc + ("range",), canonical, item.get("range"), names,
-                                    "continued") or _range_constraint_problems(
-                loc + ("range",), canonical, item.get("range"), family, values)
-            found = found or _start_problems(loc, item, values[canonical])
-            found = found or _law_range_problems(loc + ("range",), canonical,
-                                                 item.get("range"), names, values)
-            found += _orbits_problems(loc, item)
-            found += _orbits_problems(loc, item, "explore")
-            found += _seed_problems(loc, item.get("seeds"), family)
-            for key in ("explore_initial", "start_state"):
-                found += _initial_problems(loc + (key,), item.get(key), family)
-            section = item.get("explore_section")
-            if isinstance(section, str):
-                found += _state_problems(loc + ("explore_section",), section, family)
-        problems += found
+        kind = continuations.get(item.get("type")) or continuations.first()
+        problems += kind.problems(loc, item, names, family, values)
     return problems
+
+
+def pair_problems(loc: Loc, item: dict, names: Names, family: str,
+                  values: dict[str, float]) -> list[Problem]:
+    """A two-parameter continuation: its parameters, range, start, slices and seeds."""
+    return _pair_problems(loc, item, names, family, values) + \
+        _seed_problems(loc, item.get("seeds"), family)
+
+
+def single_problems(loc: Loc, item: dict, names: Names, family: str,
+                    values: dict[str, float]) -> list[Problem]:
+    """A one-parameter continuation: its parameter, range, start, ``orbits_at``,
+    ``explore``, seeds and the states it names."""
+    parameter = item.get("parameter")
+    found = _parameter_problems(loc + ("parameter",), parameter, names, family)
+    if not found and isinstance(parameter, str):
+        canonical = names.canonical(parameter)
+        found = _range_problems(loc + ("range",), canonical, item.get("range"), names,
+                                "continued") or _range_constraint_problems(
+            loc + ("range",), canonical, item.get("range"), family, values)
+        found = found or _start_problems(loc, item, values[canonical])
+        found = found or _law_range_problems(loc + ("range",), canonical,
+                                             item.get("range"), names, values)
+        found += _orbits_problems(loc, item)
+        found += _orbits_problems(loc, item, "explore")
+        found += _seed_problems(loc, item.get("seeds"), family)
+        for key in ("explore_initial", "start_state"):
+            found += _initial_problems(loc + (key,), item.get(key), family)
+        section = item.get("explore_section")
+        if isinstance(section, str):
+            found += _state_problems(loc + ("explore_section",), section, family)
+    return found
 
 
 def _seed_problems(loc: Loc, seeds: Any, family: str) -> list[Problem]:

@@ -19,17 +19,13 @@ from typing import Any
 
 from pydantic import BaseModel
 
-from ..kinds import ContinuationKind
 from ..models import LAWS, Model, Parameter, family_of, get_model, is_known
+from .values import _is_number
 
 #: Study law types: ``linear`` is the polynomial law with zero coefficients.
 LAW_TYPES = ("linear", *LAWS)
 #: The thesis' names of the single law's coefficients (``K1`` its dof's linear stiffness).
 THESIS_NAMES = ("K1", "K2", "K3")
-
-
-def _is_number(value: Any) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool)
 
 
 def _finite(value: Any) -> float | None:
@@ -199,14 +195,14 @@ def _resolved(data: dict) -> dict:
     values = _study_values(data, names)
     items = data.get("continuations")
     if isinstance(items, list | tuple):
-        data["continuations"] = [_resolved_item(c, names, values) for c in items]
+        data["continuations"] = [_resolved_continuation(c, names, values) for c in items]
     linear = data.get("linear")
     if isinstance(linear, dict) and isinstance(linear.get("sweeps"), list | tuple):
-        sweeps = [_resolved_item(s, names, None) for s in linear["sweeps"]]
+        sweeps = [resolved_parameter(s, names, None) for s in linear["sweeps"]]
         data["linear"] = {**linear, "sweeps": sweeps}
     linear = data.get("linear")
     if isinstance(linear, dict) and isinstance(linear.get("grid"), dict):
-        grid = {k: _resolved_item(v, names, None) for k, v in linear["grid"].items()}
+        grid = {k: resolved_parameter(v, names, None) for k, v in linear["grid"].items()}
         data["linear"] = {**linear, "grid": grid}
     return data
 
@@ -221,7 +217,18 @@ def _named_simulations(data: dict) -> dict:
         else item for k, item in enumerate(items, 1)]}
 
 
-def _resolved_pair(item: dict, names: Names, values: dict[str, float] | None) -> dict:
+def _resolved_continuation(item: Any, names: Names, values: dict[str, float] | None) -> Any:
+    """A continuation mapping resolved as its type resolves it (a mapping without a known
+    ``type``: as the first type)."""
+    from . import continuations  # its types resolve with this module's functions
+
+    if not isinstance(item, dict):
+        return item
+    kind = continuations.get(item.get("type")) or continuations.first()
+    return kind.resolved(item, names, values)
+
+
+def resolved_pair(item: dict, names: Names, values: dict[str, float] | None) -> dict:
     """A two-parameter continuation with canonical parameter names, ``start`` and ``slices``
     filled; the keys of ``range`` stay as written (see ``TwoParameterContinuation.bounds``)."""
     pair = item.get("parameters")
@@ -239,10 +246,8 @@ def _resolved_pair(item: dict, names: Names, values: dict[str, float] | None) ->
     return item
 
 
-def _resolved_item(item: Any, names: Names, values: dict[str, float] | None) -> Any:
+def resolved_parameter(item: Any, names: Names, values: dict[str, float] | None) -> Any:
     """A continuation or sweep with its canonical parameter name (and start, given values)."""
-    if isinstance(item, dict) and item.get("type") == ContinuationKind.TWO_PARAMETER:
-        return _resolved_pair(item, names, values)
     name = item.get("parameter") if isinstance(item, dict) else None
     if not isinstance(name, str) or name not in names.known_parameter_names():
         return item

@@ -1,194 +1,54 @@
-"""The study schema: value checks and the pydantic models of a study file.
+"""The study schema: the pydantic models of a study file.
 
-Every model forbids unknown keys and is frozen. A value check rejects a value with the reason a
-message shows (``{got}`` becomes the value as written in the YAML, see
-:mod:`whirl_cli.study.messages`); the Annotated types (``Name``, ``Number``, ``Range``, ...)
-attach the checks to the fields. :class:`Study` fills the model-dependent defaults before it
-validates (:mod:`whirl_cli.study.resolve`).
+Every model forbids unknown keys and is frozen. The value checks are those of
+:mod:`whirl_cli.study.values`, the continuation specs those of the registered types
+(:mod:`whirl_cli.study.continuations`). :class:`Study` fills the model-dependent defaults
+before it validates (:mod:`whirl_cli.study.resolve`).
 """
 
 from __future__ import annotations
 
 import functools
 import hashlib
-import math
 import operator
-import re
-from collections.abc import Callable
-from typing import Annotated, Any, Literal, NoReturn
+from typing import Annotated, Any, Literal
 
 from pydantic import (
-    AfterValidator,
     BaseModel,
     BeforeValidator,
-    ConfigDict,
     Field,
     PrivateAttr,
     create_model,
     model_validator,
 )
-from pydantic_core import PydanticCustomError
 
 from ..continuation.numerics import Numerics
-from ..models import FAMILIES, Model, is_known, is_model_file
+from ..models import Model
 from ..models.laws import LAWS, POLYNOMIAL, Coefficient, Law
 from ..plots.kinds import plot_kinds
-from .resolve import Names, _is_number, _resolved, names_of
-
-NAME_MAX = 64
-#: Largest integer AUTO-07p reads into its (32-bit) INTEGER constants (NMX, NTST, ITNW).
-FORTRAN_INT_MAX = 2**31 - 1
-#: Most values in ``orbits_at``: AUTO reads at most 2048 characters per constants line (UZR).
-ORBITS_MAX = 64
-#: The default initial state of ``explore``: the first dof displaced by this (deg for angles).
-EXPLORE_OFFSET = 2.0
-#: Whirl periods an ``explore`` simulation discards before it classifies (classify_model's 15
-#: left a weakly attracting cycle of hardening case 2 still growing, its frequency 5 % off).
-EXPLORE_TRANSIENT = 60.0
-_NAME_RE = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*")
-_NAME_REASON = (
-    "expected letters, digits, '_', '.', '-' (starting with a letter or digit), got {got}"
+from . import continuations
+from .continuations.one_parameter import OneParameterContinuation  # noqa: F401 - re-exported
+from .continuations.two_parameter import Slice, TwoParameterContinuation  # noqa: F401
+from .resolve import Names, _resolved, names_of
+from .values import (  # noqa: F401 - _as_number, _at_most_orbits: read from here by figures
+    FORTRAN_INT_MAX,
+    NAME_MAX,
+    Boolean,
+    Integer,
+    ModelFamily,
+    Name,
+    Number,
+    Positive,
+    Range,
+    Step,
+    Text,
+    _as_number,
+    _as_state,
+    _at_most_orbits,
+    _bound,
+    _fail,
+    _Strict,
 )
-
-
-def _fail(reason: str, at: tuple[str | int, ...] = ()) -> NoReturn:
-    """Reject a value; ``{got}`` in ``reason`` becomes the value as written in the YAML.
-    ``at``: the key path, below the checked value, of the part at fault (a list item, a
-    mapping's key), where the message is reported."""
-    raise PydanticCustomError("whirl", "{reason}", {"reason": reason, "at": at})
-
-
-def _as_string(value: Any) -> str:
-    if not isinstance(value, str):
-        _fail("expected a string, got {got}")
-    return value
-
-
-def _as_number(value: Any) -> float:
-    return _number(value, ())
-
-
-def _number(value: Any, at: tuple[str | int, ...]) -> float:
-    """``value`` as a finite float; else the reason, reported at ``at`` below the value."""
-    if not _is_number(value):
-        _fail("expected a number, got {got}", at)
-    if not math.isfinite(value):
-        _fail("expected a finite number, got {got}", at)
-    return float(value)
-
-
-def _as_integer(value: Any) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
-        _fail("expected an integer, got {got}")
-    return value
-
-
-def _as_boolean(value: Any) -> bool:
-    if not isinstance(value, bool):
-        _fail("expected true or false, got {got}")
-    return value
-
-
-def _as_name(value: Any) -> str:
-    if not _NAME_RE.fullmatch(_as_string(value)):
-        _fail(_NAME_REASON)
-    if len(value) > NAME_MAX:
-        _fail(f"must be at most {NAME_MAX} characters, got {len(value)}")
-    return value
-
-
-def _as_range(value: Any) -> tuple[float, float]:
-    if not isinstance(value, list | tuple) or len(value) != 2:
-        _fail("expected [lower, upper], two numbers, got {value}")
-    lower, upper = (_number(v, (k,)) for k, v in enumerate(value))
-    if not lower < upper:
-        _fail("expected [lower, upper] with lower < upper, got {value}")
-    if not (math.isfinite(upper - lower) and math.isfinite(lower - (upper - lower))
-            and math.isfinite(upper + (upper - lower))):  # AUTO's bounds lie 5 % beyond
-        _fail("the range is too wide: its width overflows double precision, got {value}")
-    return lower, upper
-
-
-def _state(value: Any, at: tuple[str | int, ...], example: str) -> dict[str, float]:
-    """A mapping state name -> finite number (a seed, an initial state), each value checked at
-    its key; ``example``: the mapping's shape, for the message."""
-    if not isinstance(value, dict) or not all(isinstance(k, str) for k in value):
-        _fail(f"expected a mapping state -> number, e.g. {example}, got {{got}}", at)
-    return {k: _number(v, (*at, k)) for k, v in value.items()}
-
-
-def _as_seeds(value: Any) -> str | tuple[dict[str, float], ...]:
-    """``auto``, or a list of mappings state name -> finite number."""
-    if value == "auto":
-        return value
-    if not isinstance(value, list):
-        _fail("expected `auto` or a list of mappings state -> number, e.g. [{{theta: 4}}], "
-              "got {got}")
-    return tuple(_state(seed, (k,), "{{theta: 4}}") for k, seed in enumerate(value))
-
-
-#: The description of ``seeds`` (one- and two-parameter continuations share the key).
-SEEDS_TEXT = (
-    "Initial states simulated at `start` until they settle; every distinct limit cycle found "
-    "is continued both ways (cycles no Hopf point leads to). A list of mappings state name -> "
-    "value (angles in deg, rates in deg/s, other states in their unit; unnamed states 0), or "
-    "`auto`: each nonlinear dof displaced alone by 2, 4 and 8 times its law's size (freeplay: "
-    "delta) or 0.05, 0.2 and 0.5 typical amplitudes. Two-parameter: simulated at `start` on "
-    "every slice; the folds of cycles of the families found are loci starts (e.g. freeplay "
-    "LCOs, which no Hopf point leads to).")
-
-
-def _as_state(value: Any) -> dict[str, float]:
-    """A mapping state name -> finite number (the names are checked against the model)."""
-    return _state(value, (), "{{theta: 2}}")
-
-
-def _at_most_orbits(values: tuple) -> tuple:
-    if len(values) > ORBITS_MAX:
-        _fail(f"at most {ORBITS_MAX} values, got {len(values)}")
-    return values
-
-
-def _as_model_family(value: str) -> str:
-    if not is_known(value):
-        if is_model_file(value):
-            _fail("no model file {got}")
-        _fail(f"unknown model {{got}} (built-in: {', '.join(FAMILIES)}; or a model file "
-              "path ending in .yaml)")
-    return value
-
-
-def _bound(symbol: str, limit: float) -> AfterValidator:
-    """A check that the value is ``symbol`` (>=, >, <=) ``limit``."""
-    compare: Callable[[Any, Any], bool] = {
-        ">=": operator.ge,
-        ">": operator.gt,
-        "<=": operator.le,
-    }[symbol]
-
-    def check(value: Any) -> Any:
-        if not compare(value, limit):
-            _fail(f"must be {symbol} {limit}, got {{got}}")
-        return value
-
-    return AfterValidator(check)
-
-
-Text = Annotated[str, BeforeValidator(_as_string)]
-Name = Annotated[str, BeforeValidator(_as_name)]
-Number = Annotated[float, BeforeValidator(_as_number)]
-Integer = Annotated[int, BeforeValidator(_as_integer)]
-Boolean = Annotated[bool, BeforeValidator(_as_boolean)]
-Range = Annotated[tuple[float, float], BeforeValidator(_as_range)]
-Positive = Annotated[Number, _bound(">", 0)]
-#: An AUTO step, a fraction of the continuation range's width.
-Step = Annotated[Positive, _bound("<=", 1)]
-ModelFamily = Annotated[Text, AfterValidator(_as_model_family)]
-
-
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
 
 _LINEAR_DOC = "linear springs; the polynomial law with K2 = K3 = 0"
 _DOF_DOC = (
@@ -257,199 +117,10 @@ def _as_laws(value: Any) -> Any:
 Laws = Annotated[tuple[LawBlock, ...], BeforeValidator(_as_laws)]
 
 
-_RUN_NAME_DOC = (
-    "Run name, unique within the study (same characters as the study name); not another "
-    "continuation's name followed by `.` (its AUTO runs are named `<name>.<run>`), nor, with "
-    "a freeplay law, a one-parameter continuation's name followed by `_eps<k>` (its "
-    "repetitions at smaller smoothing).")
-
-
-class OneParameterContinuation(_Strict):
-    """Equilibria in one parameter, with the branches that hang off them.
-
-    After validation ``parameter`` is the canonical name and ``start`` is filled.
-    """
-
-    name: Name = Field(description=_RUN_NAME_DOC)
-    type: Literal["one-parameter"] = Field(
-        description="`one-parameter`: equilibria in one parameter (AUTO-07p continuation)."
-    )
-    parameter: Text = Field(
-        description="Continuation parameter, by name or alias, in its SI unit (stored as the "
-        "canonical name: `K1` -> `K_theta`)."
-    )
-    start: Number | None = Field(
-        None,
-        description="Starting value, in the parameter's unit; must lie within `range`. Unset: "
-        "the study value (`parameters`, else the model's datum).",
-    )
-    range: Range = Field(
-        description="[lower, upper] bounds of the parameter, in its unit; AUTO stops at either."
-    )
-    periodic: Boolean = Field(
-        False, description="Continue periodic orbits from every Hopf point (main and secondary)."
-    )
-    branch_points: Boolean = Field(
-        True, description="Switch at branch points (pitchforks) to follow secondary equilibria."
-    )
-    period_doubling: Boolean = Field(
-        False, description="Follow the period-doubled family from every period-doubling (PD) "
-        "point of a periodic family (AUTO's branch switching at PD, the period doubled), and "
-        "from theirs, up to 3 doublings; stored as branches `<family>_pd<k>`."
-    )
-    start_state: Annotated[dict[str, float] | None, BeforeValidator(_as_state)] = Field(
-        None,
-        description="Where Newton's method seeks the starting equilibrium at `start` when the "
-        "zero state is not one: state name -> value (angles in deg, rates in deg/s, other "
-        "states in their unit; unnamed states 0). Unset: from the zero state.",
-    )
-    orbits_at: Annotated[tuple[Number, ...], AfterValidator(_at_most_orbits)] = Field(
-        (),
-        description="Parameter values (in its unit) at which every branch stores a labelled "
-        "solution: orbit profiles for phase-plane plots (AUTO UZR).",
-    )
-    seeds: Annotated[Any, BeforeValidator(_as_seeds)] = Field((), description=SEEDS_TEXT)
-
-    explore: Annotated[tuple[Number, ...], AfterValidator(_at_most_orbits)] = Field(
-        (),
-        description="Parameter values (in its unit), each within `range`, at which the "
-        "settled motion is classified by time simulation after the AUTO runs: equilibrium, "
-        "periodic, quasi-periodic, chaotic or diverged, with the largest Lyapunov exponent, "
-        "frequencies and Poincaré section (for the `poincare`, `spectrum` and "
-        f"`orbit_diagram` plots); at most {ORBITS_MAX} values.",
-    )
-    explore_initial: Annotated[dict[str, float] | None, BeforeValidator(_as_state)] = Field(
-        None,
-        description="Initial state of the `explore` simulations, state name -> value (angles "
-        "in deg, rates in deg/s, other states in their unit; unnamed states 0), as the "
-        f"`seeds`. Unset: the model's first dof at {EXPLORE_OFFSET:g} (deg for an angle).",
-    )
-    explore_transient: Positive = Field(
-        EXPLORE_TRANSIENT,
-        description="Periods of the least damped whirl mode (of the linearisation at the "
-        "origin) simulated and discarded before the `explore` classification's window of 20 "
-        "periods (40 where its Poincaré section and spectrum disagree), > 0 (a weakly "
-        "attracting cycle needs many to settle; a trajectory at rest at a stable equilibrium "
-        "ends it early).",
-    )
-    explore_section: Text | None = Field(
-        None,
-        description="State whose mean level, crossed upwards, is the Poincaré section of the "
-        "`explore` classification (`whirl models` lists the states). Unset: the rate of the "
-        "model's first dof (classical: `dtheta`): the section is at that dof's minima, the "
-        "points of the brute-force orbit diagram.",
-    )
-
-    def start_value(self, study: Study) -> float:
-        """``start``, or the study value of the parameter when unset (models built by hand)."""
-        if self.start is not None:
-            return self.start
-        names = study.names()
-        name = names.canonical(self.parameter)
-        return study.parameter_values().get(name, names.defaults()[name])
-
-
-LocusKind = Literal["hopf", "branch_point", "fold", "fold_of_cycles", "torus"]
-
-
-class Slice(_Strict):
-    """A slice of a two-parameter continuation: a value of its second parameter, and how
-    figures name it."""
-
-    value: Number = Field(description="Value of the second parameter, in its unit.")
-    label: Text = Field("", description="Name of the slice in figures (e.g. `case 2`); "
-                        "unset: `case <k>`, its position from 1.")
-
-
-def _as_slice(value: Any) -> Any:
-    """A slice given as a bare number is ``{value: number}``."""
-    if isinstance(value, dict):
-        return value
-    if not _is_number(value):
-        _fail("expected a finite number or a mapping {{value, label}}, got {got}")
-    return {"value": _as_number(value)}
-
-
-SliceEntry = Annotated[Slice, BeforeValidator(_as_slice)]
-
-
-class TwoParameterContinuation(_Strict):
-    """Loci of Hopf points, branch points, folds and folds of cycles in two parameters, the
-    stability boundary they draw and the unsafe (overhang) region.
-
-    After validation ``parameters`` are canonical names and ``start`` and ``slices`` are filled;
-    ``bounds(model)`` gives ``range`` by canonical names.
-    """
-
-    name: Name = Field(description=_RUN_NAME_DOC)
-    type: Literal["two-parameter"] = Field(
-        description="`two-parameter`: loci of special points in two parameters."
-    )
-    parameters: tuple[Text, Text] = Field(
-        description="[first, second]: the first is continued along each slice of the second; "
-        "both are free on the loci (names or aliases, stored canonical)."
-    )
-    range: dict[str, Range] = Field(
-        description="{first: [lower, upper], second: [lower, upper]}: the region, in the "
-        "parameters' units; loci stop at its edges."
-    )
-    start: Number | None = Field(
-        None,
-        description="Starting value of the first parameter for the one-parameter runs; unset: "
-        "its study value.",
-    )
-    slices: tuple[SliceEntry, ...] = Field(
-        (),
-        json_schema_extra={"type_text": "list of number or {value, label}"},
-        description="Values of the second parameter at which one-parameter runs find the "
-        "special points the loci start from, and at which unsafe intervals are reported, each "
-        "a number or `{value: number, label: text}` (`label` names it in figures); unset: its "
-        "study value.",
-    )
-    seeds: Annotated[Any, BeforeValidator(_as_seeds)] = Field((), description=SEEDS_TEXT)
-    loci: tuple[LocusKind, ...] = Field(
-        ("hopf", "branch_point", "fold", "fold_of_cycles"),
-        description="Which loci to continue: `hopf`, `branch_point` (pitchfork), `fold` (of "
-        "equilibria), `fold_of_cycles` (needs the periodic branches, computed for it), "
-        "`torus` (torus, Neimark-Sacker, bifurcations of cycles; needs the periodic branches "
-        "too; drawn, not used for the unsafe region). Default: all but `torus`.",
-    )
-    snaking_folds: Literal["all", "outermost"] = Field(
-        "outermost",
-        description="Folds of cycles of a family snaking toward a homoclinic orbit (three or "
-        "more of one family at one point of a slice, to 1e-3 of the ranges): `outermost` "
-        "traces only the loci of the lowest- and highest-period ones, along which the others' "
-        "lie (on the chapter-3 boundaries within 3e-3 of the ranges, the unsafe region the "
-        "same; 20-30 % less AUTO time there); `all` the locus of each.",
-    )
-    method: Literal["loci", "slices"] = Field(
-        "loci",
-        description="How the unsafe region is drawn: `loci` (between the Hopf and fold-of-cycles "
-        "loci, and between the pitchfork and fold loci) or `slices` (the thesis' method: from "
-        "one-parameter runs with periodic branches at every slice).",
-    )
-    resolution: Annotated[Integer, _bound(">=", 3), _bound("<=", 2001)] = Field(
-        101, description="Rows across the second parameter's range for the unsafe polygons."
-    )
-
-    def bounds(self, names: Names | Model) -> dict[str, tuple[float, float]]:
-        """``range`` keyed by canonical parameter names (``names``: the study's)."""
-        return {names.canonical(key): tuple(value) for key, value in self.range.items()}
-
-    @property
-    def slice_values(self) -> tuple[float, ...]:
-        """The values of the slices, in order."""
-        return tuple(s.value for s in self.slices)
-
-    @property
-    def slice_labels(self) -> tuple[str, ...]:
-        """The labels of the slices, in order ("" where the study gives none)."""
-        return tuple(s.label for s in self.slices)
-
-
 PlotKind = Literal[plot_kinds()]
-Continuation = Annotated[OneParameterContinuation | TwoParameterContinuation,
-                        Field(discriminator="type")]
+#: A study's continuation block: the spec of each registered type, by ``type``.
+Continuation = Annotated[functools.reduce(operator.or_, continuations.specs()),
+                         Field(discriminator="type")]
 
 
 class LinearAxisSpec(_Strict):

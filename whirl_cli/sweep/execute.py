@@ -26,11 +26,12 @@ from functools import partial
 from pathlib import Path
 
 from ..errors import WhirlError
-from ..kinds import ContinuationKind, LocusKind, SweepStatus
+from ..kinds import SweepStatus
 from ..publish import publish_plots, publish_study
 from ..results import StudyResult
 from ..runtime import catching, held_signals, quiet_worker
 from ..study import Study
+from ..study import continuations as continuation_types
 from ..verdict import verdict
 from .plan import INVALID, PLOT, RUN, SKIP, SweepItem
 
@@ -175,23 +176,15 @@ def _stop_running(executor: Executor, futures: Iterable[Future], grace: float = 
 
 
 def expected_cost(item: SweepItem) -> int:
-    """A rough relative cost of a study, to start the long ones first: periodic families and
-    time-simulation cross-checks dominate a one-parameter continuation; a two-parameter one
-    is one such continuation per slice and then its loci per slice (loci of folds of cycles
-    are periodic problems: the most expensive by far, e.g. boundary_combined's 175 runs);
-    a time simulation costs about what a periodic family does."""
+    """A rough relative cost of a study, to start the long ones first: each continuation's as
+    its type estimates it (in one-parameter runs without periodic families); a time
+    simulation costs about what a periodic family does."""
     study = item.study
     if study is None:
         return 0
     cost = 1 + 3 * len(study.simulations)
-    for spec in study.continuations:
-        if spec.type == ContinuationKind.TWO_PARAMETER:
-            cost += len(spec.slices) * (3 + 2 * len(spec.loci)
-                                        + 6 * (LocusKind.FOLD_OF_CYCLES in spec.loci))
-        else:
-            periodic = bool(getattr(spec, "periodic", False))
-            cost += 1 + 2 * periodic + 2 * periodic * bool(study.cross_check)
-    return cost
+    return cost + sum(continuation_types.of(spec).cost(spec, study)
+                      for spec in study.continuations)
 
 
 def _store(item: SweepItem, future: Future, plots: bool) -> Outcome:
