@@ -4,12 +4,15 @@ The *unsafe* region holds the parameters where linear analysis calls the undefle
 equilibrium stable, yet whirl flutter (a limit-cycle family with a stable part) or static
 divergence (secondary equilibria) exists. Along a slice (the second parameter fixed) it is:
 
-* flutter: between a fold of cycles (LPC) and the Hopf point its family leans over from,
+* flutter: between a fold of cycles (LPC) where stable cycles begin and the Hopf point its
+  family leans over from (a fold between two unstable sides bounds nothing),
 * divergence: between a fold of the secondary equilibria (LP) and the pitchfork (BP),
 
 each intersected with the linearly stable part of the slice. Two ways to get it:
 
-* ``loci``: cross the Hopf, LPC, BP and LP loci (two-parameter continuation) with each slice;
+* ``loci``: cross the Hopf, LPC, BP and LP loci (two-parameter continuation) with each row;
+  a fold-of-cycles locus counts only along its stretches where the slices' periodic families
+  (Floquet stability) find stable cycles on one side of its folds;
 * ``slices`` (the thesis' method): from one-parameter runs with periodic branches per slice.
 
 Polygons of the region are assembled from the intervals of consecutive slices.
@@ -20,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..models import Model
-from ..results import Boundary, Branch, BranchKind, UnsafeInterval
+from ..results import Boundary, Branch, BranchKind, PointType, UnsafeInterval
 from . import linear
 
 Interval = tuple[float, float]
@@ -39,10 +42,7 @@ def stable_intervals(model: Model, overrides: dict[str, float], first: str, seco
     values = np.asarray(values, dtype=float)
 
     def stable_at(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        params = linear.plane_matrix(model, overrides, first, x, second, y)
-        eigenvalues = linear.batched_eigenvalues(np.ascontiguousarray(
-            linear.jacobians(model, params)))
-        return eigenvalues.real.max(axis=1) < 0
+        return _origin_stable(model, overrides, (first, second), x, y)
 
     examined = np.array([_cells(grid, None if within is None else within[r])
                          for r in range(len(values))]).reshape(len(values), points)
@@ -120,14 +120,7 @@ def merge(intervals: list[Interval]) -> list[Interval]:
 
 def crossings(curve: np.ndarray, value: float) -> list[float]:
     """First-coordinate values where the polyline ``curve`` (K, 2) crosses second = value."""
-    y = curve[:, 1] - value
-    found = []
-    for k in np.flatnonzero(y[:-1] * y[1:] <= 0):
-        if y[k] == y[k + 1]:
-            continue
-        w = y[k] / (y[k] - y[k + 1])
-        found.append(float(curve[k, 0] + w * (curve[k + 1, 0] - curve[k, 0])))
-    return found
+    return [x for _, _, x in _segment_crossings(curve, value)]
 
 
 def _paired(folds: list[float], anchors: list[float]) -> list[Interval]:
@@ -135,6 +128,100 @@ def _paired(folds: list[float], anchors: list[float]) -> list[Interval]:
     if not anchors:
         return []
     return [tuple(sorted((f, min(anchors, key=lambda a: abs(a - f))))) for f in folds]
+
+
+def slice_folds(model: Model, overrides: dict[str, float], pair: tuple[str, str],
+                value: float, branches: tuple[Branch, ...]) -> list[tuple[float, bool]]:
+    """The folds of cycles of the periodic families of the slice second = ``value``: (first
+    parameter, whether it bounds stable cycles that coexist with a linearly stable y = 0: the
+    family's run of stable cycles beside the fold, by its Floquet multipliers, reaches
+    parameters where y = 0 is stable)."""
+    found = []
+    for branch in branches:
+        if branch.kind != BranchKind.PERIODIC:
+            continue
+        for k in np.flatnonzero(branch.point_type == PointType.LPC):
+            run = branch.parameters[_stable_run_beside(branch, int(k)), 0]
+            found.append((float(branch.parameters[k, 0]), bool(len(run)) and bool(
+                _origin_stable(model, overrides, pair, run, value).any())))
+    return found
+
+
+def _stable_run_beside(branch: Branch, index: int) -> np.ndarray:
+    """Rows of the runs of known stable points of ``branch`` next to row ``index``."""
+    stable = branch.stable & branch.stability_known
+    rows = []
+    for step in (-1, 1):
+        k = index + step
+        while 0 <= k < len(branch) and stable[k]:
+            rows.append(k)
+            k += step
+    return np.array(sorted(rows), dtype=int)
+
+
+def _origin_stable(model: Model, overrides: dict[str, float], pair: tuple[str, str],
+                   first: np.ndarray, second: np.ndarray | float) -> np.ndarray:
+    """Whether y = 0 is linearly stable at each point (``first``, ``second``)."""
+    params = linear.plane_matrix(model, overrides, pair[0], first, pair[1],
+                                 np.broadcast_to(second, np.shape(first)))
+    eigenvalues = linear.batched_eigenvalues(np.ascontiguousarray(
+        linear.jacobians(model, params)))
+    return eigenvalues.real.max(axis=1) < 0
+
+
+def stable_fold_stretches(curve: np.ndarray, folds: dict[float, list[tuple[float, bool]]],
+                          tolerance: float) -> list[np.ndarray]:
+    """The stretches of the fold-of-cycles locus ``curve`` (K, 2) that bound stable cycles.
+
+    Where the locus crosses a slice (second parameter = a key of ``folds``), the slice's
+    fold within ``tolerance`` of the crossing says whether stable cycles lie beside it. Between
+    two such verdicts (or one and the locus's end) the locus counts when either says so (the
+    kind of fold may change anywhere between slices), never at a slice whose verdict is no;
+    a locus that meets no slice fold is kept whole (nothing known)."""
+    verdicts = sorted((k + w, stable) for value, found in folds.items()
+                      for k, w, x in _segment_crossings(curve, value)
+                      for stable in _matched(found, x, tolerance))
+    if not verdicts:
+        return [curve]
+    ends = [(0.0, None), *verdicts, (float(len(curve) - 1), None)]
+    pieces: list[list[float]] = []
+    for (a, yes_a), (b, yes_b) in zip(ends[:-1], ends[1:], strict=True):
+        if b > a and (yes_a or yes_b):
+            lo, hi = a + 1e-9 * (yes_a is False), b - 1e-9 * (yes_b is False)
+            if pieces and pieces[-1][1] == lo:
+                pieces[-1][1] = hi
+            else:
+                pieces.append([lo, hi])
+    return [_between(curve, lo, hi) for lo, hi in pieces]
+
+
+def _between(curve: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """The polyline ``curve`` from position ``lo`` to ``hi`` (fractional point indices)."""
+    def at(position: float) -> np.ndarray:
+        k = min(int(position), len(curve) - 2)
+        return curve[k] + (position - k) * (curve[k + 1] - curve[k])
+
+    inner = curve[int(np.floor(lo)) + 1:int(np.ceil(hi))]
+    return np.vstack([at(lo), inner, at(hi)])
+
+
+def _segment_crossings(curve: np.ndarray, value: float) -> list[tuple[int, float, float]]:
+    """(segment k, fraction w along it, first coordinate) where the polyline ``curve`` crosses
+    second = ``value``."""
+    y = curve[:, 1] - value
+    found = []
+    for k in np.flatnonzero(y[:-1] * y[1:] <= 0):
+        if y[k] == y[k + 1]:
+            continue
+        w = float(y[k] / (y[k] - y[k + 1]))
+        found.append((int(k), w, float(curve[k, 0] + w * (curve[k + 1, 0] - curve[k, 0]))))
+    return found
+
+
+def _matched(found: list[tuple[float, bool]], x: float, tolerance: float) -> list[bool]:
+    """The verdict of the fold in ``found`` nearest ``x`` if within ``tolerance`` (else none)."""
+    near = [(abs(at - x), stable) for at, stable in found if abs(at - x) <= tolerance]
+    return [min(near)[1]] if near else []
 
 
 def loci_candidates(loci: dict[str, list[np.ndarray]], value: float
@@ -269,6 +356,11 @@ def boundary(name: str, model: Model, overrides: dict[str, float], pair: tuple[s
     minimum = 1e-3 * (bounds[first][1] - bounds[first][0])  # narrower pieces are round-off
     if method == "loci":
         curves_by_name = loci_curves(curves, np.array(model.typical_amplitudes))
+        folds = {value: slice_folds(model, overrides, pair, value, branches)
+                 for value, branches in zip(slices, slice_branches, strict=True)}
+        curves_by_name["fold_of_cycles"] = [
+            stretch for curve in curves_by_name.get("fold_of_cycles", [])
+            for stretch in stable_fold_stretches(curve, folds, 10 * minimum)]
         rows = sorted(set(np.linspace(*bounds[second], resolution).tolist()) | set(slices))
         candidates = [loci_candidates(curves_by_name, value) for value in rows]
     else:
