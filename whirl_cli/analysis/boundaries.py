@@ -178,9 +178,7 @@ def stable_fold_stretches(curve: np.ndarray, folds: dict[float, list[tuple[float
     two such verdicts (or one and the locus's end) the locus counts when either says so (the
     kind of fold may change anywhere between slices), never at a slice whose verdict is no;
     a locus that meets no slice fold is kept whole (nothing known)."""
-    verdicts = sorted((k + w, stable) for value, found in folds.items()
-                      for k, w, x in _segment_crossings(curve, value)
-                      for stable in _matched(found, x, tolerance))
+    verdicts = _fold_verdicts(curve, folds, tolerance)
     if not verdicts:
         return [curve]
     ends = [(0.0, None), *verdicts, (float(len(curve) - 1), None)]
@@ -193,6 +191,23 @@ def stable_fold_stretches(curve: np.ndarray, folds: dict[float, list[tuple[float
             else:
                 pieces.append([lo, hi])
     return [_between(curve, lo, hi) for lo, hi in pieces]
+
+
+def bounding_ends(curve: np.ndarray, folds: dict[float, list[tuple[float, bool]]],
+                  tolerance: float) -> tuple[bool, bool]:
+    """Whether the first and the last point of the fold-of-cycles locus ``curve`` lie on
+    stretches that bound stable cycles (see :func:`stable_fold_stretches`)."""
+    verdicts = _fold_verdicts(curve, folds, tolerance)
+    return (verdicts[0][1], verdicts[-1][1]) if verdicts else (True, True)
+
+
+def _fold_verdicts(curve: np.ndarray, folds: dict[float, list[tuple[float, bool]]],
+                   tolerance: float) -> list[tuple[float, bool]]:
+    """(position along ``curve`` in point indices, verdict) at each crossing of a slice of
+    ``folds`` where the slice has a fold within ``tolerance``, in order along the curve."""
+    return sorted((k + w, stable) for value, found in folds.items()
+                  for k, w, x in _segment_crossings(curve, value)
+                  for stable in _matched(found, x, tolerance))
 
 
 def _between(curve: np.ndarray, lo: float, hi: float) -> np.ndarray:
@@ -354,10 +369,10 @@ def boundary(name: str, model: Model, overrides: dict[str, float], pair: tuple[s
     slices, from their one-parameter branches)."""
     first, second = pair
     minimum = 1e-3 * (bounds[first][1] - bounds[first][0])  # narrower pieces are round-off
+    folds = {value: slice_folds(model, overrides, pair, value, branches)
+             for value, branches in zip(slices, slice_branches, strict=True)}
     if method == "loci":
         curves_by_name = loci_curves(curves, np.array(model.typical_amplitudes))
-        folds = {value: slice_folds(model, overrides, pair, value, branches)
-                 for value, branches in zip(slices, slice_branches, strict=True)}
         curves_by_name["fold_of_cycles"] = [
             stretch for curve in curves_by_name.get("fold_of_cycles", [])
             for stretch in stable_fold_stretches(curve, folds, 10 * minimum)]
@@ -375,6 +390,8 @@ def boundary(name: str, model: Model, overrides: dict[str, float], pair: tuple[s
     intervals = [interval for value, row, part in zip(rows, candidates, stable, strict=True)
                  for interval in _unsafe(row, part, value, minimum)]
     loci = {c.name: (LOCUS_NAMES[c.kind], c.parameters[:, :2]) for c in curves}
+    ends = {c.name: bounding_ends(c.parameters[:, :2], folds, 10 * minimum) for c in curves
+            if c.kind == BranchKind.FOLD_OF_CYCLES_LOCUS and len(c)}
     return Boundary(name, pair, tuple(model.parameter(p).unit for p in pair), method, loci,
                     tuple(intervals), tuple(polygons(intervals, rows)), tuple(slices),
-                    tuple(map(float, bounds[first])), tuple(map(float, bounds[second])))
+                    tuple(map(float, bounds[first])), tuple(map(float, bounds[second])), ends)
