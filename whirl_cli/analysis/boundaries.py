@@ -42,7 +42,10 @@ def stable_intervals(model: Model, overrides: dict[str, float], first: str, seco
     values = np.asarray(values, dtype=float)
 
     def stable_at(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        return _origin_stable(model, overrides, (first, second), x, y)
+        params = linear.plane_matrix(model, overrides, first, x, second, y)
+        eigenvalues = linear.batched_eigenvalues(np.ascontiguousarray(
+            linear.jacobians(model, params)))
+        return eigenvalues.real.max(axis=1) < 0
 
     examined = np.array([_cells(grid, None if within is None else within[r])
                          for r in range(len(values))]).reshape(len(values), points)
@@ -130,21 +133,28 @@ def _paired(folds: list[float], anchors: list[float]) -> list[Interval]:
     return [tuple(sorted((f, min(anchors, key=lambda a: abs(a - f))))) for f in folds]
 
 
-def slice_folds(model: Model, overrides: dict[str, float], pair: tuple[str, str],
-                value: float, branches: tuple[Branch, ...]) -> list[tuple[float, bool]]:
-    """The folds of cycles of the periodic families of the slice second = ``value``: (first
-    parameter, whether it bounds stable cycles that coexist with a linearly stable y = 0: the
-    family's run of stable cycles beside the fold, by its Floquet multipliers, reaches
-    parameters where y = 0 is stable)."""
+def slice_folds(branches: tuple[Branch, ...], hopfs: list[float]
+                ) -> list[tuple[float, bool]]:
+    """The folds of cycles of one slice's periodic families, each with the verdict whether
+    the family carries stable cycles from the fold to a Hopf point: its run of stable cycles
+    beside the fold (by its Floquet multipliers) covers 90 % of the way to one of ``hopfs``
+    (the slice's Hopf points)."""
     found = []
     for branch in branches:
         if branch.kind != BranchKind.PERIODIC:
             continue
         for k in np.flatnonzero(branch.point_type == PointType.LPC):
+            fold = float(branch.parameters[k, 0])
             run = branch.parameters[_stable_run_beside(branch, int(k)), 0]
-            found.append((float(branch.parameters[k, 0]), bool(len(run)) and bool(
-                _origin_stable(model, overrides, pair, run, value).any())))
+            found.append((fold, bool(len(run)) and any(
+                _covered(run, fold, hopf) >= 0.9 * abs(hopf - fold) for hopf in hopfs)))
     return found
+
+
+def _covered(run: np.ndarray, a: float, b: float) -> float:
+    """How much of the interval between ``a`` and ``b`` the extent of ``run`` covers."""
+    lo, hi = min(a, b), max(a, b)
+    return max(0.0, min(float(run.max()), hi) - max(float(run.min()), lo))
 
 
 def _stable_run_beside(branch: Branch, index: int) -> np.ndarray:
@@ -157,16 +167,6 @@ def _stable_run_beside(branch: Branch, index: int) -> np.ndarray:
             rows.append(k)
             k += step
     return np.array(sorted(rows), dtype=int)
-
-
-def _origin_stable(model: Model, overrides: dict[str, float], pair: tuple[str, str],
-                   first: np.ndarray, second: np.ndarray | float) -> np.ndarray:
-    """Whether y = 0 is linearly stable at each point (``first``, ``second``)."""
-    params = linear.plane_matrix(model, overrides, pair[0], first, pair[1],
-                                 np.broadcast_to(second, np.shape(first)))
-    eigenvalues = linear.batched_eigenvalues(np.ascontiguousarray(
-        linear.jacobians(model, params)))
-    return eigenvalues.real.max(axis=1) < 0
 
 
 def stable_fold_stretches(curve: np.ndarray, folds: dict[float, list[tuple[float, bool]]],
@@ -369,10 +369,11 @@ def boundary(name: str, model: Model, overrides: dict[str, float], pair: tuple[s
     slices, from their one-parameter branches)."""
     first, second = pair
     minimum = 1e-3 * (bounds[first][1] - bounds[first][0])  # narrower pieces are round-off
-    folds = {value: slice_folds(model, overrides, pair, value, branches)
+    curves_by_name = loci_curves(curves, np.array(model.typical_amplitudes))
+    folds = {value: slice_folds(branches, [x for curve in curves_by_name.get("hopf", [])
+                                           for x in crossings(curve, value)])
              for value, branches in zip(slices, slice_branches, strict=True)}
     if method == "loci":
-        curves_by_name = loci_curves(curves, np.array(model.typical_amplitudes))
         curves_by_name["fold_of_cycles"] = [
             stretch for curve in curves_by_name.get("fold_of_cycles", [])
             for stretch in stable_fold_stretches(curve, folds, 10 * minimum)]
