@@ -469,6 +469,8 @@ class Boundary:
     fold_of_cycles. ``polygons``: closed (K, 2) outlines of the unsafe region. ``intervals``:
     the unsafe intervals per slice (``method`` "loci" or "slices" says how they were found).
     ``first_range``, ``second_range``: the parameters' ranges (NaN in older files).
+    ``bounding_ends``: fold-of-cycles locus name -> whether its first and last points bound
+    stable cycles (a locus not listed: both do, as in older files).
     """
 
     name: str
@@ -481,6 +483,7 @@ class Boundary:
     slices: tuple[float, ...]
     first_range: tuple[float, float] = (np.nan, np.nan)
     second_range: tuple[float, float] = (np.nan, np.nan)
+    bounding_ends: dict[str, tuple[bool, bool]] = field(default_factory=dict)
 
     __repr__ = _brief_repr
 

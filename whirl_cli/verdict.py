@@ -107,7 +107,8 @@ def verdict(result: StudyResult, plot_error: str = "") -> Verdict:
 def range_warnings(found: Boundary, tolerance: float = 1e-6) -> tuple[str, ...]:
     """Where ``found``'s unsafe region may reach past its range: an unsafe interval ending at
     an edge of the first parameter's range (within ``tolerance`` of its span), and a fold or
-    fold-of-cycles locus ending there (the intervals it bounds are then never formed). None
+    fold-of-cycles locus ending there where it bounds stable cycles (the intervals it bounds
+    are then never formed). None
     for a boundary whose range is not known (older files)."""
     low, high = found.first_range
     if not (math.isfinite(low) and math.isfinite(high)):
@@ -123,8 +124,10 @@ def range_warnings(found: Boundary, tolerance: float = 1e-6) -> tuple[str, ...]:
                 f"[{low:g}, {high:g}]: the region may extend beyond it"
                 for i in found.intervals if edge(i.lower) or edge(i.upper)]
     for name, (kind, curve) in found.loci.items():
-        ends = [point for point in (curve[[0, -1]] if len(curve) else ())
-                if kind in FOLD_LOCI and edge(point[0])]
+        bounding = found.bounding_ends.get(name, (True, True))
+        ends = [point for point, bounds in zip(curve[[0, -1]] if len(curve) else (), bounding,
+                                               strict=False)
+                if kind in FOLD_LOCI and bounds and edge(point[0])]
         warnings += [f"{found.name}: the {kind.replace('_', ' ')} locus {name} leaves the range "
                      f"of {first} at {first} = {p[0]:.6g}, {second} = {p[1]:.6g}: unsafe "
                      "intervals it bounds beyond are not formed" for p in ends]

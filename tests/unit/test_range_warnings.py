@@ -53,3 +53,18 @@ def test_the_ranges_are_stored_and_older_files_warn_of_nothing(tmp_path):
             del handle["boundaries/boundary"].attrs[key]
     (older,) = store.read(path).boundaries
     assert np.isnan(older.first_range).all() and range_warnings(older) == ()
+
+
+def test_a_fold_of_cycles_locus_leaving_where_it_bounds_no_stable_cycles_is_not_warned_of(
+        tmp_path):
+    """The locus's last point lies past the slices whose folds join unstable cycles to
+    unstable ones: no unsafe interval is formed there inside or outside the range."""
+    silent = boundary([INSIDE], LEAVING)
+    silent = Boundary(**{**silent.__dict__, "bounding_ends": {"fold_of_cycles_0a": (True, False)}})
+    assert range_warnings(silent) == ()
+    result = StudyResult("s", "classical", (ContinuationResult("boundary", "two-parameter",
+                                                               (), ()),), (), (),
+                         {}, (silent,))
+    (read,) = store.read(store.write(result, tmp_path / "silent.h5")).boundaries
+    assert read.bounding_ends == {"fold_of_cycles_0a": (True, False)}
+    assert range_warnings(read) == ()

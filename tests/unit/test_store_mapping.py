@@ -21,7 +21,8 @@ STRUCTURAL = {
     results.CrossCheck: set(),
     results.LinearSweep: set(),
     results.LinearGrid: {"flutter", "divergence"},
-    results.Boundary: {"name", "loci", "intervals", "polygons"},
+    results.Boundary: {"name", "loci", "intervals", "polygons",
+                       "bounding_ends"},  # bounding_ends: attributes of the loci
     results.UnsafeInterval: set(),
     results.RunRecord: {"name"},
     results.FreeplayAmplitudes: {"branch"},

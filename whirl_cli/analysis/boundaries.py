@@ -4,12 +4,15 @@ The *unsafe* region holds the parameters where linear analysis calls the undefle
 equilibrium stable, yet whirl flutter (a limit-cycle family with a stable part) or static
 divergence (secondary equilibria) exists. Along a slice (the second parameter fixed) it is:
 
-* flutter: between a fold of cycles (LPC) and the Hopf point its family leans over from,
+* flutter: between a fold of cycles (LPC) where stable cycles begin and the Hopf point its
+  family leans over from (a fold between two unstable sides bounds nothing),
 * divergence: between a fold of the secondary equilibria (LP) and the pitchfork (BP),
 
 each intersected with the linearly stable part of the slice. Two ways to get it:
 
-* ``loci``: cross the Hopf, LPC, BP and LP loci (two-parameter continuation) with each slice;
+* ``loci``: cross the Hopf, LPC, BP and LP loci (two-parameter continuation) with each row;
+  a fold-of-cycles locus counts only along its stretches where the slices' periodic families
+  (Floquet stability) find stable cycles on one side of its folds;
 * ``slices`` (the thesis' method): from one-parameter runs with periodic branches per slice.
 
 Polygons of the region are assembled from the intervals of consecutive slices.
@@ -120,14 +123,7 @@ def merge(intervals: list[Interval]) -> list[Interval]:
 
 def crossings(curve: np.ndarray, value: float) -> list[float]:
     """First-coordinate values where the polyline ``curve`` (K, 2) crosses second = value."""
-    y = curve[:, 1] - value
-    found = []
-    for k in np.flatnonzero(y[:-1] * y[1:] <= 0):
-        if y[k] == y[k + 1]:
-            continue
-        w = y[k] / (y[k] - y[k + 1])
-        found.append(float(curve[k, 0] + w * (curve[k + 1, 0] - curve[k, 0])))
-    return found
+    return [x for _, _, x in _segment_crossings(curve, value)]
 
 
 def _paired(folds: list[float], anchors: list[float]) -> list[Interval]:
@@ -135,6 +131,112 @@ def _paired(folds: list[float], anchors: list[float]) -> list[Interval]:
     if not anchors:
         return []
     return [tuple(sorted((f, min(anchors, key=lambda a: abs(a - f))))) for f in folds]
+
+
+def slice_folds(branches: tuple[Branch, ...], hopfs: list[float]
+                ) -> list[tuple[float, bool]]:
+    """The folds of cycles of one slice's periodic families, each with the verdict whether
+    the family carries stable cycles from the fold to a Hopf point: its run of stable cycles
+    beside the fold (by its Floquet multipliers) covers 90 % of the way to one of ``hopfs``
+    (the slice's Hopf points)."""
+    found = []
+    for branch in branches:
+        if branch.kind != BranchKind.PERIODIC:
+            continue
+        for k in np.flatnonzero(branch.point_type == PointType.LPC):
+            fold = float(branch.parameters[k, 0])
+            run = branch.parameters[_stable_run_beside(branch, int(k)), 0]
+            found.append((fold, bool(len(run)) and any(
+                _covered(run, fold, hopf) >= 0.9 * abs(hopf - fold) for hopf in hopfs)))
+    return found
+
+
+def _covered(run: np.ndarray, a: float, b: float) -> float:
+    """How much of the interval between ``a`` and ``b`` the extent of ``run`` covers."""
+    lo, hi = min(a, b), max(a, b)
+    return max(0.0, min(float(run.max()), hi) - max(float(run.min()), lo))
+
+
+def _stable_run_beside(branch: Branch, index: int) -> np.ndarray:
+    """Rows of the runs of known stable points of ``branch`` next to row ``index``."""
+    stable = branch.stable & branch.stability_known
+    rows = []
+    for step in (-1, 1):
+        k = index + step
+        while 0 <= k < len(branch) and stable[k]:
+            rows.append(k)
+            k += step
+    return np.array(sorted(rows), dtype=int)
+
+
+def stable_fold_stretches(curve: np.ndarray, folds: dict[float, list[tuple[float, bool]]],
+                          tolerance: float) -> list[np.ndarray]:
+    """The stretches of the fold-of-cycles locus ``curve`` (K, 2) that bound stable cycles.
+
+    Where the locus crosses a slice (second parameter = a key of ``folds``), the slice's
+    fold within ``tolerance`` of the crossing says whether stable cycles lie beside it. Between
+    two such verdicts (or one and the locus's end) the locus counts when either says so (the
+    kind of fold may change anywhere between slices), never at a slice whose verdict is no;
+    a locus that meets no slice fold is kept whole (nothing known)."""
+    verdicts = _fold_verdicts(curve, folds, tolerance)
+    if not verdicts:
+        return [curve]
+    ends = [(0.0, None), *verdicts, (float(len(curve) - 1), None)]
+    pieces: list[list[float]] = []
+    for (a, yes_a), (b, yes_b) in zip(ends[:-1], ends[1:], strict=True):
+        if b > a and (yes_a or yes_b):
+            lo, hi = a + 1e-9 * (yes_a is False), b - 1e-9 * (yes_b is False)
+            if pieces and pieces[-1][1] == lo:
+                pieces[-1][1] = hi
+            else:
+                pieces.append([lo, hi])
+    return [_between(curve, lo, hi) for lo, hi in pieces]
+
+
+def bounding_ends(curve: np.ndarray, folds: dict[float, list[tuple[float, bool]]],
+                  tolerance: float) -> tuple[bool, bool]:
+    """Whether the first and the last point of the fold-of-cycles locus ``curve`` lie on
+    stretches that bound stable cycles (see :func:`stable_fold_stretches`)."""
+    verdicts = _fold_verdicts(curve, folds, tolerance)
+    return (verdicts[0][1], verdicts[-1][1]) if verdicts else (True, True)
+
+
+def _fold_verdicts(curve: np.ndarray, folds: dict[float, list[tuple[float, bool]]],
+                   tolerance: float) -> list[tuple[float, bool]]:
+    """(position along ``curve`` in point indices, verdict) at each crossing of a slice of
+    ``folds`` where the slice has a fold within ``tolerance``, in order along the curve."""
+    return sorted((k + w, stable) for value, found in folds.items()
+                  for k, w, x in _segment_crossings(curve, value)
+                  for stable in _matched(found, x, tolerance))
+
+
+def _between(curve: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """The polyline ``curve`` from position ``lo`` to ``hi`` (fractional point indices)."""
+    def at(position: float) -> np.ndarray:
+        k = min(int(position), len(curve) - 2)
+        return curve[k] + (position - k) * (curve[k + 1] - curve[k])
+
+    inner = curve[int(np.floor(lo)) + 1:int(np.ceil(hi))]
+    return np.vstack([at(lo), inner, at(hi)])
+
+
+def _segment_crossings(curve: np.ndarray, value: float) -> list[tuple[int, float, float]]:
+    """(segment k, fraction w along it, first coordinate) where the polyline ``curve`` crosses
+    second = ``value``."""
+    y = curve[:, 1] - value
+    found = []
+    for k in np.flatnonzero(y[:-1] * y[1:] <= 0):
+        if y[k] == y[k + 1]:
+            continue
+        w = float(y[k] / (y[k] - y[k + 1]))
+        found.append((int(k), w, float(curve[k, 0] + w * (curve[k + 1, 0] - curve[k, 0]))))
+    return found
+
+
+def _matched(found: list[tuple[float, bool]], x: float, tolerance: float) -> list[bool]:
+    """The verdict of the fold in ``found`` nearest ``x`` if within ``tolerance`` (else none)."""
+    near = [(abs(at - x), stable) for at, stable in found if abs(at - x) <= tolerance]
+    return [min(near)[1]] if near else []
 
 
 def loci_candidates(loci: dict[str, list[np.ndarray]], value: float
@@ -267,8 +369,14 @@ def boundary(name: str, model: Model, overrides: dict[str, float], pair: tuple[s
     slices, from their one-parameter branches)."""
     first, second = pair
     minimum = 1e-3 * (bounds[first][1] - bounds[first][0])  # narrower pieces are round-off
+    curves_by_name = loci_curves(curves, np.array(model.typical_amplitudes))
+    folds = {value: slice_folds(branches, [x for curve in curves_by_name.get("hopf", [])
+                                           for x in crossings(curve, value)])
+             for value, branches in zip(slices, slice_branches, strict=True)}
     if method == "loci":
-        curves_by_name = loci_curves(curves, np.array(model.typical_amplitudes))
+        curves_by_name["fold_of_cycles"] = [
+            stretch for curve in curves_by_name.get("fold_of_cycles", [])
+            for stretch in stable_fold_stretches(curve, folds, 10 * minimum)]
         rows = sorted(set(np.linspace(*bounds[second], resolution).tolist()) | set(slices))
         candidates = [loci_candidates(curves_by_name, value) for value in rows]
     else:
@@ -283,6 +391,8 @@ def boundary(name: str, model: Model, overrides: dict[str, float], pair: tuple[s
     intervals = [interval for value, row, part in zip(rows, candidates, stable, strict=True)
                  for interval in _unsafe(row, part, value, minimum)]
     loci = {c.name: (LOCUS_NAMES[c.kind], c.parameters[:, :2]) for c in curves}
+    ends = {c.name: bounding_ends(c.parameters[:, :2], folds, 10 * minimum) for c in curves
+            if c.kind == BranchKind.FOLD_OF_CYCLES_LOCUS and len(c)}
     return Boundary(name, pair, tuple(model.parameter(p).unit for p in pair), method, loci,
                     tuple(intervals), tuple(polygons(intervals, rows)), tuple(slices),
-                    tuple(map(float, bounds[first])), tuple(map(float, bounds[second])))
+                    tuple(map(float, bounds[first])), tuple(map(float, bounds[second])), ends)

@@ -368,6 +368,8 @@ def _write_boundary(group: h5py.Group, boundary: Boundary) -> None:
     for name, (kind, curve) in boundary.loci.items():
         data = _collection(group, "loci").create_dataset(name, data=curve.reshape(-1, 2))
         data.attrs.update(kind=kind, **pair)
+        if name in boundary.bounding_ends:
+            data.attrs["bounding_ends"] = np.array(boundary.bounding_ends[name], dtype=np.int8)
     for k, polygon in enumerate(boundary.polygons):
         _collection(group, "unsafe").create_dataset(f"polygon_{k}", data=polygon).attrs.update(
             pair)
@@ -573,9 +575,11 @@ def _read_boundary(name: str, group: h5py.Group) -> Boundary:
             for key, data in group.get("loci", {}).items()}
     polygons = tuple(group["unsafe"][key][()] for key in _members(group.get("unsafe", {}),
                                                                    _number))
+    ends = {key: tuple(bool(v) for v in data.attrs["bounding_ends"])
+            for key, data in group.get("loci", {}).items() if "bounding_ends" in data.attrs}
     return Boundary(name=name, **read_record(group, BOUNDARY), loci=loci, polygons=polygons,
                     intervals=read_table(member(group, "unsafe_intervals"), UnsafeInterval,
-                                         UNSAFE_INTERVAL))
+                                         UNSAFE_INTERVAL), bounding_ends=ends)
 
 
 def _read_grid(group: h5py.Group) -> LinearGrid:
