@@ -134,7 +134,8 @@ def _stages(study: Study, model, parameters: dict[str, float], workroot: Path, j
                 numerics, branch_points=spec.branch_points, periodic=spec.periodic,
                 orbits_at=spec.orbits_at, start_orbits=starts,
                 start_state=None if spec.start_state is None
-                else seeds.seed_state(model, spec.start_state), resting=rests)
+                else seeds.seed_state(model, spec.start_state), resting=rests,
+                spread=spec.spread_equilibria)
 
         continuation = replace(continued(spec.name, parameters), seeds=outcomes)
         if model.smoothing_parameters:
