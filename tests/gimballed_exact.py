@@ -85,7 +85,7 @@ def freeplay_simulation(values: dict, dof: str, delta: float, k_out: float, y0: 
         sol = solve_ivp(field(piece), (t0, duration), y, method="DOP853", rtol=1e-10,
                         atol=1e-13, t_eval=grid[grid >= t0], events=leaving[piece])
         out_t.append(sol.t)
-        out_y.append(sol.y.T)
+        out_y.append(np.reshape(sol.y, (len(y), -1)).T)  # no samples left: sol.y is []
         if sol.status != 1:
             return np.concatenate(out_t), np.vstack(out_y)
         hit = next(k for k, times in enumerate(sol.t_events) if len(times))

@@ -395,7 +395,8 @@ def continue_one_parameter(stage: Stage, spec) -> tuple[ContinuationResult, None
             orbits_at=spec.orbits_at, start_orbits=starts,
             period_doubling=spec.period_doubling,
             start_state=None if spec.start_state is None
-            else seeds.seed_state(model, spec.start_state), resting=rests)
+            else seeds.seed_state(model, spec.start_state), resting=rests,
+            spread=spec.spread_equilibria)
 
     continuation = replace(continued(spec.name, parameters), seeds=outcomes)
     if model.smoothing_parameters:

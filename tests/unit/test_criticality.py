@@ -64,3 +64,16 @@ def test_with_eigenvalues_the_family_decides_and_a_disagreement_is_noted():
     (labelled,) = _with_criticality([hopf], [family], [equilibria], 0.8, np.ones(4))
     assert labelled.criticality == "supercritical"  # unstable below 0.2, the family there
     assert "first Lyapunov coefficient says subcritical" in labelled.note
+
+
+def test_a_family_that_grows_at_the_hopf_value_first_lies_where_it_then_turns():
+    """A family growing at a fixed parameter value (a Hopf point where the right-hand side is
+    locally linear, e.g. just outside a freeplay gap), a hair above it in K1, then turning to
+    K1 < 0.2 where the pair is unstable: supercritical (the hair's side said subcritical)."""
+    equilibria, hopf, _ = hopf_and_family(printed=True, lyapunov_says="")
+    family = branch("periodic_1", BranchKind.PERIODIC,
+                    np.array([0.2, 0.2 + 1e-9, 0.2 + 2e-9, 0.2, 0.19, 0.17]),
+                    np.full((6, 4), np.nan + 0j), np.array([0.0, 0.01, 0.02, 0.03, 0.04, 0.05]),
+                    origin=Origin.at(hopf))
+    (labelled,) = _with_criticality([hopf], [family], [equilibria], 0.8, np.ones(4))
+    assert labelled.criticality == "supercritical"

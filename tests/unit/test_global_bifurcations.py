@@ -4,11 +4,15 @@ good share of its period; a family that has only reached a slower mode is none."
 
 from __future__ import annotations
 
+from dataclasses import replace
+from types import SimpleNamespace
+
 import numpy as np
 
 from whirl_cli.analysis.global_bifurcations import analyse
+from whirl_cli.continuation.homoclinic import locate_homoclinics
 from whirl_cli.models import FAMILIES, Model
-from whirl_cli.results import Branch, BranchKind, Orbit, PointType
+from whirl_cli.results import Branch, BranchKind, Orbit, PointType, SpecialPoint
 
 MODEL = Model(FAMILIES["classical"], ("polynomial",) * 2)
 PARAMETERS = {"K_psi": 0.3}
@@ -73,3 +77,37 @@ def test_an_orbit_that_sits_at_the_saddle_is_a_homoclinic_approach():
     assert point.status == "bracketed"
     np.testing.assert_array_equal(point.state, np.zeros(4))
     assert "80% of its period" in point.note
+
+
+class _Engine:
+    """Records the runs it is asked for; every run fails (no output)."""
+
+    def __init__(self):
+        self.model, self.names = MODEL, []
+
+    def run_with_label(self, runs: str, _label: int) -> str:
+        return runs
+
+    def run_many(self, specs):
+        self.names += [spec.name for spec in specs]
+        return [SimpleNamespace(has_output=False, status="mx", message="stub") for _ in specs]
+
+
+def test_both_sides_of_a_family_locate_their_ends_in_runs_of_their_own():
+    """A family started at an orbit has two sides, each of which can end in a blow-up: each
+    gets a HomCont run under a name of its own (one name for both: the second run's work
+    directory collided with the first's)."""
+    angle = np.linspace(0, 2 * np.pi, 201)
+    lopsided = 0.05 * np.column_stack([1 + np.cos(angle), np.sin(angle), -np.sin(angle),
+                                       np.cos(angle)])
+    sides = []
+    for k in range(2):
+        side = replace(_family(lopsided), name="periodic_o1", run=f"run_{k}",
+                       label=np.arange(1, ROWS + 1))
+        point = SpecialPoint("periodic_o1", ROWS - 1, int(PointType.HOMOCLINIC), ("K_theta",),
+                             np.array([-0.2]), np.zeros(4), 1.5, False, status="bracketed")
+        sides.append((side, point))
+    engine = _Engine()
+    located = locate_homoclinics(engine, "k1", sides, (-0.3, 0.5), PARAMETERS)
+    assert len(engine.names) == 2 and len(set(engine.names)) == 2, engine.names
+    assert [p.status for p in located] == ["bracketed", "bracketed"]

@@ -391,8 +391,9 @@ RUN = "continuations:\n  - name: k1\n    type: one-parameter\n    parameter: K1\
         (
             "    range: [0, 1]\n    loci: [hopf]\n",
             "s.yaml:8: continuations[0].loci: unknown key (allowed: name, type, parameter, "
-            "start, range, periodic, branch_points, period_doubling, start_state, orbits_at, "
-            "seeds, explore, explore_initial, explore_transient, explore_section)",
+            "start, range, periodic, branch_points, period_doubling, spread_equilibria, "
+            "start_state, orbits_at, seeds, explore, explore_initial, explore_transient, "
+            "explore_section)",
         ),
         ("", "s.yaml:4: continuations[0].range: required key is missing"),
     ],

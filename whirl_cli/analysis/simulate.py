@@ -332,12 +332,28 @@ def _interior_stable(branch: Branch, index: int) -> bool:
                   PointType.BP, PointType.LP]).any()
 
 
+#: An orbit this fraction of its branch's parameter span or closer to a fold of cycles is not
+#: checked: a smoothed law moves its folds by about its smoothing width, so the unsmoothed
+#: law's cycle may be gone there (it leaves for another attractor).
+FOLD_MARGIN = 1e-3
+
+
+def _near_fold(branch: Branch, index: int) -> bool:
+    """True if row ``index`` lies within FOLD_MARGIN of the branch's parameter span of one of
+    its folds of cycles."""
+    p = branch.parameters[:, 0]
+    folds = p[branch.point_type == PointType.LPC]
+    return bool(len(folds)) and bool(
+        np.abs(folds - p[index]).min() <= FOLD_MARGIN * max(float(np.ptp(p)), 1e-300))
+
+
 def cross_check(model: Model, overrides: dict[str, float], branches: tuple[Branch, ...],
                 per_branch: int = 2, jobs: int = 1) -> tuple[CrossCheck, ...]:
     """Checks of up to ``per_branch`` stable points of every branch (orbits for periodic
     branches, perturbations for equilibria), spread along each branch. Not checked: points next
-    to bifurcations, orbits in a period blow-up (T > 3 T_Hopf) and equilibria too weakly damped
-    or too stiff to simulate in bounded time. ``jobs`` > 1 simulates in that many forked
+    to bifurcations, orbits near a fold of cycles (:data:`FOLD_MARGIN`), orbits in a period
+    blow-up (T > 3 T_Hopf) and equilibria too weakly damped or too stiff to simulate in
+    bounded time. ``jobs`` > 1 simulates in that many forked
     processes (:func:`whirl_cli.runtime.forked_map`: results identical, in the same
     order; an interrupt of the parent kills them at once)."""
     preloaded()  # scipy may be being imported in the background (it is then used here)
@@ -368,7 +384,8 @@ def planned_checks(branches: tuple[Branch, ...], per_branch: int = 2
             candidates = [k for k, o in enumerate(branch.orbits)
                           if 0 < o.index < len(branch) - 1
                           and _interior_stable(branch, o.index) and o.states.shape[0] > 1
-                          and o.period < BLOWUP_FACTOR * hopf_period]
+                          and o.period < BLOWUP_FACTOR * hopf_period
+                          and not _near_fold(branch, o.index)]
             tasks += [(number, CheckKind.ORBIT, k) for k in _spread(candidates, per_branch)]
         elif branch.kind == BranchKind.EQUILIBRIUM:
             rows = [k for k in range(1, len(branch) - 1)

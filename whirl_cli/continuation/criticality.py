@@ -27,12 +27,11 @@ def _with_criticality(points: list[SpecialPoint], families: list[Branch],
     for family in families:
         if len(family) < 3:
             continue
-        for row, neighbour in ((0, 1), (len(family) - 1, len(family) - 2)):
+        for row, step in ((0, 1), (len(family) - 1, -1)):
             k = _hopf_at(family, row, hopfs, width, scale) if row else next(
                 (i for i, h in enumerate(hopfs) if family.origin == Origin.at(h)), None)
             if k is not None and k not in sides:
-                sides[k] = float(np.sign(family.parameters[neighbour, 0]
-                                         - hopfs[k].parameters[0]))
+                sides[k] = _side(family.parameters[::step, 0], hopfs[k].parameters[0], width)
     labelled = []
     for point in points:
         if point.point_type == PointType.HB:
@@ -48,6 +47,20 @@ def _with_criticality(points: list[SpecialPoint], families: list[Branch],
                 point = replace(point, criticality=from_family)
         labelled.append(point)
     return labelled
+
+
+#: A family has left its Hopf point's parameter value once it is this fraction of the range
+#: away: a family that grows at a fixed value first (a Hopf point of an equilibrium where the
+#: right-hand side is locally linear, e.g. just outside a freeplay gap) lies on the side it
+#: then turns to.
+SIDE_MARGIN = 1e-4
+
+
+def _side(values: np.ndarray, hopf: float, width: float) -> float:
+    """The side of ``hopf`` (-1, +1) the family's parameter ``values`` (from its Hopf end)
+    first leave it to by SIDE_MARGIN of ``width``; 0 if they never do."""
+    away = np.flatnonzero(np.abs(values - hopf) > SIDE_MARGIN * width)
+    return float(np.sign(values[away[0]] - hopf)) if len(away) else 0.0
 
 
 def with_lyapunov(model: Model, parameter: str, parameters: dict[str, float],

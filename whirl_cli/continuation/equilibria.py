@@ -4,10 +4,11 @@
 2. at every branch point (BP) found, branch switching (ISW=-1) in both directions to the
    secondary (static-divergence) equilibria, recursively for branch points on those branches
    (each point once);
-3. from every further equilibrium given at the start value (e.g. one a seed settled on) that
-   lies on none of these branches, a branch both ways; of a symmetric model whose right-hand
-   side is odd there, from its mirror image too (offset equilibria no branch point leads to,
-   such as those of freeplay with K_in = 0).
+3. from every further equilibrium given at the start value (e.g. one a seed settled on, or
+   one Newton's method finds from a spread of starts, :func:`spread_equilibria`) that lies on
+   none of these branches, a branch both ways; of a symmetric model whose right-hand side is
+   odd there, from its mirror image too (offset equilibria no branch point leads to, such as
+   those of freeplay with K_in = 0).
 """
 
 from __future__ import annotations
@@ -23,6 +24,9 @@ from .engine import Engine, Numerics, RunSpec, _run_branches
 
 #: How deep branch switching recurses (main -> secondary -> tertiary).
 MAX_SWITCH_DEPTH = 3
+#: The spread of Newton starts: these fractions of each dof's typical amplitude (13 from 0.01
+#: to 1, evenly on a log scale), both signs.
+SPREAD = tuple(10.0 ** (k / 6 - 2) for k in range(13))
 
 
 def _stops(model: Model, parameter: str, bounds: tuple[float, float], amplitude: float) -> dict:
@@ -59,12 +63,13 @@ def equilibrium_constants(model: Model, numerics: Numerics, parameter: str,
 def equilibria(engine: Engine, name: str, parameter: str, start: float,
                bounds: tuple[float, float], parameters: dict[str, float], numerics: Numerics,
                branch_points: bool = True, guess: np.ndarray | None = None,
-               also_from: tuple[np.ndarray, ...] = ()
+               also_from: tuple[np.ndarray, ...] = (), spread: bool = False
                ) -> tuple[list[Branch], list[SpecialPoint]]:
     """Equilibrium branches (main, then secondary from every BP, then one from each state of
     ``also_from`` on no branch yet) and their special points; the main branch starts at the
     equilibrium :func:`starting_equilibrium` finds from ``guess``, the others at those it
-    finds from each of ``also_from`` (SI states at ``start``)."""
+    finds from each of ``also_from`` (SI states at ``start``) and, if ``spread``, from each
+    of :func:`spread_equilibria`."""
     model = engine.model
     lower, upper = bounds
     width = upper - lower
@@ -106,6 +111,9 @@ def equilibria(engine: Engine, name: str, parameter: str, start: float,
         frontier = [p for p in _run_branches(engine, todo, branches, points, skip_first=True)
                     if not any(_same_point(p, q, width, amplitudes) for q in switched)]
 
+    if spread:
+        also_from = (*also_from, *spread_equilibria(model, start_parameters,
+                                                    numerics.max_amplitude))
     found = 0
     for rest in _mirrored(model, start_parameters, also_from):
         state = starting_equilibrium(model, start_parameters, rest, f"{name}: {parameter} = "
@@ -162,6 +170,47 @@ def _mirrored(model: Model, values: dict[str, float], states: tuple[np.ndarray, 
         if model.symmetric and state.any() and is_odd(model, params, [state]):
             out.append(-state)
     return out
+
+
+def spread_starts(model: Model) -> list[np.ndarray]:
+    """Newton starts (SI) across the dofs' amplitudes: each dof alone, and all of them together
+    (of one sign, and of alternating signs), at each fraction of :data:`SPREAD` of its typical
+    amplitude, both signs; rates and first-order states zero."""
+    amplitudes = typical_amplitudes(model)
+    dofs = list(model.positions)
+    patterns = [np.eye(len(dofs))[k] for k in range(len(dofs))]
+    if len(dofs) > 1:
+        patterns += [np.ones(len(dofs)), (-1.0) ** np.arange(len(dofs))]
+    starts = []
+    for pattern in patterns:
+        for fraction in SPREAD:
+            for sign in (1.0, -1.0):
+                start = np.zeros(model.n_states)
+                start[dofs] = sign * fraction * pattern * amplitudes[dofs]
+                starts.append(start)
+    return starts
+
+
+def spread_equilibria(model: Model, parameters: dict[str, float], bound: float
+                      ) -> list[np.ndarray]:
+    """The distinct equilibria (SI) Newton's method finds from :func:`spread_starts`, those
+    within ``bound`` typical amplitudes in every state (a branch stops there), the zero state
+    left out."""
+    values = model.parameter_vector(parameters)
+    field, jacobian = model.field_at(values)
+    amplitudes = typical_amplitudes(model)
+    scale = np.asarray(model.state_scale, dtype=float)
+    found: list[np.ndarray] = []
+    for start in spread_starts(model):
+        root, _ = newton(field, jacobian, start, scale)
+        if root is None or np.abs(root / amplitudes).max() >= bound:
+            continue
+        if np.allclose(root / amplitudes, 0.0, atol=1e-9) or any(
+                np.allclose(root / amplitudes, known / amplitudes, atol=1e-6, rtol=1e-6)
+                for known in found):
+            continue
+        found.append(root)
+    return found
 
 
 def on_branch(branches: list[Branch], value: float, state: np.ndarray, width: float,

@@ -53,7 +53,11 @@ def locate_homoclinics(engine: Engine, name: str, ends: list[tuple[Branch, Speci
     points = [point for _, point in ends]
     runs = []
     for k, (family, point) in enumerate(ends):
-        planned = _homoclinic_run(engine, name, family, point, bounds, parameters)
+        # both sides of a family started at an orbit can end at one: each run its own name
+        side = sum(f.name == family.name for f, _ in ends[:k])
+        planned = _homoclinic_run(engine, f"{name}/{family.name}.homoclinic"
+                                  f"{side + 1 if side else ''}", family, point, bounds,
+                                  parameters)
         if isinstance(planned, str):
             points[k] = replace(point, note=_joined(point.note, planned))
         else:
@@ -65,12 +69,12 @@ def locate_homoclinics(engine: Engine, name: str, ends: list[tuple[Branch, Speci
     return points
 
 
-def _homoclinic_run(engine: Engine, name: str, family: Branch, point: SpecialPoint,
+def _homoclinic_run(engine: Engine, run: str, family: Branch, point: SpecialPoint,
                     bounds: tuple[float, float], parameters: dict[str, float]
                     ) -> RunSpec | str:
-    """The HomCont run for one homoclinic end, or why none is tried. A symmetric orbit passing
-    the saddle twice per period (a pair of homoclinic loops of a symmetric model) is not:
-    HomCont follows one loop."""
+    """The HomCont run (named ``run``) for one homoclinic end, or why none is tried. A
+    symmetric orbit passing the saddle twice per period (a pair of homoclinic loops of a
+    symmetric model) is not: HomCont follows one loop."""
     model = engine.model
     parameter = family.parameter_names[0]
     labelled = [k for k in np.flatnonzero(family.label) if np.isfinite(family.period[k])]
@@ -89,7 +93,7 @@ def _homoclinic_run(engine: Engine, name: str, family: Branch, point: SpecialPoi
         return "HomCont not tried: no saddle"
     label = int(family.label[row])
     period_tau = float(family.period[row]) * model.time_scale
-    return RunSpec(f"{name}/{family.name}.homoclinic",
+    return RunSpec(run,
                    homoclinic_constants(model, parameter, bounds, period_tau, n_unstable),
                    BranchKind.HOMOCLINIC, Origin(point.note), (parameter,),
                    restart=(engine.run_with_label(family.runs, label), label))

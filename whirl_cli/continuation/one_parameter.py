@@ -23,7 +23,7 @@ def one_parameter(engine: Engine, name: str, parameter: str, start: float,
                   periodic: bool = False, orbits_at: tuple[float, ...] = (),
                   start_orbits: tuple[OrbitStart, ...] = (),
                   start_state: np.ndarray | None = None,
-                  resting: tuple[np.ndarray, ...] = (),
+                  resting: tuple[np.ndarray, ...] = (), spread: bool = False,
                   period_doubling: bool = False) -> ContinuationResult:
     """Equilibria of ``parameter`` over ``bounds`` from ``start`` (from the equilibrium found
     by Newton's method from ``start_state``, SI, default zero), with branch switching, and
@@ -31,11 +31,12 @@ def one_parameter(engine: Engine, name: str, parameter: str, start: float,
     ``start_orbits`` (e.g. orbits settled by time simulation). ``orbits_at``: parameter values
     where every branch stores a labelled solution (orbit profiles); ``resting``: states (SI)
     at ``start`` near equilibria (e.g. where seeds came to rest), each starting a branch if
-    it is on none (see :func:`.equilibria.equilibria`); ``period_doubling``: the families
-    doubled at the PD points of the periodic ones (:mod:`.doubling`)."""
+    it is on none (see :func:`.equilibria.equilibria`), as does (``spread``) every
+    equilibrium Newton's method finds there from a spread of starts; ``period_doubling``: the
+    families doubled at the PD points of the periodic ones (:mod:`.doubling`)."""
     numerics = replace(numerics, orbits_at=tuple(orbits_at))
     branches, points = equilibria(engine, name, parameter, start, bounds, parameters, numerics,
-                                  branch_points, start_state, tuple(resting))
+                                  branch_points, start_state, tuple(resting), spread)
     points = with_lyapunov(engine.model, parameter, parameters, points)
     # a linear model has no limit cycles: at a Hopf point it carries a continuum of neutral
     # orbits of every amplitude, which AUTO reports as folds everywhere

@@ -45,7 +45,8 @@ PERIOD_CAP = 25.0
 ORBIT_EVERY = 20
 #: A family is continued fold by fold (AUTO stops at each fold of cycles); at most this many.
 MAX_SEGMENTS = 24
-#: After MX, a family is restarted with a finer mesh and smaller steps at most this often.
+#: After MX, a family is restarted with a finer mesh and smaller steps at most this often
+#: (each time twice the mesh intervals and half the largest step, kept for its later segments).
 MAX_RETRIES = 2
 #: A family that came back onto its own Hopf point is computed again with this many times
 #: the mesh intervals.
@@ -450,11 +451,14 @@ def _retry(family: _Family, piece: Branch) -> RunSpec | None:
     row = int(labelled[-1])
     family.pieces[-1] = head(piece, row + 1)
     family.retries += 1
-    refine = 2 ** family.retries
-    constants = _segment_constants(family, NTST=family.spec.constants["NTST"] * refine,
-                                   DSMAX=family.spec.constants["DSMAX"] / refine)
+    # the family keeps the finer mesh for its later segments: back on the coarse one, the
+    # next segment fails where the last one did
+    first = family.spec.constants
+    family.spec = replace(family.spec, constants=dict(
+        first, NTST=2 * first["NTST"], DSMAX=first["DSMAX"] / 2))
     return replace(family.spec, name=f"{family.spec.name.rsplit('.', 1)[0]}."
-                   f"{len(family.pieces)}r{family.retries}", constants=constants,
+                   f"{len(family.pieces)}r{family.retries}",
+                   constants=_segment_constants(family),
                    restart=(piece.runs[-1], int(piece.label[row])), data=None)
 
 

@@ -67,6 +67,12 @@ class OneParameterContinuation(ContinuationSpec):
         "point of a periodic family (AUTO's branch switching at PD, the period doubled), and "
         "from theirs, up to 3 doublings; stored as branches `<family>_pd<k>`."
     )
+    spread_equilibria: Boolean = Field(
+        False, description="Also seek equilibria at `start` by Newton's method from a spread of "
+        "starts (each dof alone and all together at 13 amplitudes from 0.01 to 1 typical "
+        "amplitude, both signs); each one on no computed branch starts a branch both ways "
+        "(equilibria no branch point reaches, e.g. freeplay's offset ones)."
+    )
     start_state: Annotated[dict[str, float] | None, BeforeValidator(_as_state)] = Field(
         None,
         description="Where Newton's method seeks the starting equilibrium at `start` when the "
