@@ -52,6 +52,23 @@ class LocusKind(Word):
 FOLD_LOCI = (LocusKind.FOLD, LocusKind.FOLD_OF_CYCLES)
 
 
+class UnsafeCause(Word):
+    """Why an interval of a slice is unsafe though linearly stable: stable limit cycles
+    (flutter, between a Hopf and a fold-of-cycles locus) or offset equilibria (divergence,
+    between a pitchfork and a fold locus)."""
+
+    FLUTTER = "flutter"
+    DIVERGENCE = "divergence"
+
+
+class BoundaryMethod(Word):
+    """How a boundary's unsafe intervals were found: from the locus curves on rows across the
+    second parameter (loci) or from each slice's one-parameter branches (slices)."""
+
+    LOCI = "loci"
+    SLICES = "slices"
+
+
 class ContinuationKind(Word):
     """A study's continuation ``type``, and a result's continuation kind."""
 

@@ -27,6 +27,7 @@ from .continuation.periodic import OrbitStart
 from .output.provenance import provenance, resolved_parameters
 from .results import (
     Boundary,
+    BoundaryMethod,
     ContinuationResult,
     Exploration,
     MotionKind,
@@ -372,7 +373,8 @@ def continue_two_parameter(stage: Stage, spec) -> tuple[ContinuationResult, Boun
     continuation = replace(continuation, seeds=outcomes)
     per_slice = [tuple(b for b in continuation.branches if on_slice(b.name, k) is not None)
                  for k in range(len(spec.slices))]
-    found = boundaries.boundary(spec.name, model, parameters, pair, bounds, spec.method,
+    found = boundaries.boundary(spec.name, model, parameters, pair, bounds,
+                                BoundaryMethod(spec.method),
                                 spec.slice_values, spec.resolution, curves, per_slice)
     return continuation, found
 

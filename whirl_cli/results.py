@@ -15,20 +15,24 @@ from enum import IntEnum
 import numpy as np
 
 from .kinds import (
+    BoundaryMethod,
     BranchKind,
     CheckKind,
     ContinuationKind,
     Criticality,
     LocateStatus,
+    LocusKind,
     MotionKind,
     RunStatus,
     SeedKind,
     SimulationLaw,
+    UnsafeCause,
 )
 
 #: re-exported: the vocabulary results are written in
-__all__ = ["BranchKind", "CheckKind", "ContinuationKind", "Criticality", "LocateStatus",
-           "MotionKind", "RunStatus", "SeedKind", "SimulationLaw"]
+__all__ = ["BoundaryMethod", "BranchKind", "CheckKind", "ContinuationKind", "Criticality",
+           "LocateStatus", "LocusKind", "MotionKind", "RunStatus", "SeedKind", "SimulationLaw",
+           "UnsafeCause"]
 
 
 def _brief(value) -> str:
@@ -452,13 +456,13 @@ class LinearGrid:
 @dataclass(frozen=True)
 class UnsafeInterval:
     """Where, on one slice (second parameter = ``slice_value``), the first parameter lies in
-    the unsafe region: linearly stable, yet flutter (``cause`` "flutter") or divergence
-    ("divergence") exists for ``lower`` < first < ``upper``."""
+    the unsafe region: linearly stable, yet flutter (``cause`` :attr:`UnsafeCause.FLUTTER`) or
+    divergence (:attr:`UnsafeCause.DIVERGENCE`) exists for ``lower`` < first < ``upper``."""
 
     slice_value: float
     lower: float
     upper: float
-    cause: str
+    cause: UnsafeCause
 
 
 @dataclass(frozen=True)
@@ -467,7 +471,8 @@ class Boundary:
 
     ``loci``: name -> (kind, curve (K, 2) in (first, second)); kinds hopf, branch_point, fold,
     fold_of_cycles. ``polygons``: closed (K, 2) outlines of the unsafe region. ``intervals``:
-    the unsafe intervals per slice (``method`` "loci" or "slices" says how they were found).
+    the unsafe intervals per slice (``method``, a :class:`BoundaryMethod`, says how they were
+    found).
     ``first_range``, ``second_range``: the parameters' ranges (NaN in older files).
     ``bounding_ends``: fold-of-cycles locus name -> whether its first and last points bound
     stable cycles (a locus not listed: both do, as in older files).
@@ -476,8 +481,8 @@ class Boundary:
     name: str
     parameter_names: tuple[str, str]
     parameter_units: tuple[str, str]
-    method: str
-    loci: dict[str, tuple[str, np.ndarray]]
+    method: BoundaryMethod
+    loci: dict[str, tuple[LocusKind, np.ndarray]]
     intervals: tuple[UnsafeInterval, ...]
     polygons: tuple[np.ndarray, ...]
     slices: tuple[float, ...]

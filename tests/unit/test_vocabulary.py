@@ -18,6 +18,7 @@ from whirl_cli.errors import OutputError
 from whirl_cli.output import store
 from whirl_cli.plots.cuts import _cycle
 from whirl_cli.results import (
+    BoundaryMethod,
     Branch,
     BranchKind,
     CheckKind,
@@ -25,6 +26,7 @@ from whirl_cli.results import (
     ContinuationResult,
     Criticality,
     LocateStatus,
+    LocusKind,
     MotionKind,
     Orbit,
     Origin,
@@ -34,6 +36,7 @@ from whirl_cli.results import (
     SimulationLaw,
     SpecialPoint,
     StudyResult,
+    UnsafeCause,
 )
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -88,6 +91,9 @@ DOCUMENTED = [
     (CheckKind, r"kind \((orbit \| equilibrium)\)"),
     (SimulationLaw, r"law \((smoothed \| exact)\)"),
     (RunStatus, r"status \((ok \| mx \| error \| timeout \| crashed)\)"),
+    (BoundaryMethod, r"method \((loci \| slices)\)"),
+    (UnsafeCause, r"cause \((flutter \|\s+divergence)\)"),
+    (LocusKind, r"attrs kind \((hopf \|\s+branch_point \| fold \| fold_of_cycles \| torus)\)"),
 ]
 
 

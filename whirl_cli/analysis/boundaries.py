@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..kinds import BoundaryMethod, LocusKind, UnsafeCause
 from ..models import Model
 from ..results import Boundary, Branch, BranchKind, PointType, UnsafeInterval
 from . import linear
@@ -245,11 +246,11 @@ def loci_candidates(loci: dict[str, list[np.ndarray]], value: float
     fold_of_cycles, branch_point, fold), by cause: every fold-of-cycles crossing with the
     nearest Hopf crossing (flutter), every fold crossing with the nearest pitchfork crossing
     (divergence), before intersecting with the linearly stable part."""
-    def at(kind: str) -> list[float]:
+    def at(kind: LocusKind) -> list[float]:
         return [x for curve in loci.get(kind, []) for x in crossings(curve, value)]
 
-    return {"flutter": _paired(at("fold_of_cycles"), at("hopf")),
-            "divergence": _paired(at("fold"), at("branch_point"))}
+    return {UnsafeCause.FLUTTER: _paired(at(LocusKind.FOLD_OF_CYCLES), at(LocusKind.HOPF)),
+            UnsafeCause.DIVERGENCE: _paired(at(LocusKind.FOLD), at(LocusKind.BRANCH_POINT))}
 
 
 def unsafe_from_loci(loci: dict[str, list[np.ndarray]], stable: list[Interval], value: float,
@@ -263,17 +264,17 @@ def branch_candidates(branches: tuple[Branch, ...]) -> dict[str, list[Interval]]
     """Where one slice may be unsafe, from its one-parameter branches, by cause: the extent of
     every periodic family with a stable part (flutter) and of every secondary equilibrium
     branch with a fold (divergence)."""
-    found: dict[str, list[Interval]] = {"flutter": [], "divergence": []}
+    found: dict[UnsafeCause, list[Interval]] = {cause: [] for cause in UnsafeCause}
     for branch in branches:
         if not len(branch):
             continue
         extent = (float(branch.parameters[:, 0].min()), float(branch.parameters[:, 0].max()))
         if branch.kind == BranchKind.PERIODIC and (branch.stable
                                                    & branch.stability_known)[1:-1].any():
-            found["flutter"].append(extent)
+            found[UnsafeCause.FLUTTER].append(extent)
         elif (branch.kind == BranchKind.EQUILIBRIUM and branch.origin.point == PointType.BP
               and np.any(branch.point_type == 2)):
-            found["divergence"].append(extent)
+            found[UnsafeCause.DIVERGENCE].append(extent)
     return found
 
 
@@ -288,7 +289,7 @@ def _unsafe(candidates: dict[str, list[Interval]], stable: list[Interval], value
             minimum: float) -> list[UnsafeInterval]:
     """The ``candidates`` (cause -> intervals) inside the ``stable`` intervals, pieces longer
     than ``minimum``, flutter first."""
-    return [UnsafeInterval(value, lo, hi, cause) for cause in ("flutter", "divergence")
+    return [UnsafeInterval(value, lo, hi, cause) for cause in UnsafeCause
             for lo, hi in intersect(candidates[cause], stable, minimum)]
 
 
@@ -331,11 +332,11 @@ def polygons(intervals: list[UnsafeInterval], values: list[float],
 
 #: Locus branch kinds -> the names used in ``unsafe_from_loci``.
 LOCUS_NAMES = {
-    BranchKind.HOPF_LOCUS: "hopf",
-    BranchKind.FOLD_OF_CYCLES_LOCUS: "fold_of_cycles",
-    BranchKind.BRANCH_POINT_LOCUS: "branch_point",
-    BranchKind.FOLD_LOCUS: "fold",
-    BranchKind.TORUS_LOCUS: "torus",  # drawn, not used by the unsafe region
+    BranchKind.HOPF_LOCUS: LocusKind.HOPF,
+    BranchKind.FOLD_OF_CYCLES_LOCUS: LocusKind.FOLD_OF_CYCLES,
+    BranchKind.BRANCH_POINT_LOCUS: LocusKind.BRANCH_POINT,
+    BranchKind.FOLD_LOCUS: LocusKind.FOLD,
+    BranchKind.TORUS_LOCUS: LocusKind.TORUS,  # drawn, not used by the unsafe region
 }
 
 
@@ -349,7 +350,8 @@ def loci_curves(curves: list[Branch], amplitudes: np.ndarray | float = 1.0
     for curve in curves:
         name = LOCUS_NAMES[curve.kind]
         keep = np.ones(len(curve), dtype=bool)
-        if name in ("hopf", "fold_of_cycles"):  # centred within 2 % of the orbit's size
+        # centred within 2 % of the orbit's size
+        if name in (LocusKind.HOPF, LocusKind.FOLD_OF_CYCLES):
             centre = np.abs(0.5 * (curve.state_max + curve.state_min))
             size = 0.5 * (curve.state_max - curve.state_min)
             keep = np.all(centre <= 0.02 * size + 1e-6 * np.asarray(amplitudes), axis=1)
@@ -361,7 +363,7 @@ def loci_curves(curves: list[Branch], amplitudes: np.ndarray | float = 1.0
 
 
 def boundary(name: str, model: Model, overrides: dict[str, float], pair: tuple[str, str],
-             bounds: dict[str, Interval], method: str, slices: tuple[float, ...],
+             bounds: dict[str, Interval], method: BoundaryMethod, slices: tuple[float, ...],
              resolution: int, curves: list[Branch], slice_branches: list[tuple[Branch, ...]]
              ) -> Boundary:
     """The unsafe region of a two-parameter continuation, by ``method`` ("loci": on
@@ -370,12 +372,12 @@ def boundary(name: str, model: Model, overrides: dict[str, float], pair: tuple[s
     first, second = pair
     minimum = 1e-3 * (bounds[first][1] - bounds[first][0])  # narrower pieces are round-off
     curves_by_name = loci_curves(curves, np.array(model.typical_amplitudes))
-    folds = {value: slice_folds(branches, [x for curve in curves_by_name.get("hopf", [])
+    folds = {value: slice_folds(branches, [x for curve in curves_by_name.get(LocusKind.HOPF, [])
                                            for x in crossings(curve, value)])
              for value, branches in zip(slices, slice_branches, strict=True)}
-    if method == "loci":
-        curves_by_name["fold_of_cycles"] = [
-            stretch for curve in curves_by_name.get("fold_of_cycles", [])
+    if method == BoundaryMethod.LOCI:
+        curves_by_name[LocusKind.FOLD_OF_CYCLES] = [
+            stretch for curve in curves_by_name.get(LocusKind.FOLD_OF_CYCLES, [])
             for stretch in stable_fold_stretches(curve, folds, 10 * minimum)]
         rows = sorted(set(np.linspace(*bounds[second], resolution).tolist()) | set(slices))
         candidates = [loci_candidates(curves_by_name, value) for value in rows]

@@ -40,6 +40,7 @@ from ..errors import OutputError
 from ..results import (
     ROOT_FIELDS,
     Boundary,
+    BoundaryMethod,
     Branch,
     BranchKind,
     CheckKind,
@@ -54,6 +55,7 @@ from ..results import (
     LinearGrid,
     LinearSweep,
     LocateStatus,
+    LocusKind,
     MotionKind,
     Orbit,
     Origin,
@@ -69,6 +71,7 @@ from ..results import (
     SliceLabel,
     SpecialPoint,
     StudyResult,
+    UnsafeCause,
     UnsafeInterval,
 )
 from .atomic import publish
@@ -82,6 +85,7 @@ from .mapping import (
     read_table,
     text,
     texts,
+    word,
     write_record,
     write_table,
 )
@@ -221,14 +225,15 @@ LINEAR_GRID = (
 BOUNDARY = (
     Field("parameter_names", "attribute", "text", key="parameters"),
     Field("parameter_units", "attribute", "text", key="units"),
-    Field("method", "attribute", "text"), Field("slices", "attribute", "float"),
+    Field("method", "attribute", "text", vocabulary=BoundaryMethod),
+    Field("slices", "attribute", "float"),
     Field("first_range", "attribute", "float", default=(np.nan, np.nan)),
     Field("second_range", "attribute", "float", default=(np.nan, np.nan)),
 )
 #: The :class:`UnsafeInterval` table of a boundary (``unsafe_intervals/``).
 UNSAFE_INTERVAL = (
     Field("slice_value", kind="float"), Field("lower", kind="float"),
-    Field("upper", kind="float"), Field("cause", kind="text"),
+    Field("upper", kind="float"), Field("cause", kind="text", vocabulary=UnsafeCause),
 )
 #: A :class:`Simulation` in ``simulations/<name>`` (its name is the group's).
 SIMULATION = (
@@ -571,8 +576,8 @@ def _read_explorations(group) -> tuple[Exploration, ...]:
 
 
 def _read_boundary(name: str, group: h5py.Group) -> Boundary:
-    loci = {key: (text(attribute(data, "kind")), data[()])
-            for key, data in group.get("loci", {}).items()}
+    loci = {key: (word(LocusKind, text(attribute(data, "kind")), data.name, "locus kind"),
+                  data[()]) for key, data in group.get("loci", {}).items()}
     polygons = tuple(group["unsafe"][key][()] for key in _members(group.get("unsafe", {}),
                                                                    _number))
     ends = {key: tuple(bool(v) for v in data.attrs["bounding_ends"])
