@@ -102,7 +102,7 @@ def test_both_sides_of_a_family_locate_their_ends_in_runs_of_their_own():
                                        np.cos(angle)])
     sides = []
     for k in range(2):
-        side = replace(_family(lopsided), name="periodic_o1", run=f"run_{k}",
+        side = replace(_family(lopsided), name="periodic_o1", runs=(f"run_{k}",),
                        label=np.arange(1, ROWS + 1))
         point = SpecialPoint("periodic_o1", ROWS - 1, int(PointType.HOMOCLINIC), ("K_theta",),
                              np.array([-0.2]), np.zeros(4), 1.5, False, status="bracketed")
