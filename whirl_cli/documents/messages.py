@@ -18,6 +18,7 @@ from .source import Loc, Problem, Tree
 
 
 def report(problems: list[Problem], tree: Tree, name: str) -> str:
+    """The problems as ``<file>:<line>: <key.path>: <reason>`` lines, sorted by line."""
     lines = sorted((tree.line(loc), dotted(loc), reason) for loc, reason in problems)
     return "\n".join(f"{name}:{line}: {path}: {reason}" for line, path, reason in lines)
 
@@ -67,6 +68,7 @@ def translate(error: Any, tree: Tree, root: type[BaseModel]) -> Problem:
 
 
 def choice_reason(options: Any, got: str) -> str:
+    """The reason for a value not among ``options``."""
     return f"expected one of {', '.join(map(str, options))}, got {got}"
 
 

@@ -132,6 +132,7 @@ def read_text(path: Path, label: str, what: str = "study") -> str:
 
 
 def too_large(name: str, size: int, what: str = "study") -> str:
+    """The message for a file of ``size`` bytes, over :data:`MAX_BYTES`."""
     return f"{name}: the {what} file is too large ({size} bytes; the limit is {MAX_BYTES})"
 
 

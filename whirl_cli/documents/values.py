@@ -27,6 +27,7 @@ _NAME_REASON = (
 
 
 def is_number(value: Any) -> bool:
+    """True for an int or float that is not a bool."""
     return isinstance(value, int | float) and not isinstance(value, bool)
 
 
@@ -44,6 +45,7 @@ def _as_string(value: Any) -> str:
 
 
 def as_number(value: Any) -> float:
+    """``value`` as a finite float, else the reason."""
     return _number(value, ())
 
 
@@ -123,6 +125,7 @@ def as_state(value: Any) -> dict[str, float]:
 
 
 def at_most_orbits(values: tuple) -> tuple:
+    """``values`` if there are at most :data:`ORBITS_MAX` of them."""
     if len(values) > ORBITS_MAX:
         fail(f"at most {ORBITS_MAX} values, got {len(values)}")
     return values
@@ -157,4 +160,6 @@ Step = Annotated[Positive, bound("<=", 1)]
 
 
 class Strict(BaseModel):
+    """The base of every model read from YAML: unknown keys refused, frozen."""
+
     model_config = ConfigDict(extra="forbid", frozen=True)
