@@ -29,13 +29,13 @@ Validation also fills the model-dependent defaults (:mod:`~whirl_cli.study.resol
 ``Study.model_validate`` applies these fills too, but only the two entry points check parameter
 names and ranges against the model.
 
-Modules, lowest first (each imports only those above it, :mod:`whirl_cli.models`, and the
-schema :mod:`whirl_cli.continuation.numerics` for the AUTO defaults its step checks use):
+Modules, lowest first (each imports only those above it, :mod:`whirl_cli.models`,
+:mod:`whirl_cli.documents` -- the reader, the value types and the messages -- and the schema
+:mod:`whirl_cli.continuation.numerics` for the AUTO defaults its step checks use):
 
-* :mod:`~whirl_cli.documents.source` -- the file as YAML nodes and data, with line numbers;
 * :mod:`~whirl_cli.study.resolve` -- model-dependent defaults filled on the raw data;
-* :mod:`~whirl_cli.study.schema` -- value checks and the pydantic models;
-* :mod:`~whirl_cli.documents.messages` -- pydantic errors as (key path, reason), the report;
+* :mod:`~whirl_cli.study.continuations` -- the continuation types' registry;
+* :mod:`~whirl_cli.study.schema` -- the pydantic models;
 * :mod:`~whirl_cli.study.checks` -- meaning checks against the model variant;
 * :mod:`~whirl_cli.study.reference` -- the YAML reference table, read off the schema.
 
