@@ -21,9 +21,9 @@ from .plots.kinds import plot_kinds
 
 
 def _version() -> str:
-    from . import _version as installed
+    from . import __version__
 
-    return installed()
+    return __version__
 
 
 #: whirl's log: progress (INFO), notes (WARNING) and details (DEBUG), as lines on stderr;
@@ -62,7 +62,7 @@ def _tell(text: str, end: str = "\n") -> None:
 
 
 def _show_version(ctx: click.Context, _param: click.Parameter, value: bool) -> None:
-    """``--version``: the installed version, looked up only when asked (whirl_cli._version)."""
+    """``--version``: the installed version, looked up only when asked (whirl_cli.__version__)."""
     if value and not ctx.resilient_parsing:
         click.echo(f"whirl, version {_version()}")
         ctx.exit()

@@ -171,7 +171,7 @@ def test_the_outermost_folds_of_snaking_families_draw_the_same_boundary(tmp_path
     point of the loci traced with ``all`` lies within 3e-3 of the ranges of the loci drawn
     (and the other way round within 1e-3), the unsafe intervals are the same, and fewer AUTO
     runs are made."""
-    from whirl_cli.continuation.geometry import _on_paths
+    from whirl_cli.continuation.geometry import on_paths
 
     found = {}
     for mode in ("all", "outermost"):
@@ -191,8 +191,8 @@ def test_the_outermost_folds_of_snaking_families_draw_the_same_boundary(tmp_path
                 if b.kind.endswith("_locus")]
 
     every, outer = picture(found["all"]), picture(found["outermost"])
-    assert all(_on_paths(curve, outer, 3e-3).all() for curve in every)
-    assert all(_on_paths(curve, every, 1e-3).all() for curve in outer)
+    assert all(on_paths(curve, outer, 3e-3).all() for curve in every)
+    assert all(on_paths(curve, every, 1e-3).all() for curve in outer)
 
     def intervals(result):
         return sorted((i.cause, i.lower, i.upper) for i in result.boundaries[0].intervals)

@@ -42,7 +42,7 @@ SPEC = '''
 from pydantic import Field
 
 from ...kinds import ContinuationKind
-from ..values import Number, Text
+from ...documents.values import Number, Text
 from . import ContinuationSpec, ContinuationType
 from typing import Literal
 

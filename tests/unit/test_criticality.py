@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from whirl_cli.continuation.criticality import _with_criticality
+from whirl_cli.continuation.criticality import with_criticality
 from whirl_cli.results import Branch, BranchKind, Origin, PointType, SpecialPoint
 
 OMEGA = 30.0  # rad/s, the Hopf pair
@@ -54,14 +54,14 @@ def hopf_and_family(printed: bool, lyapunov_says: str):
 @pytest.mark.parametrize("lyapunov_says", ["supercritical", "subcritical"])
 def test_no_eigenvalues_beside_the_hopf_point_leaves_the_lyapunov_verdict(lyapunov_says):
     equilibria, hopf, family = hopf_and_family(printed=False, lyapunov_says=lyapunov_says)
-    (labelled,) = _with_criticality([hopf], [family], [equilibria], 0.8, np.ones(4))
+    (labelled,) = with_criticality([hopf], [family], [equilibria], 0.8, np.ones(4))
     assert labelled.criticality == lyapunov_says
     assert labelled.note == ""
 
 
 def test_with_eigenvalues_the_family_decides_and_a_disagreement_is_noted():
     equilibria, hopf, family = hopf_and_family(printed=True, lyapunov_says="subcritical")
-    (labelled,) = _with_criticality([hopf], [family], [equilibria], 0.8, np.ones(4))
+    (labelled,) = with_criticality([hopf], [family], [equilibria], 0.8, np.ones(4))
     assert labelled.criticality == "supercritical"  # unstable below 0.2, the family there
     assert "first Lyapunov coefficient says subcritical" in labelled.note
 
@@ -75,5 +75,5 @@ def test_a_family_that_grows_at_the_hopf_value_first_lies_where_it_then_turns():
                     np.array([0.2, 0.2 + 1e-9, 0.2 + 2e-9, 0.2, 0.19, 0.17]),
                     np.full((6, 4), np.nan + 0j), np.array([0.0, 0.01, 0.02, 0.03, 0.04, 0.05]),
                     origin=Origin.at(hopf))
-    (labelled,) = _with_criticality([hopf], [family], [equilibria], 0.8, np.ones(4))
+    (labelled,) = with_criticality([hopf], [family], [equilibria], 0.8, np.ones(4))
     assert labelled.criticality == "supercritical"

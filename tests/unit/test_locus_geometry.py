@@ -6,7 +6,7 @@ import dataclasses
 
 import numpy as np
 
-from whirl_cli.continuation.geometry import _near_polyline
+from whirl_cli.continuation.geometry import near_polyline
 
 from .locus_data import make_locus
 
@@ -14,23 +14,23 @@ from .locus_data import make_locus
 def test_point_between_vertices_is_on_the_polyline():
     curve = np.array([[0.0, 0.0], [0.1, 0.0], [0.1, 0.2]])
     width = np.array([1.0, 1.0])
-    assert _near_polyline(np.array([0.05, 0.0005]), curve, width)  # mid-segment, 5e-4 off
-    assert _near_polyline(np.array([0.1003, 0.1]), curve, width)
-    assert not _near_polyline(np.array([0.05, 0.002]), curve, width)
-    assert not _near_polyline(np.array([0.2, 0.2]), curve, width)
+    assert near_polyline(np.array([0.05, 0.0005]), curve, width)  # mid-segment, 5e-4 off
+    assert near_polyline(np.array([0.1003, 0.1]), curve, width)
+    assert not near_polyline(np.array([0.05, 0.002]), curve, width)
+    assert not near_polyline(np.array([0.2, 0.2]), curve, width)
 
 
 def test_distance_is_measured_in_axes_scaled_by_the_ranges():
     curve = np.array([[0.0, 0.0], [1.0, 0.0]])
     point = np.array([0.5, 0.05])
-    assert not _near_polyline(point, curve, np.array([1.0, 1.0]))
-    assert _near_polyline(point, curve, np.array([1.0, 100.0]))  # 0.05 of a 100-wide axis
+    assert not near_polyline(point, curve, np.array([1.0, 1.0]))
+    assert near_polyline(point, curve, np.array([1.0, 100.0]))  # 0.05 of a 100-wide axis
 
 
 def test_degenerate_curves():
     width = np.array([1.0, 1.0])
-    assert not _near_polyline(np.zeros(2), np.empty((0, 2)), width)
-    assert _near_polyline(np.zeros(2), np.zeros((1, 2)), width)
+    assert not near_polyline(np.zeros(2), np.empty((0, 2)), width)
+    assert near_polyline(np.zeros(2), np.zeros((1, 2)), width)
 
 
 def _circle(turns: float, points_per_turn: int = 200, centre=(0.5, 0.5)) -> np.ndarray:
@@ -39,21 +39,21 @@ def _circle(turns: float, points_per_turn: int = 200, centre=(0.5, 0.5)) -> np.n
 
 
 def test_a_locus_is_cut_where_it_returns_to_its_start():
-    from whirl_cli.continuation.geometry import _closed
+    from whirl_cli.continuation.geometry import cut_closed
 
     width = np.ones(2)
-    cut = _closed(make_locus(_circle(2.5)), width)
+    cut = cut_closed(make_locus(_circle(2.5)), width)
     assert 200 <= len(cut) <= 202  # one turn and the point that closes it
 
 
 def test_a_locus_that_runs_onto_a_closed_loop_is_cut_after_one_turn_of_it():
     """AUTO can switch onto a closed locus and go round it to its step limit, never back at
     the start: the curve is cut where it retraces its own path the same way."""
-    from whirl_cli.continuation.geometry import _closed
+    from whirl_cli.continuation.geometry import cut_closed
 
     lead = np.column_stack([np.linspace(0.9, 0.7, 41), np.full(41, 0.5)])[:-1]
     curve = np.vstack([lead, _circle(3.0, centre=(0.5, 0.5))])
-    cut = _closed(make_locus(curve), np.ones(2))
+    cut = cut_closed(make_locus(curve), np.ones(2))
     assert len(lead) + 200 <= len(cut) <= len(lead) + 210
 
 
@@ -64,33 +64,33 @@ def test_a_locus_round_a_loop_whose_sampled_extremes_jitter_is_cut_after_one_lap
     whose period changes from lap to lap (another orbit each time) goes on."""
     from dataclasses import replace
 
-    from whirl_cli.continuation.geometry import _closed
+    from whirl_cli.continuation.geometry import cut_closed
 
     lead = np.column_stack([np.linspace(0.9, 0.7, 41), np.full(41, 0.5)])[:-1]
     curve = np.vstack([lead, _circle(4.0, centre=(0.5, 0.5))])
     jitter = 0.1 * (1 + 0.03 * np.sin(np.arange(len(curve)) * 2.7))  # 3 %, no lap alike
     locus = make_locus(curve, jitter)
-    cut = _closed(replace(locus, period=np.full(len(curve), 0.5)), np.ones(2))
+    cut = cut_closed(replace(locus, period=np.full(len(curve), 0.5)), np.ones(2))
     assert len(lead) + 200 <= len(cut) <= len(lead) + 210
     growing = np.linspace(0.5, 0.9, len(curve))  # 0.1 of its spread per lap
-    assert len(_closed(replace(locus, period=growing), np.ones(2))) == len(curve)
+    assert len(cut_closed(replace(locus, period=growing), np.ones(2))) == len(curve)
 
 
 def test_a_hairpin_or_a_crossing_of_the_projection_is_not_cut():
     """At a cusp a locus comes back along itself the other way; elsewhere its projection on
     the parameters may pass over an earlier stretch where the orbit differs: neither is a
     retrace (the end of such a locus would be lost)."""
-    from whirl_cli.continuation.geometry import _closed
+    from whirl_cli.continuation.geometry import cut_closed
 
     width = np.ones(2)
     out = np.column_stack([np.linspace(0.1, 0.6, 101), np.full(101, 0.3)])
     hairpin = np.vstack([out, out[::-1][1:] + [0.0, 0.002], [[0.1, 0.5]]])
-    assert len(_closed(make_locus(np.vstack([[0.05, 0.3], hairpin])), width)) == len(hairpin) + 1
+    assert len(cut_closed(make_locus(np.vstack([[0.05, 0.3], hairpin])), width)) == len(hairpin) + 1
     # down, back up, down again over the same parameters with a larger orbit
     path = np.vstack([[0.05, 0.25], out, out[::-1][1:], out[1:]])
     extremes = np.concatenate([np.full(102, 0.1), np.linspace(0.1, 0.3, 100),
                                np.full(100, 0.3)])
-    assert len(_closed(make_locus(path, extremes), width)) == len(path)
+    assert len(cut_closed(make_locus(path, extremes), width)) == len(path)
 
 
 def test_mirror_image_starts_are_traced_once():
@@ -142,7 +142,7 @@ def test_a_locus_that_passed_the_range_edge_ends_there_and_is_not_continued():
     """AUTO locates no UZSTOP in the first step after a restart: a locus continued chunk by
     chunk from just inside the edge can end beyond it. That is the range's end, like one on
     the edge; one inside is continued."""
-    from whirl_cli.continuation.geometry import _at_range_edge, _chunk_used
+    from whirl_cli.continuation.geometry import at_range_edge, chunk_used
     from whirl_cli.results import PointType
 
     bounds = {"p": (0.0, 1.0), "q": (0.0, 0.5)}
@@ -152,8 +152,8 @@ def test_a_locus_that_passed_the_range_edge_ends_there_and_is_not_continued():
         points = np.array([[0.2, 0.1], [0.3, 0.2], last])
         curve = make_locus(points)
         curve.point_type[-1] = PointType.EP
-        assert _at_range_edge(curve, bounds, width) == edge, last
-        assert _chunk_used(curve, width, bounds) == (not edge), last
+        assert at_range_edge(curve, bounds, width) == edge, last
+        assert chunk_used(curve, width, bounds) == (not edge), last
 
 
 def test_a_locus_chunk_that_adds_no_point_ends_the_locus(monkeypatch):
@@ -178,7 +178,7 @@ def test_a_locus_chunk_that_adds_no_point_ends_the_locus(monkeypatch):
             assert len(calls) < 3, "the same chunk run again"
             return [None] * len(specs)
 
-    monkeypatch.setattr(loci, "_read", lambda _engine, _spec, _outcome: make_locus(
+    monkeypatch.setattr(loci, "read_run", lambda _engine, _spec, _outcome: make_locus(
         np.array([[0.4, 0.3]])))
     kept, _ = loci._grown(Engine(), {0: (PointType.LPC, spec, curve)}, [], Numerics(),
                           {"p": (0.0, 1.0), "q": (0.0, 0.5)}, np.array([1.0, 0.5]))
@@ -213,7 +213,7 @@ def test_a_locus_chunk_drawn_over_its_own_path_ends_the_locus(monkeypatch):
                 calls.append([s.name for s in specs])
                 return [None] * len(specs)
 
-        monkeypatch.setattr(loci, "_read", lambda _engine, s, _outcome, chunk=chunk: (
+        monkeypatch.setattr(loci, "read_run", lambda _engine, s, _outcome, chunk=chunk: (
             ending(chunk) if s.name.endswith("c1") else ending(chunk[-1:])))
         loci._grown(Engine(), {0: (PointType.LPC, spec, curve)}, [], Numerics(),
                     {"p": (0.0, 1.0), "q": (0.0, 0.5)}, np.array([1.0, 0.5]))
@@ -266,13 +266,13 @@ def test_a_locus_that_runs_onto_another_stops_where_both_are_kept():
 
 
 def test_points_on_paths_are_measured_to_segments():
-    from whirl_cli.continuation.geometry import _on_paths
+    from whirl_cli.continuation.geometry import on_paths
 
     path = np.array([[0.0, 0.0], [0.1, 0.0], [0.1, 0.2]])
     points = np.array([[0.05, 0.0009], [0.05, 0.0011], [0.1009, 0.1], [0.3, 0.3]])
-    assert _on_paths(points, [path]).tolist() == [True, False, True, False]
-    assert _on_paths(points, [np.array([[0.3, 0.3]])]).tolist() == [False, False, False, True]
-    assert not _on_paths(points, []).any()
+    assert on_paths(points, [path]).tolist() == [True, False, True, False]
+    assert on_paths(points, [np.array([[0.3, 0.3]])]).tolist() == [False, False, False, True]
+    assert not on_paths(points, []).any()
 
 
 def _segment_distance(point: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
@@ -287,7 +287,7 @@ def test_points_on_paths_agree_with_the_distance_to_every_segment():
     """Random walks and points in 2 and 6 coordinates, many of them near the walks: a point
     is on the paths exactly when its distance to some segment (the closed form, segment by
     segment) is below the tolerance; also with a one-point path and an empty one."""
-    from whirl_cli.continuation.geometry import _on_paths
+    from whirl_cli.continuation.geometry import on_paths
 
     rng = np.random.default_rng(7)
     found = []
@@ -301,7 +301,7 @@ def test_points_on_paths_agree_with_the_distance_to_every_segment():
                         for a, b in zip(path[:-1], path[1:], strict=True))
                     or any(len(path) == 1 and np.linalg.norm(p - path[0]) < 1e-3
                            for path in paths) for p in points]
-        assert _on_paths(points, paths).tolist() == expected
+        assert on_paths(points, paths).tolist() == expected
         found += expected
     assert 0 < sum(found) < len(found)
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from whirl_cli.continuation.engine import RunSpec
-from whirl_cli.continuation.periodic import _Family, _retry, _segment_constants
+from whirl_cli.continuation.periodic import FamilySide, _retry, _segment_constants
 from whirl_cli.results import Branch, BranchKind, Origin, PointType, RunStatus
 
 ROWS = 6
@@ -29,7 +29,7 @@ def _piece(status: RunStatus) -> Branch:
 
 def test_a_retried_family_keeps_its_finer_mesh_for_its_later_segments():
     constants = {"NTST": 40, "DSMAX": 0.01, "DS": 0.001, "UZSTOP": {}}
-    family = _Family("periodic_1", 0.2, RunSpec("a/periodic_1.0", constants,
+    family = FamilySide("periodic_1", 0.2, RunSpec("a/periodic_1.0", constants,
                                                 BranchKind.PERIODIC, Origin("test"), ("V",)), [])
     family.pieces.append(_piece(RunStatus.MX))
     retried = _retry(family, family.pieces[-1])

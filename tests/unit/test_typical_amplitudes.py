@@ -9,7 +9,7 @@ import dataclasses
 import numpy as np
 
 from whirl_cli.analysis.global_bifurcations import equilibria_at
-from whirl_cli.continuation.branches import _same_point, typical_amplitudes
+from whirl_cli.continuation.branches import same_point, typical_amplitudes
 from whirl_cli.continuation.engine import Numerics
 from whirl_cli.continuation.equilibria import equilibrium_constants
 from whirl_cli.models import FAMILIES, Model
@@ -51,8 +51,8 @@ def test_special_points_told_apart_in_typical_amplitudes():
     (absolute 1e-5 called them one); 1e-6 apart in a model of amplitude 1 they are one."""
     tiny = typical_amplitudes(scaled(FAMILIES["oscillators"], 1e-6, "tiny"))
     a, b = point([5e-6, 0, 0, 0, 0, 0]), point([0, 0, 0, 0, 0, 0])
-    assert not _same_point(a, b, 1.0, tiny)
-    assert _same_point(point([1e-6, 0, 0, 0, 0, 0]), b, 1.0, np.ones(6))
+    assert not same_point(a, b, 1.0, tiny)
+    assert same_point(point([1e-6, 0, 0, 0, 0, 0]), b, 1.0, np.ones(6))
 
 
 def test_equilibria_at_counts_distinct_states_in_typical_amplitudes():

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from whirl_cli import kinds
-from whirl_cli.continuation.criticality import _with_criticality
+from whirl_cli.continuation.criticality import with_criticality
 from whirl_cli.errors import OutputError
 from whirl_cli.output import store
 from whirl_cli.plots.cuts import _cycle
@@ -172,7 +172,7 @@ def test_a_family_labels_the_hopf_point_it_starts_at_not_one_written_alike():
     assert str(Origin.at(first)) == str(Origin.at(second))
     family = _branch("periodic_2", BranchKind.PERIODIC, Origin.at(second),
                      np.array([0.2, 0.19, 0.18, 0.17]))
-    labelled = _with_criticality([first, second], [family], [main], 0.8, np.ones(4))
+    labelled = with_criticality([first, second], [family], [main], 0.8, np.ones(4))
     assert [p.criticality for p in labelled] == [Criticality.SUBCRITICAL,
                                                  Criticality.SUPERCRITICAL]
 

@@ -111,7 +111,7 @@ def typical_amplitudes(model: Model) -> np.ndarray:
     return np.array(model.typical_amplitudes, dtype=float)
 
 
-def _same_point(a: SpecialPoint, b: SpecialPoint, width: float,
+def same_point(a: SpecialPoint, b: SpecialPoint, width: float,
                 amplitudes: np.ndarray) -> bool:
     """Within 1e-5 of the range in the parameter and 1e-5 typical amplitudes (``amplitudes``:
     :func:`typical_amplitudes`) or 1e-4 relative in every state."""
@@ -119,6 +119,7 @@ def _same_point(a: SpecialPoint, b: SpecialPoint, width: float,
             and np.allclose(a.state / amplitudes, b.state / amplitudes, atol=1e-5, rtol=1e-4))
 
 
-def _joined(*notes: str) -> str:
+def joined_notes(*notes: str) -> str:
+    """The non-empty notes, joined by ``; ``."""
     return "; ".join(n for n in notes if n)
 

@@ -12,11 +12,11 @@ import numpy as np
 from ..analysis.normal_form import criticality_of, hopf_lyapunov_coefficient
 from ..models import Model
 from ..results import Branch, Criticality, Origin, PointType, SpecialPoint
-from .branches import _joined
-from .periodic import _hopf_at
+from .branches import joined_notes
+from .periodic import hopf_at
 
 
-def _with_criticality(points: list[SpecialPoint], families: list[Branch],
+def with_criticality(points: list[SpecialPoint], families: list[Branch],
                       branches: list[Branch], width: float, scale: np.ndarray
                       ) -> list[SpecialPoint]:
     """Hopf points labelled supercritical or subcritical from the periodic family at them:
@@ -28,7 +28,7 @@ def _with_criticality(points: list[SpecialPoint], families: list[Branch],
         if len(family) < 3:
             continue
         for row, step in ((0, 1), (len(family) - 1, -1)):
-            k = _hopf_at(family, row, hopfs, width, scale) if row else next(
+            k = hopf_at(family, row, hopfs, width, scale) if row else next(
                 (i for i, h in enumerate(hopfs) if family.origin == Origin.at(h)), None)
             if k is not None and k not in sides:
                 sides[k] = _side(family.parameters[::step, 0], hopfs[k].parameters[0], width)
@@ -42,7 +42,7 @@ def _with_criticality(points: list[SpecialPoint], families: list[Branch],
                 from_family = (Criticality.SUPERCRITICAL if side == growth
                                else Criticality.SUBCRITICAL)
                 if point.criticality and point.criticality != from_family:
-                    point = replace(point, note=_joined(
+                    point = replace(point, note=joined_notes(
                         point.note, f"first Lyapunov coefficient says {point.criticality}"))
                 point = replace(point, criticality=from_family)
         labelled.append(point)
@@ -67,7 +67,7 @@ def with_lyapunov(model: Model, parameter: str, parameters: dict[str, float],
                   points: list[SpecialPoint]) -> list[SpecialPoint]:
     """Hopf points of equilibria with their first Lyapunov coefficient and, from its sign, a
     provisional criticality (a periodic family, when computed, has the last word: see
-    :func:`_with_criticality`)."""
+    :func:`with_criticality`)."""
     labelled = []
     for point in points:
         if point.point_type == PointType.HB:

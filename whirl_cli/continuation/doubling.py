@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from ..results import Branch, BranchKind, Origin, PointType, SpecialPoint
 from .engine import Engine, Numerics, RunSpec
-from .periodic import _collect, _continue, _end, _Family, periodic_constants
+from .periodic import FamilySide, collect, continue_families, end_of, periodic_constants
 
 #: Levels of a period-doubling cascade followed (period 2, 4, 8 times the first family's).
 MAX_DOUBLINGS = 3
@@ -35,9 +35,9 @@ def doubled_families(engine: Engine, name: str, parameter: str, bounds: tuple[fl
         starts = _starts(engine, name, parameter, bounds, numerics, level, current)
         if not starts:
             break
-        _continue(engine, starts, hopfs, width)
-        ended = [_end(f, model, hopfs, bounds, numerics, equilibria, parameters) for f in starts]
-        level, current = _collect(engine, name, bounds, parameters, hopfs,
+        continue_families(engine, starts, hopfs, width)
+        ended = [end_of(f, model, hopfs, bounds, numerics, equilibria, parameters) for f in starts]
+        level, current = collect(engine, name, bounds, parameters, hopfs,
                                   [(side.branch, side.blowups()) for side in ended],
                                   skip_first=True)
         kept += level
@@ -48,10 +48,10 @@ def doubled_families(engine: Engine, name: str, parameter: str, bounds: tuple[fl
 
 def _starts(engine: Engine, name: str, parameter: str, bounds: tuple[float, float],
             numerics: Numerics, families: list[Branch], points: list[SpecialPoint]
-            ) -> list[_Family]:
+            ) -> list[FamilySide]:
     """One family to continue from each of the PD ``points`` on one of ``families``."""
     by_name = {b.name: b for b in families}
-    starts: list[_Family] = []
+    starts: list[FamilySide] = []
     count: dict[str, int] = {}
     for point in points:
         branch = by_name.get(point.branch)
@@ -67,5 +67,5 @@ def _starts(engine: Engine, name: str, parameter: str, bounds: tuple[float, floa
         spec = RunSpec(f"{name}/{family}.0", constants, BranchKind.PERIODIC,
                        Origin.at(point), (parameter,),
                        restart=(engine.run_with_label(branch.runs, label), label))
-        starts.append(_Family(family, period, spec, []))
+        starts.append(FamilySide(family, period, spec, []))
     return starts

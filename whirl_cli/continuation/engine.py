@@ -1,7 +1,7 @@
 """The engine under every recipe: AUTO numerics, run specifications, runs made in parallel.
 
 An :class:`Engine` compiles a model's equations once and makes :class:`RunSpec` runs, each in
-its own directory, ``jobs`` at a time; :func:`_run_branches` and :func:`_read` read the branches
+its own directory, ``jobs`` at a time; :func:`run_branches` and :func:`read_run` read the branches
 they wrote (an empty branch with the run's status and message where a run failed).
 """
 
@@ -155,12 +155,12 @@ class Engine:
             for o in sorted(self.outcomes.values(), key=lambda o: str(o.workdir)))
 
 
-def _run_branches(engine: Engine, specs: list[RunSpec], branches: list[Branch],
+def run_branches(engine: Engine, specs: list[RunSpec], branches: list[Branch],
                   points: list[SpecialPoint], skip_first: bool) -> list[SpecialPoint]:
     """Run ``specs``, append their branches and special points; return the new points."""
     new_points: list[SpecialPoint] = []
     for spec, outcome in zip(specs, engine.run_many(specs), strict=True):
-        branch = _read(engine, spec, outcome)
+        branch = read_run(engine, spec, outcome)
         branches.append(branch)
         found = special_points(branch, skip_first=skip_first)
         points.extend(found)
@@ -184,7 +184,7 @@ def _failed_branch(model: Model, spec: RunSpec, outcome: runner.RunOutcome) -> B
         torus_angle=np.empty(0) if spec.kind == BranchKind.TORUS_LOCUS else None)
 
 
-def _read(engine: Engine, spec: RunSpec, outcome: runner.RunOutcome) -> Branch:
+def read_run(engine: Engine, spec: RunSpec, outcome: runner.RunOutcome) -> Branch:
     """The branch of one run, with why it ends (:func:`run_end`; recipes that know more, such
     as the periodic one, say more)."""
     if not outcome.has_output:

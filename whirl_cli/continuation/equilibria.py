@@ -19,8 +19,8 @@ from ..auto.constants import base_constants, par_layout
 from ..errors import WhirlError
 from ..models import Model
 from ..results import Branch, BranchKind, Origin, PointType, SpecialPoint
-from .branches import _same_point, typical_amplitudes
-from .engine import Engine, Numerics, RunSpec, _run_branches
+from .branches import same_point, typical_amplitudes
+from .engine import Engine, Numerics, RunSpec, run_branches
 
 #: How deep branch switching recurses (main -> secondary -> tertiary).
 MAX_SWITCH_DEPTH = 3
@@ -82,7 +82,7 @@ def equilibria(engine: Engine, name: str, parameter: str, start: float,
                        _start_line(model, state) if state.any() else None)
     branches: list[Branch] = []
     points: list[SpecialPoint] = []
-    frontier = _run_branches(engine, specs, branches, points, skip_first=False)
+    frontier = run_branches(engine, specs, branches, points, skip_first=False)
 
     # In a linear model a branch point carries a straight line of equilibria at a fixed
     # parameter value; AUTO's fold test fires all along it, so fold detection is switched off.
@@ -94,7 +94,7 @@ def equilibria(engine: Engine, name: str, parameter: str, start: float,
         todo = []
         for point in frontier:
             if point.point_type != PointType.BP or any(
-                    _same_point(point, done, width, amplitudes) for done in switched):
+                    same_point(point, done, width, amplitudes) for done in switched):
                 continue
             switched.append(point)
             source = _run_of(branches, point.branch)
@@ -108,8 +108,8 @@ def equilibria(engine: Engine, name: str, parameter: str, start: float,
                     BranchKind.EQUILIBRIUM,
                     Origin.at(point),
                     (parameter,), restart=(source, point.label)))
-        frontier = [p for p in _run_branches(engine, todo, branches, points, skip_first=True)
-                    if not any(_same_point(p, q, width, amplitudes) for q in switched)]
+        frontier = [p for p in run_branches(engine, todo, branches, points, skip_first=True)
+                    if not any(same_point(p, q, width, amplitudes) for q in switched)]
 
     if spread:
         also_from = (*also_from, *spread_equilibria(model, start_parameters,
@@ -121,7 +121,7 @@ def equilibria(engine: Engine, name: str, parameter: str, start: float,
         if on_branch(branches, start, state, width, amplitudes):
             continue
         found += 1
-        _run_branches(engine, _both_ways(
+        run_branches(engine, _both_ways(
             model, numerics, parameter, start, bounds, start_parameters,
             f"{name}/resting_{found}", f"equilibrium at {parameter} = {start:g} off every "
             "branch (a seed settled on it, or its mirror image)", _start_line(model, state)),
@@ -129,7 +129,7 @@ def equilibria(engine: Engine, name: str, parameter: str, start: float,
 
     unique: list[SpecialPoint] = []
     for point in points:
-        if not any(point.point_type == q.point_type and _same_point(point, q, width, amplitudes)
+        if not any(point.point_type == q.point_type and same_point(point, q, width, amplitudes)
                    for q in unique):
             unique.append(point)
     return branches, unique

@@ -10,16 +10,16 @@ from ..results import Branch, PointType, RunStatus
 from .branches import head
 
 
-def _chunk_used(curve: Branch, width: np.ndarray, bounds: dict[str, tuple[float, float]]
+def chunk_used(curve: Branch, width: np.ndarray, bounds: dict[str, tuple[float, float]]
                 ) -> bool:
     """True if a locus run stopped only because its chunk of steps was used up: it ended
     with status ok on a plain end point, not closed, not at the range edge."""
     if curve.status != RunStatus.OK or len(curve) < 2 or curve.point_type[-1] != PointType.EP:
         return False
-    return len(_closed(curve, width)) == len(curve) and not _at_range_edge(curve, bounds, width)
+    return len(cut_closed(curve, width)) == len(curve) and not at_range_edge(curve, bounds, width)
 
 
-def _at_range_edge(curve: Branch, bounds: dict[str, tuple[float, float]], width: np.ndarray
+def at_range_edge(curve: Branch, bounds: dict[str, tuple[float, float]], width: np.ndarray
                    ) -> bool:
     """True if the locus ends on the edge of the study's range (where UZSTOP stops it) or
     beyond it (AUTO locates no event in the first step after a restart, so a locus continued
@@ -29,12 +29,12 @@ def _at_range_edge(curve: Branch, bounds: dict[str, tuple[float, float]], width:
     return bool(np.any((last < edges[:, 0] + 1e-6 * width) | (last > edges[:, 1] - 1e-6 * width)))
 
 
-def _near_polyline(point: np.ndarray, curve: np.ndarray, width: np.ndarray,
+def near_polyline(point: np.ndarray, curve: np.ndarray, width: np.ndarray,
                    tolerance: float = 1e-3) -> bool:
     """True if ``point`` lies within ``tolerance`` of the polyline ``curve`` (K, >= 2), in
     axes scaled by the ranges ``width`` (Euclidean distance to the nearest segment)."""
     target = np.asarray(point[:2], dtype=float)[None] / width
-    return bool(_on_paths(target, [curve[:, :2] / width], tolerance)[0])
+    return bool(on_paths(target, [curve[:, :2] / width], tolerance)[0])
 
 
 def locus_coordinates(curve: Branch, width: np.ndarray, scale: np.ndarray) -> np.ndarray:
@@ -58,7 +58,7 @@ def extreme_scale(curves: list[Branch]) -> np.ndarray:
     return _spread(np.vstack([np.hstack([c.state_max, c.state_min]) for c in curves]))
 
 
-def _on_paths(points: np.ndarray, paths: list[np.ndarray], tolerance: float = 1e-3
+def on_paths(points: np.ndarray, paths: list[np.ndarray], tolerance: float = 1e-3
               ) -> np.ndarray:
     """(K,) True where a row of ``points`` (K, D) lies within ``tolerance`` (Euclidean) of a
     segment of one of the polylines ``paths`` (each (M, D), in the same coordinates).
@@ -96,7 +96,7 @@ def _on_paths(points: np.ndarray, paths: list[np.ndarray], tolerance: float = 1e
     return near
 
 
-def _merged(points: np.ndarray, others: list[np.ndarray], follow: int = 5) -> bool:
+def has_merged(points: np.ndarray, others: list[np.ndarray], follow: int = 5) -> bool:
     """True if a locus (``points`` in :func:`locus_coordinates`) has run onto one of the
     ``others``: its last ``follow`` points lie on them, after it had left its start by more
     than 0.02 of the ranges (near its start a locus lies on its twin traced the other way).
@@ -104,10 +104,10 @@ def _merged(points: np.ndarray, others: list[np.ndarray], follow: int = 5) -> bo
     if len(points) < follow + 1:
         return False
     left = np.abs(points[:, :2] - points[0, :2]).max(axis=1) > 0.02
-    return bool(left.any() and _on_paths(points[-follow:], others).all())
+    return bool(left.any() and on_paths(points[-follow:], others).all())
 
 
-def _closed(curve: Branch, width: np.ndarray, follow: int = 5) -> Branch:
+def cut_closed(curve: Branch, width: np.ndarray, follow: int = 5) -> Branch:
     """A locus cut where it first comes back to its start, or back onto its own earlier path
     and follows it the same way for ``follow`` more points: AUTO goes round a closed locus
     until its step limit, also one it has run onto from elsewhere. Coming back means within

@@ -13,7 +13,7 @@ from ..auto.constants import base_constants
 from ..auto.parse import parse_b
 from ..models import Model
 from ..results import Branch, BranchKind, LocateStatus, Origin, SpecialPoint
-from .branches import _joined, typical_amplitudes
+from .branches import joined_notes, typical_amplitudes
 from .engine import Engine, RunSpec
 
 #: HomCont: a homoclinic orbit counts as located when the principal parameter varies by less
@@ -59,7 +59,7 @@ def locate_homoclinics(engine: Engine, name: str, ends: list[tuple[Branch, Speci
                                   f"{side + 1 if side else ''}", family, point, bounds,
                                   parameters)
         if isinstance(planned, str):
-            points[k] = replace(point, note=_joined(point.note, planned))
+            points[k] = replace(point, note=joined_notes(point.note, planned))
         else:
             runs.append((k, planned))
     outcomes = engine.run_many([spec for _, spec in runs])
@@ -110,18 +110,20 @@ def _homoclinic_verdict(outcome: runner.RunOutcome, point: SpecialPoint, paramet
             values = np.concatenate([s.column(parameter) for s in segments])
             periods = np.concatenate([s.column("PERIOD") for s in segments])
     if len(values) < 5:
-        return replace(point, note=_joined(
+        return replace(point, note=joined_notes(
             point.note, f"HomCont (IPS=9) did not converge ({outcome.status}: "
             f"{outcome.message})"))
     tail = values[len(values) // 2:]
     spread = float(np.ptp(tail))
     if spread > HOMOCLINIC_SPREAD * width:
-        return replace(point, note=_joined(
+        return replace(point, note=joined_notes(
             point.note, f"HomCont (IPS=9): {parameter} did not settle (spread {spread:.2g} "
             f"over {len(tail)} points)"))
     value = float(values[-1])
     span = periods[len(values) // 2:] / time_scale
-    return replace(point, parameters=np.array([value]), status=LocateStatus.LOCATED, note=_joined(
-        point.note, f"located by HomCont (IPS=9): {parameter} = {value:.10g}, spread "
-        f"{spread:.2g} while the truncation period runs {span.min():.4g}-{span.max():.4g} s"))
+    return replace(point, parameters=np.array([value]), status=LocateStatus.LOCATED,
+                   note=joined_notes(point.note, (
+                       f"located by HomCont (IPS=9): {parameter} = {value:.10g}, spread "
+                       f"{spread:.2g} while the truncation period runs "
+                       f"{span.min():.4g}-{span.max():.4g} s")))
 

@@ -27,18 +27,18 @@ from ..results import (
     slice_branch,
 )
 from ..runtime import thread_map
-from .branches import _same_point, head, join, special_points, typical_amplitudes
-from .engine import Engine, Numerics, RunSpec, _read
+from .branches import head, join, same_point, special_points, typical_amplitudes
+from .engine import Engine, Numerics, RunSpec, read_run
 from .equilibria import equilibrium_constants
 from .geometry import (
-    _at_range_edge,
-    _chunk_used,
-    _closed,
-    _merged,
-    _near_polyline,
-    _on_paths,
+    at_range_edge,
+    chunk_used,
+    cut_closed,
     extreme_scale,
+    has_merged,
     locus_coordinates,
+    near_polyline,
+    on_paths,
 )
 from .one_parameter import one_parameter
 from .periodic import OrbitStart
@@ -119,7 +119,7 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
             width = bounds[first][1] - bounds[first][0]
             if point.point_type in wanted and _starts_locus(point) and not any(
                     point.point_type == other.point_type
-                    and _same_point(named, other, width, amplitudes)
+                    and same_point(named, other, width, amplitudes)
                     for other, _ in starts):
                 starts.append((named, runs[point.branch]))
     curves = _loci(engine, name, pair, bounds, numerics, starts,
@@ -168,7 +168,7 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
     def todo(wave: list, also: list[tuple[int, Branch]] = ()
              ) -> list[tuple[int, SpecialPoint, str]]:
         distinct = _without_twins([(k, point, runs) for k, point, runs in wave if not any(
-            kind == point.point_type and _near_polyline(point.parameters[:2], curve.parameters,
+            kind == point.point_type and near_polyline(point.parameters[:2], curve.parameters,
                                                         width)
             for kind, curve in [*curves, *also])], width)
         return _outermost_folds(distinct, width) if outermost else distinct
@@ -290,9 +290,9 @@ def _distinct(curves: dict[int, tuple[int, RunSpec | None, Branch]],
     those lying wholly (every point within 1e-3 of the ranges) on the ``known`` loci and the
     other kept ones of their type, later ones dropped first (a mirror image, or a locus drawn
     within a line's width of others, adds nothing to the picture); and the indices of the
-    kept loci that have run onto another of their type (:func:`_merged`, where orbits are
+    kept loci that have run onto another of their type (:func:`has_merged`, where orbits are
     compared too: continued, they would retrace it)."""
-    closed = {k: (kind, spec, _closed(curve, width)) for k, (kind, spec, curve) in curves.items()
+    closed = {k: (kind, spec, cut_closed(curve, width)) for k, (kind, spec, curve) in curves.items()
               if len(curve)}
     kept = set(closed)
 
@@ -304,7 +304,7 @@ def _distinct(curves: dict[int, tuple[int, RunSpec | None, Branch]],
     plane = {k: c.parameters[:, :2] / width for k, (_, _, c) in closed.items()}
     known_plane = [(kind, c.parameters[:, :2] / width) for kind, c in known if len(c)]
     for k in sorted(closed, reverse=True):
-        if _on_paths(plane[k], others(k, plane, known_plane)).all():
+        if on_paths(plane[k], others(k, plane, known_plane)).all():
             kept.discard(k)
     merged = set()
     for kind in {closed[k][0] for k in kept}:
@@ -315,7 +315,7 @@ def _distinct(curves: dict[int, tuple[int, RunSpec | None, Branch]],
                 if closed[k][0] == kind}
         known_full = [(kind, locus_coordinates(c, width, scale)) for other, c in known
                       if other == kind and len(c)]
-        merged |= {k for k in full if _merged(full[k], others(k, full, known_full))}
+        merged |= {k for k in full if has_merged(full[k], others(k, full, known_full))}
     return {k: closed[k] for k in sorted(kept)}, merged
 
 
@@ -354,7 +354,7 @@ def _trace(engine: Engine, name: str, pair: tuple[str, str],
     final += [(k, kind, spec, outcome) for (k, kind, spec), outcome in zip(
         second_stage, engine.run_many([spec for _, _, spec in second_stage], background),
         strict=True)]
-    return [(k, kind, spec, _read(engine, spec, outcome)) for k, kind, spec, outcome in final]
+    return [(k, kind, spec, read_run(engine, spec, outcome)) for k, kind, spec, outcome in final]
 
 
 #: Loci of cycles (fold of cycles, torus) go FIRST_CHUNK steps, then LOCUS_CHUNK steps at a
@@ -391,18 +391,18 @@ def _grown(engine: Engine, traced: dict[int, tuple[int, RunSpec, Branch]],
                             restart=(curve.runs[-1], int(curve.label[-1])))
                  for k, (_, spec, curve) in kept.items()
                  if k not in cut | stalled and spec.kind in CHUNKED
-                 and _chunk_used(curve, width, bounds) and len(curve) < numerics.max_steps
+                 and chunk_used(curve, width, bounds) and len(curve) < numerics.max_steps
                  and curve.label[-1]}
         if not again:
             return kept, set(kept) - cut
         grown = dict(kept)
         for (k, spec), outcome in zip(again.items(), engine.run_many(list(again.values())),
                                       strict=True):
-            extra = _read(engine, spec, outcome)
+            extra = read_run(engine, spec, outcome)
             kind, last, curve = kept[k]
             if len(extra) > 1:
                 grown[k] = (kind, last, join(curve, extra, curve.name))
-            if len(extra) <= 1 or _on_paths(extra.parameters[1:, :2] / width,
+            if len(extra) <= 1 or on_paths(extra.parameters[1:, :2] / width,
                                             [curve.parameters[:, :2] / width]).all():
                 stalled.add(k)
         chunk += 1
@@ -434,7 +434,7 @@ def _retried(engine: Engine, loci: dict[int, tuple[int, RunSpec, Branch]], numer
         where.append((k, row))
     done: dict[int, tuple[int, RunSpec, Branch]] = {}
     for spec, (k, row), outcome in zip(again, where, engine.run_many(again), strict=True):
-        extra = _read(engine, spec, outcome)
+        extra = read_run(engine, spec, outcome)
         kind, _, curve = loci[k]
         if len(extra):
             done[k] = (kind, spec, join(head(curve, row + 1), extra, curve.name))
@@ -479,7 +479,7 @@ def _locus_end(curve: Branch, codim2: list[SpecialPoint], bounds: dict[str, tupl
     natural end, not a failure), its study's step limit (``max_steps`` points), or a chunk
     of steps after which whirl did not continue it (:func:`_grown`)."""
     last = curve.parameters[-1, :2]
-    if _at_range_edge(curve, bounds, width):
+    if at_range_edge(curve, bounds, width):
         return replace(curve, end="range")
     if len(curve) > 2 and np.abs((last - curve.parameters[0, :2]) / width).max() < 0.005:
         if not _other_orbit(curve):

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..models import Model
 from ..results import Branch, Origin, PointType, SpecialPoint
-from .branches import _joined, typical_amplitudes
+from .branches import joined_notes, typical_amplitudes
 
 #: Mirror Hopf points agree to this fraction of the range in the parameter, this many typical
 #: amplitudes (or relatively) in the state and relatively in the period.
@@ -68,7 +68,7 @@ def mirrored_branch(branch: Branch, name: str, origin: Origin, end: str) -> Bran
     says."""
     return replace(branch, name=name, origin=origin, end=end,
                    state_max=-branch.state_min, state_min=-branch.state_max,
-                   message=_joined(branch.message, f"mirror image (y -> -y) of {branch.name}"),
+                   message=joined_notes(branch.message, f"mirror image (y -> -y) of {branch.name}"),
                    orbits=tuple(replace(o, states=-o.states) for o in branch.orbits))
 
 

@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..results import ContinuationKind, ContinuationResult
-from .criticality import _with_criticality, with_lyapunov
+from .criticality import with_criticality, with_lyapunov
 from .doubling import doubled_families
 from .engine import Engine, Numerics
 from .equilibria import equilibria, is_linear
@@ -44,7 +44,7 @@ def one_parameter(engine: Engine, name: str, parameter: str, start: float,
         families, family_points = periodic_families(engine, name, parameter, bounds, numerics,
                                                      branches, points, parameters)
         branches += families
-        points = _with_criticality(points, families, branches, bounds[1] - bounds[0],
+        points = with_criticality(points, families, branches, bounds[1] - bounds[0],
                                    np.asarray(engine.model.state_scale, dtype=float)) \
             + family_points
     if start_orbits:

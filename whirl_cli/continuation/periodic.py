@@ -29,7 +29,7 @@ from ..results import (
 )
 from ..runtime import thread_map
 from .branches import amplitude, head, join, reverse, special_points
-from .engine import Engine, Numerics, RunSpec, _read
+from .engine import Engine, Numerics, RunSpec, read_run
 from .equilibria import equilibrium_constants
 from .homoclinic import locate_homoclinics
 from .mirror import mirror_sources, mirrored_branch, mirrored_point
@@ -82,7 +82,7 @@ class OrbitStart:
 
 
 @dataclass
-class _Family:
+class FamilySide:
     """One side of a periodic family being continued, and its branch pieces so far.
 
     ``name``: its branch name; ``period``: its reference period (s), the Hopf period or the
@@ -118,7 +118,7 @@ def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
     hopfs = [p for p in points if p.point_type == PointType.HB]
     sources = mirror_sources(model, hopfs, width, parameters)
     runs = {b.name: b.runs[-1] for b in equilibria}
-    families: dict[int, _Family] = {}
+    families: dict[int, FamilySide] = {}
     for k, hopf in enumerate(hopfs):
         if k in sources:
             continue
@@ -127,9 +127,9 @@ def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
         constants["UZSTOP"][AMPLITUDE] = GROWN_AMPLITUDE
         spec = RunSpec(f"{name}/periodic_{k + 1}.0", constants, BranchKind.PERIODIC,
                        _hopf_origin(hopf), (parameter,), restart=(runs[hopf.branch], hopf.label))
-        families[k] = _Family(f"periodic_{k + 1}", hopf.period, spec, [], hopf=k, grows=True)
+        families[k] = FamilySide(f"periodic_{k + 1}", hopf.period, spec, [], hopf=k, grows=True)
 
-    _continue(engine, list(families.values()), hopfs, width)
+    continue_families(engine, list(families.values()), hopfs, width)
     # On too coarse a mesh AUTO can turn back along a family of long orbits and retrace it to
     # its own Hopf point (combined case 5 at 40 mesh intervals): such families are computed
     # once more on a finer mesh, kept if they then do not come back
@@ -137,24 +137,24 @@ def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
         f.spec, name=f"{name}/{f.name}m.0",
         constants=dict(f.spec.constants, NTST=RETRACE_MESH_FACTOR * f.spec.constants["NTST"])))
         for f in families.values() if _back_at_own_hopf(f, hopfs, width, scale)]
-    _continue(engine, again, hopfs, width)
+    continue_families(engine, again, hopfs, width)
     for family in again:
         if not _back_at_own_hopf(family, hopfs, width, scale):
             families[family.hopf] = family
 
     image = {**sources, **{j: k for k, j in sources.items()}}
-    ended: dict[int, _Ended] = {}
+    ended: dict[int, Ended] = {}
     reached: set[int] = set()
     for k in range(len(hopfs)):
         if k in reached or (k in sources and sources[k] not in ended):
             continue  # the same family, already reached from another Hopf point (or its image)
         side = _mirrored(ended[sources[k]], k, hopfs, image) if k in sources else \
-            _end(families[k], model, hopfs, bounds, numerics, equilibria, parameters)
+            end_of(families[k], model, hopfs, bounds, numerics, equilibria, parameters)
         if side.returned_to is not None:  # and the image of the family, to the image point
             reached |= {side.returned_to} | ({image.get(side.returned_to, side.returned_to)}
                                              if k in image else set())
         ended[k] = side
-    kept, found = _collect(engine, name, bounds, parameters, hopfs,
+    kept, found = collect(engine, name, bounds, parameters, hopfs,
                            [(side.branch, side.blowups()) for k, side in ended.items()
                             if k not in sources], skip_first=True)
     for k in sorted(set(ended) & set(sources)):
@@ -171,15 +171,15 @@ def _hopf_origin(hopf: SpecialPoint) -> Origin:
     return Origin.at(hopf)
 
 
-def _mirrored(side: _Ended, k: int, hopfs: list[SpecialPoint], image: dict[int, int]
-              ) -> _Ended:
+def _mirrored(side: Ended, k: int, hopfs: list[SpecialPoint], image: dict[int, int]
+              ) -> Ended:
     """The family of Hopf point ``k``, the mirror image of ``side`` (that of k's image)."""
     returned = None if side.returned_to is None else image.get(side.returned_to,
                                                                side.returned_to)
     end = side.branch.end if returned is None else \
         _return_end(side.branch.parameter_names[0], hopfs, returned, own=returned == k)
     branch = mirrored_branch(side.branch, f"periodic_{k + 1}", _hopf_origin(hopfs[k]), end)
-    return _Ended(branch, None, returned)
+    return Ended(branch, None, returned)
 
 
 def _return_end(parameter: str, hopfs: list[SpecialPoint], returned: int, own: bool) -> str:
@@ -213,14 +213,14 @@ def orbit_families(engine: Engine, name: str, parameter: str, bounds: tuple[floa
                                 "PERIOD": period_tau}
             spec = RunSpec(f"{name}/periodic_o{k}{tag}.0", constants, BranchKind.PERIODIC,
                            start.origin, (parameter,), data=orbit_data(model, start.orbit))
-            sides.append(_Family(f"periodic_o{k}", start.orbit.period, spec, []))
-    _continue(engine, sides, hopfs, width)
+            sides.append(FamilySide(f"periodic_o{k}", start.orbit.period, spec, []))
+    continue_families(engine, sides, hopfs, width)
     families = []
     for first, second in zip(sides[::2], sides[1::2], strict=True):
-        a, b = (_end(side, model, hopfs, bounds, numerics, equilibria, parameters)
+        a, b = (end_of(side, model, hopfs, bounds, numerics, equilibria, parameters)
                 for side in (first, second))
         families.append((_two_sided(a.branch, b.branch), a.blowups() + b.blowups()))
-    return _collect(engine, name, bounds, parameters, hopfs, families, skip_first=False)
+    return collect(engine, name, bounds, parameters, hopfs, families, skip_first=False)
 
 
 def _two_sided(a: Branch, b: Branch) -> Branch:
@@ -235,7 +235,7 @@ def _two_sided(a: Branch, b: Branch) -> Branch:
 
 
 @dataclass(frozen=True)
-class _Ended:
+class Ended:
     """One side of a family, assembled: its branch (``end`` set), the global bifurcation its
     period blows up at (if so) and the index of the Hopf point it returns to (if so)."""
 
@@ -248,8 +248,8 @@ class _Ended:
         return [] if self.global_point is None else [(self.global_point, self.branch)]
 
 
-def _end(family: _Family, model: Model, hopfs: list[SpecialPoint], bounds: tuple[float, float],
-         numerics: Numerics, equilibria: list[Branch], parameters: dict[str, float]) -> _Ended:
+def end_of(family: FamilySide, model: Model, hopfs: list[SpecialPoint], bounds: tuple[float, float],
+         numerics: Numerics, equilibria: list[Branch], parameters: dict[str, float]) -> Ended:
     """Assemble ``family``'s pieces and say how it ends: a Hopf point, a period blow-up (a
     bracketed global bifurcation; never for a family that ends on a Hopf point, whose period
     is that point's), the range, ..."""
@@ -264,10 +264,10 @@ def _end(family: _Family, model: Model, hopfs: list[SpecialPoint], bounds: tuple
         if whole.status == RunStatus.MX:  # AUTO's expected failure right at the blow-up
             whole = replace(whole, status=RunStatus.OK, message="ended with MX at the period "
                             "blow-up (expected near a global bifurcation)")
-    return _Ended(replace(whole, end=end), global_point, returned_to)
+    return Ended(replace(whole, end=end), global_point, returned_to)
 
 
-def _collect(engine: Engine, name: str, bounds: tuple[float, float],
+def collect(engine: Engine, name: str, bounds: tuple[float, float],
              parameters: dict[str, float], hopfs: list[SpecialPoint],
              families: list[tuple[Branch, list[tuple[SpecialPoint, Branch]]]],
              skip_first: bool) -> tuple[list[Branch], list[SpecialPoint]]:
@@ -289,7 +289,7 @@ def _collect(engine: Engine, name: str, bounds: tuple[float, float],
         kept.append(whole)
         small = amplitude(whole, model) < HOPF_RETURN_AMPLITUDE
         found += [p for p in special_points(whole, skip_first=skip_first)
-                  if not small[p.index] and _hopf_at(whole, p.index, hopfs, width, scale) is None]
+                  if not small[p.index] and hopf_at(whole, p.index, hopfs, width, scale) is None]
     for row, point in zip([row for row, _ in homoclinic], locate_homoclinics(
             engine, name, [(side, found[row]) for row, side in homoclinic], bounds,
             parameters), strict=True):
@@ -309,30 +309,30 @@ def orbit_data(model: Model, orbit: Orbit) -> str:
     return "".join(" ".join(f"{x:.12g}" for x in row) + "\n" for row in rows)
 
 
-def _continue(engine: Engine, families: list[_Family], hopfs: list[SpecialPoint],
+def continue_families(engine: Engine, families: list[FamilySide], hopfs: list[SpecialPoint],
               width: float) -> None:
     """Run every family's segments: each family's one after another (a segment starts where
     the last one ended), the families side by side, each as soon as its last segment is read
     (no family waits for another's; the engine runs at most its ``jobs`` at once)."""
-    def grow(family: _Family) -> None:
+    def grow(family: FamilySide) -> None:
         spec = family.spec
         while spec is not None:
             outcome, = engine.run_many([spec])
-            family.pieces.append(_read(engine, spec, outcome))
+            family.pieces.append(read_run(engine, spec, outcome))
             spec = _next_segment(family, engine.model, hopfs, width)
 
     thread_map(grow, families, len(families))
 
 
-def _back_at_own_hopf(family: _Family, hopfs: list[SpecialPoint], width: float,
+def _back_at_own_hopf(family: FamilySide, hopfs: list[SpecialPoint], width: float,
                       scale: np.ndarray) -> bool:
     """True if the family, grown, has come back onto the Hopf point it started from."""
     whole = _assemble(family, hopfs, width, scale)
-    return len(whole) > 3 and _hopf_at(whole, len(whole) - 1, hopfs, width,
+    return len(whole) > 3 and hopf_at(whole, len(whole) - 1, hopfs, width,
                                        scale) == family.hopf
 
 
-def _assemble(family: _Family, hopfs: list[SpecialPoint], width: float,
+def _assemble(family: FamilySide, hopfs: list[SpecialPoint], width: float,
               scale: np.ndarray) -> Branch:
     """One branch from a family's pieces, cut after the first point beyond the period cap
     (AUTO can step over that stop while it locates a fold there) or the first return to a
@@ -340,7 +340,7 @@ def _assemble(family: _Family, hopfs: list[SpecialPoint], width: float,
     return _assembled(family, hopfs, width, scale)[0]
 
 
-def _assembled(family: _Family, hopfs: list[SpecialPoint], width: float,
+def _assembled(family: FamilySide, hopfs: list[SpecialPoint], width: float,
                scale: np.ndarray) -> tuple[Branch, int | None]:
     """:func:`_assemble`, and the index of the Hopf point the family first returns to (judged
     on the whole of its pieces, where the family's size is that of all of it), if any."""
@@ -354,7 +354,7 @@ def _assembled(family: _Family, hopfs: list[SpecialPoint], width: float,
     returned_to = None
     if returned is not None:
         ends.append(returned)
-        returned_to = _hopf_at(whole, returned, hopfs, width, scale)
+        returned_to = hopf_at(whole, returned, hopfs, width, scale)
     if ends and min(ends) + 1 < len(whole):
         if returned is not None and min(ends) < returned:
             returned_to = None  # the period cap came first
@@ -373,12 +373,12 @@ def _first_return(branch: Branch, hopfs: list[SpecialPoint], width: float,
     if not len(grown):
         return None
     for row in range(int(grown[0]), len(branch)):
-        if _hopf_at(branch, row, hopfs, width, scale) is not None:
+        if hopf_at(branch, row, hopfs, width, scale) is not None:
             return row
     return None
 
 
-def _hopf_at(branch: Branch, row: int, hopfs: list[SpecialPoint], width: float,
+def hopf_at(branch: Branch, row: int, hopfs: list[SpecialPoint], width: float,
              scale: np.ndarray) -> int | None:
     """Index of the Hopf point the orbit at ``row`` has shrunk onto, if any: a small orbit
     (in AUTO's non-dimensional units, ``scale`` = the model's state scale) centred on that Hopf
@@ -394,7 +394,7 @@ def _hopf_at(branch: Branch, row: int, hopfs: list[SpecialPoint], width: float,
     return None
 
 
-def _next_segment(family: _Family, model: Model, hopfs: list[SpecialPoint],
+def _next_segment(family: FamilySide, model: Model, hopfs: list[SpecialPoint],
                   width: float) -> RunSpec | None:
     """The run continuing ``family`` after its last piece, or None if the family has ended."""
     piece = family.pieces[-1]
@@ -411,7 +411,7 @@ def _next_segment(family: _Family, model: Model, hopfs: list[SpecialPoint],
             return None
     elif last != PointType.LPC or \
             _first_return(piece, hopfs, width, scale, family.grows) is not None or \
-            _hopf_at(piece, len(piece) - 1, hopfs, width, scale) is not None:
+            hopf_at(piece, len(piece) - 1, hopfs, width, scale) is not None:
         return None  # an end (range, amplitude, period, steps) or back at a Hopf point
     if global_bifurcations.in_blowup(piece, family.period) and \
             global_bifurcations.blowup_turns(*_columns(family), family.period) \
@@ -422,7 +422,7 @@ def _next_segment(family: _Family, model: Model, hopfs: list[SpecialPoint],
                    restart=(piece.runs[-1], int(piece.label[-1])), data=None)
 
 
-def _segment_constants(family: _Family, **changes) -> dict:
+def _segment_constants(family: FamilySide, **changes) -> dict:
     """Constants of a run that continues ``family`` from a labelled point of its last piece:
     its first run's (the sign of DS with them: AUTO goes on in the direction the restart
     point was reached), to the next fold of cycles, without a Hopf start's amplitude stop, an
@@ -435,14 +435,14 @@ def _segment_constants(family: _Family, **changes) -> dict:
     return constants
 
 
-def _columns(family: _Family) -> tuple[np.ndarray, np.ndarray]:
+def _columns(family: FamilySide) -> tuple[np.ndarray, np.ndarray]:
     """(principal parameter, period) along the family's pieces so far (a restart repeats the
     point it starts from: a zero step, which counts as no turn)."""
     return (np.concatenate([p.parameters[:, 0] for p in family.pieces]),
             np.concatenate([p.period for p in family.pieces]))
 
 
-def _retry(family: _Family, piece: Branch) -> RunSpec | None:
+def _retry(family: FamilySide, piece: Branch) -> RunSpec | None:
     """After MX (no convergence): restart from the last good labelled point of the piece with
     twice the mesh intervals and half the largest step; the piece is cut back to that point."""
     labelled = [k for k in np.flatnonzero(piece.label) if piece.point_type[k] != PointType.MX]
@@ -464,7 +464,7 @@ def _retry(family: _Family, piece: Branch) -> RunSpec | None:
 
 def _periodic_end(family: Branch, model: Model, hopfs: list[SpecialPoint],
                   bounds: tuple[float, float], numerics: Numerics,
-                  state: _Family, returned_to: int | None = None) -> tuple[str, int | None]:
+                  state: FamilySide, returned_to: int | None = None) -> tuple[str, int | None]:
     """Why a periodic family ends, and the index of the Hopf point it returns to (if so;
     ``returned_to``: the one :func:`_assembled` found, if its last point does not say)."""
     if not len(family):
@@ -472,7 +472,7 @@ def _periodic_end(family: Branch, model: Model, hopfs: list[SpecialPoint],
     width = bounds[1] - bounds[0]
     scale = np.asarray(model.state_scale, dtype=float)
     value = family.parameters[-1, 0]
-    returned = _hopf_at(family, len(family) - 1, hopfs, width, scale) if len(family) > 3 else None
+    returned = hopf_at(family, len(family) - 1, hopfs, width, scale) if len(family) > 3 else None
     if returned is None:
         returned = returned_to
     if returned is not None:

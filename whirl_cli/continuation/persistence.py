@@ -17,7 +17,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..results import ContinuationResult, PointType, SpecialPoint
-from .branches import _joined
+from .branches import joined_notes
 
 #: The smoothing widths the continuation is repeated at, as fractions of the study's.
 FACTORS = (0.5, 0.25)
@@ -73,7 +73,7 @@ def _annotated(point: SpecialPoint, refined: list[ContinuationResult], width: fl
         why = f"smoothing artefact: moves by {moved:.3g} as epsilon shrinks"
     else:
         why = ""
-    return replace(point, refined=values, artefact=artefact, note=_joined(point.note, why),
+    return replace(point, refined=values, artefact=artefact, note=joined_notes(point.note, why),
                    refined_by=method)
 
 

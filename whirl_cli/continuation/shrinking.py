@@ -33,7 +33,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..results import BranchKind, ContinuationResult, Origin, PointType, SpecialPoint
-from .engine import Engine, Numerics, RunSpec, _read
+from .engine import Engine, Numerics, RunSpec, read_run
 from .loci import locus_constants
 
 #: AUTO's STOP code for the first point of each type a restart looks for.
@@ -118,7 +118,7 @@ def _restart_spec(engine: Engine, name: str, k: int, j: int, point: SpecialPoint
     """The short run from the label before ``point`` in ``source`` at ``factor`` times the
     smoothing, or None (no earlier label in that run)."""
     spec = engine.specs[source]
-    run = _read(engine, spec, engine.outcomes[source])
+    run = read_run(engine, spec, engine.outcomes[source])
     rows = np.flatnonzero(run.label == point.label)
     labelled = [r for r in np.flatnonzero(run.label) if rows.size and r < rows[0]]
     if not labelled:
@@ -148,7 +148,7 @@ def _restarted(engine: Engine, name: str, points: dict[int, SpecialPoint],
             specs += [(k, spec) for spec in made]
     values: dict[int, list[float]] = {}
     for (k, spec), outcome in zip(specs, engine.run_many([s for _, s in specs]), strict=True):
-        branch = _read(engine, spec, outcome)
+        branch = read_run(engine, spec, outcome)
         same = [r for r in range(1, len(branch))
                 if branch.point_type[r] == points[k].point_type]
         values.setdefault(k, []).append(float(branch.parameters[same[0], 0]) if same
@@ -195,7 +195,7 @@ def _by_locus(engine: Engine, name: str, folds: dict[int, SpecialPoint],
     values: dict[int, np.ndarray] = {}
     for (k, spec), outcome in zip(second, engine.run_many([s for _, s in second]),
                                   strict=True):
-        crossed = _crossings(_read(engine, spec, outcome), value, factors)
+        crossed = _crossings(read_run(engine, spec, outcome), value, factors)
         known = values.get(k, crossed)
         values[k] = np.where(np.isnan(known), crossed, known)  # either side's crossings
     return {k: Recomputed(v, LOCUS) for k, v in values.items() if np.all(np.isfinite(v))}

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..output.store import _lyapunov_unit
+from ..output.store import lyapunov_unit
 from ..results import Branch, BranchKind, ContinuationResult, LinearSweep, PointType, StudyResult
 from ..units import axis_label
 
@@ -160,7 +160,7 @@ def special_point_table(continuation: ContinuationResult) -> Table:
         column("bracket", float, ("special_point", "bound"), principal,
                "bracket of the principal parameter", "bracket {label}"),
         column("residual", float, unit="1", long_name="relative fit residual"),
-        column("lyapunov", float, unit=_lyapunov_unit(states.units) if first else "",
+        column("lyapunov", float, unit=lyapunov_unit(states.units) if first else "",
                long_name="first Lyapunov coefficient"),
         column("refined", float, ("special_point", "refinement"), principal,
                "principal parameter with the smoothing halved and quartered",

@@ -28,20 +28,20 @@ from pydantic import (
     model_validator,
 )
 
-from ..plots.kinds import overlay_kinds, panel_kinds
-from ..study import load_yaml_file
-from ..study.schema import (
+from ..documents.values import (
     Boolean,
     Integer,
     Number,
     Range,
+    Strict,
     Text,
-    _as_number,
-    _at_most_orbits,
-    _bound,
-    _fail,
-    _Strict,
+    as_number,
+    at_most_orbits,
+    bound,
+    fail,
 )
+from ..plots.kinds import overlay_kinds, panel_kinds
+from ..study import load_yaml_file
 from .numbers import POINTS
 
 PanelKind = Literal[panel_kinds()]  # the kinds plots.panels.draw draws
@@ -62,23 +62,23 @@ _MAX_CUTS = 8
 
 def _at_most_cuts(value: tuple) -> tuple:
     if not 1 <= len(value) <= _MAX_CUTS:
-        _fail(f"expected 1 to {_MAX_CUTS} values, got {len(value)}")
+        fail(f"expected 1 to {_MAX_CUTS} values, got {len(value)}")
     return value
 
 
 def _as_figure(value: str) -> str:
     if not _FIGURE_RE.fullmatch(value):
-        _fail("expected a figure number such as 3.14, got {got}")
+        fail("expected a figure number such as 3.14, got {got}")
     return value
 
 
 def _as_inches(value: Any) -> float:
     """A finite width or height within :data:`INCHES`."""
-    number = _as_number(value)
+    number = as_number(value)
     low, high = INCHES
     if not low <= number <= high:
         hint = " (the size is in inches, not pixels)" if number > high else ""
-        _fail(f"expected inches, {low:g} to {high:g}, got {{got}}{hint}")
+        fail(f"expected inches, {low:g} to {high:g}, got {{got}}{hint}")
     return number
 
 
@@ -86,15 +86,15 @@ def _panel_count(value: Any) -> Any:
     """A list of 1 to _MAX_PANELS panels (counted before the panels are checked, so that a
     bad panel is reported alone)."""
     if isinstance(value, list) and not 1 <= len(value) <= _MAX_PANELS:
-        _fail(f"expected 1 to {_MAX_PANELS} panels, got {len(value)}")
+        fail(f"expected 1 to {_MAX_PANELS} panels, got {len(value)}")
     return value
 
 
 Inches = Annotated[float, BeforeValidator(_as_inches)]
-Count = Annotated[Integer, _bound(">=", 1), _bound("<=", _MAX_PANELS)]
+Count = Annotated[Integer, bound(">=", 1), bound("<=", _MAX_PANELS)]
 
 
-class Member(_Strict):
+class Member(Strict):
     """One result of an overlay."""
 
     study: Text = Field(description="Study file, relative to the sheet's folder.")
@@ -102,7 +102,7 @@ class Member(_Strict):
         None, description="Legend label; unset: the parameters that differ between the members.")
 
 
-class PanelSpec(_Strict):
+class PanelSpec(Strict):
     """One panel: a plot kind of one study's result, or of several overlaid."""
 
     kind: PanelKind = Field(description="Plot kind drawn in the panel.")
@@ -115,10 +115,10 @@ class PanelSpec(_Strict):
     branch: Text | None = Field(None, description="Periodic branch of a `phase` panel.")
     state: Text | None = Field(None, description="State drawn; unset: the model's first dof.")
     sweep: Text | None = Field(None, description="Parameter of the linear sweep drawn.")
-    slice: Annotated[Integer, _bound(">=", 0)] | None = Field(
+    slice: Annotated[Integer, bound(">=", 0)] | None = Field(
         None, description="Boundary slice of an `overhang` panel, from 0.")
-    orbits: Annotated[tuple[Annotated[Integer, _bound(">=", 1)], ...],
-                      AfterValidator(_at_most_orbits)] | None = Field(
+    orbits: Annotated[tuple[Annotated[Integer, bound(">=", 1)], ...],
+                      AfterValidator(at_most_orbits)] | None = Field(
         None, description="AUTO labels (>= 1) of the orbits a `phase` panel draws.")
     simulation: Text | None = Field(
         None, description="Simulation of a `time_history` or `hub_path` panel; unset: the first.")
@@ -131,14 +131,14 @@ class PanelSpec(_Strict):
     @model_validator(mode="after")
     def _one_source(self) -> PanelSpec:
         if (self.study is None) == (not self.overlay):
-            _fail("give exactly one of `study` and `overlay`")
+            fail("give exactly one of `study` and `overlay`")
         if self.overlay and self.kind not in overlay_kinds():
             kinds = ", ".join(overlay_kinds()[:-1]) + f" and {overlay_kinds()[-1]}"
-            _fail(f"only {kinds} panels can be overlaid")
+            fail(f"only {kinds} panels can be overlaid")
         return self
 
 
-class ThesisNumber(_Strict):
+class ThesisNumber(Strict):
     """A number the thesis gives for the figure, and the special point of a study's result
     that is whirl's (for the index's table)."""
 
@@ -160,9 +160,9 @@ class ThesisNumber(_Strict):
     @model_validator(mode="after")
     def _one_value(self) -> ThesisNumber:
         if self.value is not None and self.between is not None:
-            _fail("give at most one of `value` and `between`")
+            fail("give at most one of `value` and `between`")
         if self.value is None and self.between is None and self.near is None:
-            _fail("give `near` (where whirl's point lies) when the thesis's value is unset")
+            fail("give `near` (where whirl's point lies) when the thesis's value is unset")
         return self
 
     @property
@@ -174,7 +174,7 @@ class ThesisNumber(_Strict):
         return self.value if self.value is not None else sum(self.between) / 2
 
 
-class Sheet(_Strict):
+class Sheet(Strict):
     """One figure of a sheet folder."""
 
     figure: Annotated[Text, AfterValidator(_as_figure)] = Field(

@@ -31,10 +31,10 @@ from typing import Annotated, Any
 
 from pydantic import BaseModel, BeforeValidator, Field, ValidationError
 
+from ..documents.messages import report, translate
+from ..documents.source import Tree, compose, read_text
+from ..documents.values import Boolean, Number, Positive, Strict, Text, fail
 from ..errors import StudyError
-from ..study.messages import _report, _translate
-from ..study.schema import Boolean, Number, Positive, Text, _fail, _Strict
-from ..study.source import _compose, _read_text, _Tree
 from .declaration import (
     AUTO_NAME_LENGTH,
     NAME_RE,
@@ -73,26 +73,26 @@ def _as_expression(value: Any) -> Expression:
     try:
         return parse(value)
     except ExpressionError as error:
-        _fail(str(error).replace("{", "{{").replace("}", "}}"))
+        fail(str(error).replace("{", "{{").replace("}", "}}"))
 
 
 def _as_comparison(value: Any) -> Comparison:
     try:
         return parse_comparison(value)
     except ExpressionError as error:
-        _fail(str(error).replace("{", "{{").replace("}", "}}"))
+        fail(str(error).replace("{", "{{").replace("}", "}}"))
 
 
 def _as_symbol(value: Any) -> str:
     if not isinstance(value, str) or not NAME_RE.fullmatch(value):
-        _fail("expected a name of letters, digits and '_' starting with a letter, got {got}")
+        fail("expected a name of letters, digits and '_' starting with a letter, got {got}")
     if value.lower() in RESERVED_NAMES or value.lower().startswith("w_") or value.startswith(
             "_"):
-        _fail("{got} is reserved by the generated Fortran (or starts with w_)")
+        fail("{got} is reserved by the generated Fortran (or starts with w_)")
     if value in FUNCTIONS or value in CONSTANTS:
-        _fail("{got} is the name of a function or constant of expressions")
+        fail("{got} is the name of a function or constant of expressions")
     if len(value) > AUTO_NAME_LENGTH:
-        _fail(f"must be at most {AUTO_NAME_LENGTH} characters (AUTO's names), got {{got}}")
+        fail(f"must be at most {AUTO_NAME_LENGTH} characters (AUTO's names), got {{got}}")
     return value
 
 
@@ -107,13 +107,13 @@ def _as_bounds(value: Any) -> Bounds | None:
             isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
             for v in value) and value[0] < value[1]:
         return Bounds(lower=float(value[0]), upper=float(value[1]))
-    _fail("expected `positive`, `non-negative` or [lower, upper] with lower < upper, "
+    fail("expected `positive`, `non-negative` or [lower, upper] with lower < upper, "
           "got {value}")
 
 
 def _as_model_name(value: Any) -> str:
     if not isinstance(value, str) or not NAME_RE.fullmatch(value) or len(value) > 40:
-        _fail("expected a name of letters, digits and '_' starting with a letter, at most 40 "
+        fail("expected a name of letters, digits and '_' starting with a letter, at most 40 "
               "characters, got {got}")
     return value
 
@@ -122,7 +122,7 @@ Expr = Annotated[Any, BeforeValidator(_as_expression)]
 Symbol = Annotated[str, BeforeValidator(_as_symbol)]
 
 
-class DofEntry(_Strict):
+class DofEntry(Strict):
     """A degree of freedom q_i (second order): its rate is ``d<name>`` unless ``rate`` says."""
 
     name: Symbol = Field(description="Name (state order = list order).")
@@ -135,7 +135,7 @@ class DofEntry(_Strict):
     rate: Symbol | None = Field(None, description="Name of its rate (default d<name>).")
 
 
-class StateEntry(_Strict):
+class StateEntry(Strict):
     """A first-order state x_j: its rate x_j' is given under ``rates``."""
 
     name: Symbol = Field(description="Name (state order = list order, after the dofs' rates).")
@@ -145,7 +145,7 @@ class StateEntry(_Strict):
                                 "state.")
 
 
-class ParameterEntry(_Strict):
+class ParameterEntry(Strict):
     """A parameter: travels to AUTO through PAR."""
 
     name: Symbol
@@ -159,14 +159,14 @@ class ParameterEntry(_Strict):
     aliases: tuple[Symbol, ...] = ()
 
 
-class ConstraintEntry(_Strict):
+class ConstraintEntry(Strict):
     """A condition on several parameters, e.g. ``I_y - I_d > 0``."""
 
     expression: Annotated[Any, BeforeValidator(_as_comparison)]
     reason: Text = ""
 
 
-class PathEntry(_Strict):
+class PathEntry(Strict):
     """A path normal to the spin axis: components y and z as linear combinations of the
     states with constant factors (e.g. ``-psi``)."""
 
@@ -174,13 +174,13 @@ class PathEntry(_Strict):
     z: Expr
 
 
-class ModeGroupEntry(_Strict):
+class ModeGroupEntry(Strict):
     name: Symbol
     dofs: tuple[Symbol, ...]
     path: PathEntry
 
 
-class ModelFile(_Strict):
+class ModelFile(Strict):
     """A model file (see the module doc)."""
 
     name: Annotated[str, BeforeValidator(_as_model_name)]
@@ -231,7 +231,7 @@ class FileEquations:
 def read_model_file(path: Path, label: str | None = None) -> Family:
     """The family a model file declares; StudyError listing every problem otherwise."""
     label = str(path) if label is None else label
-    return model_from_text(_read_text(path, label, "model").replace("\r\n", "\n"), label)
+    return model_from_text(read_text(path, label, "model").replace("\r\n", "\n"), label)
 
 
 def read_builtin(path: Path) -> Family:
@@ -250,15 +250,15 @@ def read_builtin(path: Path) -> Family:
 
 def model_from_text(text: str, label: str, builtin: bool = False) -> Family:
     """The family the model file ``text`` declares (messages name it ``label``)."""
-    tree = _Tree(_compose(text, label, "model"))
+    tree = Tree(compose(text, label, "model"))
     try:
         declared = ModelFile.model_validate(tree.data)
     except ValidationError as error:
-        problems = [_translate(e, tree, ModelFile) for e in error.errors(include_url=False)]
-        raise StudyError(_report(tree.problems + problems, tree, label)) from None
+        problems = [translate(e, tree, ModelFile) for e in error.errors(include_url=False)]
+        raise StudyError(report(tree.problems + problems, tree, label)) from None
     problems = tree.problems + _Checker(declared, builtin).problems()
     if problems:
-        raise StudyError(_report(problems, tree, label))
+        raise StudyError(report(problems, tree, label))
     return _family(declared, text)
 
 

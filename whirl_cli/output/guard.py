@@ -67,7 +67,8 @@ def _result(fd: int) -> str:
     return "" if marked else "an HDF5 file without whirl's whirl_schema attribute"
 
 
-def _starting(signature: bytes, what: str) -> Callable[[int], str]:
+def starting(signature: bytes, what: str) -> Callable[[int], str]:
+    """A check for :class:`Own`: the file starts with ``signature`` (any case), else ``what``."""
     def recognise(fd: int) -> str:
         head = os.pread(fd, len(signature), 0)
         return "" if head.lower() == signature.lower() else what
@@ -75,8 +76,8 @@ def _starting(signature: bytes, what: str) -> Callable[[int], str]:
 
 
 RESULT = Own("a whirl result file", _result)
-IMAGE = Own("a PNG image", _starting(b"\x89PNG\r\n\x1a\n", "a file that is not PNG"))
-PAGE = Own("an HTML page", _starting(b"<!DOCTYPE html>", "a file that is not HTML"))
+IMAGE = Own("a PNG image", starting(b"\x89PNG\r\n\x1a\n", "a file that is not PNG"))
+PAGE = Own("an HTML page", starting(b"<!DOCTYPE html>", "a file that is not HTML"))
 #: Any regular file (no check of its content).
 FILE = Own("a regular file", lambda fd: "")
 

@@ -146,7 +146,7 @@ SPECIAL_POINT = (
     Field("criticality", kind="text", vocabulary=Criticality), Field("note", kind="text"),
     Field("bracket", width=2),  # units: the principal parameter's
     Field("residual", kind="float", units="1"),
-    Field("lyapunov", kind="float", default=float("nan")),  # units: see _lyapunov_unit
+    Field("lyapunov", kind="float", default=float("nan")),  # units: see lyapunov_unit
     Field("refined", width=2, default=lambda: np.full(2, np.nan)),  # units: the bracket's
     Field("artefact", kind="bool", default=False),
     Field("refined_by", kind="text", default=""),  # older files: not recorded
@@ -324,7 +324,7 @@ def _write_continuation(group: h5py.Group, continuation: ContinuationResult) -> 
         "state": states,
         "bracket": {"units": first.parameter_units[0] if first else ""},
         "refined": {"units": first.parameter_units[0] if first else ""},
-        "lyapunov": {"units": _lyapunov_unit(first.state_units) if first else ""}})
+        "lyapunov": {"units": lyapunov_unit(first.state_units) if first else ""}})
     if continuation.seeds:
         write_table(group.create_group("seeds"), continuation.seeds, SEED,
                     {"states": len(first.state_names) if first else 0}, {"seed": states})
@@ -349,7 +349,7 @@ def _cross_check_units(checks, branch: Branch) -> dict[str, dict]:
             "exact": {"units": rows}}
 
 
-def _lyapunov_unit(state_units: tuple[str, ...]) -> str:
+def lyapunov_unit(state_units: tuple[str, ...]) -> str:
     """The unit of the first Lyapunov coefficient with SI states, 1/(s u^2) where every dof
     is in u (the first half of the states are the dofs)."""
     dofs = set(state_units[: len(state_units) // 2])

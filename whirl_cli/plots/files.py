@@ -248,11 +248,11 @@ bitmaps), SVG text drawn as paths (no font needed to view it), SVG ids the same 
 def _own(suffix: str):
     """The kind of file (:class:`whirl_cli.output.guard.Own`) a figure of ``suffix`` may
     replace: a PNG, PDF or SVG file."""
-    from ..output.guard import IMAGE, Own, _starting
+    from ..output.guard import IMAGE, Own, starting
 
     return {"png": IMAGE,
-            "pdf": Own("a PDF document", _starting(b"%PDF-", "a file that is not PDF")),
-            "svg": Own("an SVG image", _starting(b"<?xml", "a file that is not SVG"))}[suffix]
+            "pdf": Own("a PDF document", starting(b"%PDF-", "a file that is not PDF")),
+            "svg": Own("an SVG image", starting(b"<?xml", "a file that is not SVG"))}[suffix]
 
 
 def rendered_formats(figure: Figure, formats: tuple[str, ...], dpi: int,

@@ -6,17 +6,17 @@ They report every problem at once, as ``<file>:<line>: <key.path>: <reason>`` li
 
 How a file is read:
 
-1. bytes: at most :data:`MAX_BYTES`, UTF-8 (:mod:`~whirl_cli.study.source`);
+1. bytes: at most :data:`MAX_BYTES`, UTF-8 (:mod:`~whirl_cli.documents.source`);
 2. YAML, composed with a SafeLoader subclass into nodes (for line numbers): anchors, aliases,
    tags beyond the core ones (str, int, float, bool, null, seq, map) and nesting deeper than
-   :data:`~whirl_cli.study.source.MAX_DEPTH` are refused. Two YAML 1.1 surprises are switched
+   :data:`~whirl_cli.documents.source.MAX_DEPTH` are refused. Two YAML 1.1 surprises are switched
    off: only ``true`` and ``false`` are booleans (``yes``, ``on`` stay strings) and ``1e-6`` is
-   a number; dates stay strings and ``<<`` is a plain key (:mod:`~whirl_cli.study.source`);
+   a number; dates stay strings and ``<<`` is a plain key (:mod:`~whirl_cli.documents.source`);
 3. plain Python data from the nodes, scalars built by the safe constructors; duplicate keys are
-   reported (:mod:`~whirl_cli.study.source`);
+   reported (:mod:`~whirl_cli.documents.source`);
 4. structure: the pydantic models of :mod:`~whirl_cli.study.schema` (``extra="forbid"``), their
    errors translated into the reasons that tests/unit/test_study.py spells out
-   (:mod:`~whirl_cli.study.messages`);
+   (:mod:`~whirl_cli.documents.messages`);
 5. meaning, on the raw data so that it adds to the structural problems: parameter names known
    to the model variant, ``K2``/``K3`` only under ``nonlinearity``, ``dof`` a degree of freedom
    of the model, unique continuation names, ``start`` inside ``range``, simulations' initial
@@ -29,13 +29,13 @@ Validation also fills the model-dependent defaults (:mod:`~whirl_cli.study.resol
 ``Study.model_validate`` applies these fills too, but only the two entry points check parameter
 names and ranges against the model.
 
-Modules, lowest first (each imports only those above it, :mod:`whirl_cli.models`, and the
-schema :mod:`whirl_cli.continuation.numerics` for the AUTO defaults its step checks use):
+Modules, lowest first (each imports only those above it, :mod:`whirl_cli.models`,
+:mod:`whirl_cli.documents` -- the reader, the value types and the messages -- and the schema
+:mod:`whirl_cli.continuation.numerics` for the AUTO defaults its step checks use):
 
-* :mod:`~whirl_cli.study.source` -- the file as YAML nodes and data, with line numbers;
 * :mod:`~whirl_cli.study.resolve` -- model-dependent defaults filled on the raw data;
-* :mod:`~whirl_cli.study.schema` -- value checks and the pydantic models;
-* :mod:`~whirl_cli.study.messages` -- pydantic errors as (key path, reason), the report;
+* :mod:`~whirl_cli.study.continuations` -- the continuation types' registry;
+* :mod:`~whirl_cli.study.schema` -- the pydantic models;
 * :mod:`~whirl_cli.study.checks` -- meaning checks against the model variant;
 * :mod:`~whirl_cli.study.reference` -- the YAML reference table, read off the schema.
 
@@ -52,10 +52,11 @@ from pathlib import Path
 
 from pydantic import BaseModel, ValidationError
 
+from ..documents.messages import report, translate
+from ..documents.source import MAX_BYTES, Problem, Tree, compose, read_text, too_large
 from ..errors import StudyError
 from ..models import is_model_file, load_model_file, register_model_text
-from .checks import _meaning_problems
-from .messages import _report, _translate
+from .checks import meaning_problems
 from .reference import schema_reference
 from .schema import (
     AutoSettings,
@@ -68,7 +69,6 @@ from .schema import (
     Study,
     TwoParameterContinuation,
 )
-from .source import MAX_BYTES, Problem, _compose, _read_text, _too_large, _Tree
 
 __all__ = [
     "MAX_BYTES",
@@ -96,7 +96,7 @@ def load_study(path: str | os.PathLike[str], label: str | None = None) -> Study:
     read relative to the study's folder."""
     path = Path(path)
     label = path.name if label is None else label
-    return _validate(_read_text(path, label), label, str(path), path.parent)
+    return _validate(read_text(path, label), label, str(path), path.parent)
 
 
 def validate_text(text: str, filename: str = "<study>",
@@ -114,24 +114,24 @@ def load_yaml_file(path: Path, model: type[BaseModel], what: str,
     reason) on the valid object; StudyError lists every problem as ``<path>:<line>: <key>:
     <reason>``."""
     label = str(path)
-    tree = _Tree(_compose(_read_text(Path(path), label, what), label, what))
+    tree = Tree(compose(read_text(Path(path), label, what), label, what))
     problems = list(tree.problems)
     found = None
     try:
         found = model.model_validate(tree.data)
     except ValidationError as error:
-        problems += [_translate(e, tree, model) for e in error.errors(include_url=False)]
+        problems += [translate(e, tree, model) for e in error.errors(include_url=False)]
     if found is not None and checks is not None:
         problems += checks(found)
     if problems:
-        raise StudyError(_report(problems, tree, label))
+        raise StudyError(report(problems, tree, label))
     return found
 
 
 def read_yaml_data(path: Path, what: str = "study") -> dict:
     """The data of a YAML file read as studies are, not validated (StudyError where it is
     not readable YAML of a mapping)."""
-    return _Tree(_compose(_read_text(Path(path), Path(path).name, what), Path(path).name,
+    return Tree(compose(read_text(Path(path), Path(path).name, what), Path(path).name,
                           what)).data
 
 
@@ -145,7 +145,7 @@ def stored_study(provenance, filename: str = "<stored study>") -> Study:
     return validate_text(provenance.study_yaml, filename, stored)
 
 
-def _model_reference(tree: _Tree, name: str, folder: Path,
+def _model_reference(tree: Tree, name: str, folder: Path,
                      stored: tuple[str, str] | None) -> None:
     """Where the study names a model file, read it (StudyError for its problems, each at its
     own file and line) and put its reference in the data; a missing file is left for the
@@ -172,25 +172,25 @@ def _validate(text: str, name: str, path: str, folder: Path,
         reason = f"not UTF-8 text (character U+{code:04X} at offset {offset})"
         raise StudyError(f"{name}: {reason}") from None
     if len(encoded) > MAX_BYTES:
-        raise StudyError(_too_large(name, len(encoded)))
-    tree = _Tree(_compose(text, name))
+        raise StudyError(too_large(name, len(encoded)))
+    tree = Tree(compose(text, name))
     _model_reference(tree, name, folder, model_file)
     study, problems = _check(tree)
     if problems:
-        raise StudyError(_report(problems, tree, name))
+        raise StudyError(report(problems, tree, name))
     study._source, study._sha256, study._path = text, hashlib.sha256(encoded).hexdigest(), path
     study._read = dict(study.__dict__)
     return study
 
 
-def _check(tree: _Tree) -> tuple[Study | None, list[Problem]]:
+def _check(tree: Tree) -> tuple[Study | None, list[Problem]]:
     """The study (None if its structure is invalid) and every problem found."""
     problems = []
     try:
         study = Study.model_validate(tree.data)
     except ValidationError as error:
         study = None
-        problems = [_translate(e, tree) for e in error.errors(include_url=False)]
-    problems += _meaning_problems(tree.data)
+        problems = [translate(e, tree, Study) for e in error.errors(include_url=False)]
+    problems += meaning_problems(tree.data)
     return study, tree.problems + [p for p in problems if p[0] not in tree.unreadable]
 

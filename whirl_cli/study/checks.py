@@ -20,23 +20,23 @@ import re
 from collections.abc import Iterator
 from typing import Any
 
+from ..documents.messages import choice_reason, dotted
+from ..documents.source import Loc, Problem
 from ..kinds import SimulationLaw
 from ..models import family_of, is_known
 from . import continuations
-from .messages import _choice_reason, _dotted
 from .resolve import (
     Names,
-    _finite,
-    _is_single,
-    _names_of_data,
-    _study_values,
     block_dof,
+    finite,
+    is_single,
     law_blocks,
+    names_of_data,
+    study_values,
 )
-from .source import Loc, Problem
 
 
-def _meaning_problems(data: dict) -> list[Problem]:
+def meaning_problems(data: dict) -> list[Problem]:
     """Checks against the model variant, on the raw data; malformed parts are skipped."""
     family = data.get("model")
     if not is_known(family):
@@ -44,17 +44,17 @@ def _meaning_problems(data: dict) -> list[Problem]:
     problems = _law_problems(data, family)
     if problems:
         return problems
-    names = _names_of_data(data)
+    names = names_of_data(data)
     if names is None:
         return []
-    values = _study_values(data, names)
+    values = study_values(data, names)
     problems = _override_problems(data.get("parameters"), names, family)
     problems += _constraint_problems(data.get("parameters"), names, family, values)
     problems += _plot_state_problems(data.get("plot_state"), family)
     for loc, block in law_blocks(data):
         if not isinstance(block, dict):
             continue
-        dof = block_dof(block, family, _is_single(data))
+        dof = block_dof(block, family, is_single(data))
         found = [p for key, name in names.model.coefficient_names(dof).items() if key in block
                  for p in _bound_problems(loc + (key,), name, block[key], names)]
         problems += found or _combination_problems(loc, block, dof, names, values)
@@ -173,13 +173,13 @@ def _simulation_problems(items: Any, names: Names, family: str,
         found = _override_problems(parameters, names, family, loc + ("parameters",))
         if not found and isinstance(parameters, dict):
             mine = {names.canonical(k): float(v) for k, v in parameters.items()
-                    if _finite(v) is not None}
+                    if finite(v) is not None}
             found = _constraint_problems(parameters, names, family, {**values, **mine},
                                          loc + ("parameters",))
         problems += found
         initial = item.get("initial")
         if isinstance(initial, dict):
-            problems += [(loc + ("initial", key), _choice_reason(states, repr(key)))
+            problems += [(loc + ("initial", key), choice_reason(states, repr(key)))
                          for key in initial if isinstance(key, str) and key not in states]
         if item.get("law") == SimulationLaw.EXACT and not names.model.piecewise_dofs:
             problems.append((loc + ("law",), "the exact law needs a piecewise stiffness law "
@@ -191,7 +191,7 @@ def _law_problems(data: dict, family: str) -> list[Problem]:
     """Each law on a dof of the model, each dof with at most one law, and a dof named by every
     law of a list."""
     dofs = family_of(family).dof_names
-    single = _is_single(data)
+    single = is_single(data)
     problems: list[Problem] = []
     seen: dict[str, tuple] = {}
     for loc, block in law_blocks(data):
@@ -211,10 +211,10 @@ def _law_problems(data: dict, family: str) -> list[Problem]:
         if not isinstance(dof, str):
             continue  # a structural problem
         if dof not in dofs:
-            problems.append((loc + ("dof",), _choice_reason(dofs, repr(dof))))
+            problems.append((loc + ("dof",), choice_reason(dofs, repr(dof))))
         elif dof in seen:
             problems.append((loc + ("dof",), f"a second law on {dof} (the first is at "
-                             f"{_dotted(seen[dof])}); a dof takes at most one law"))
+                             f"{dotted(seen[dof])}); a dof takes at most one law"))
         else:
             seen[dof] = loc
     return problems
@@ -235,7 +235,7 @@ def _law_range_problems(loc: Loc, canonical: str, bounds: Any, names: Names,
     """A continuation of a law coefficient (or of a stiffness a law names, freeplay's K_out)
     whose range reaches values the law refuses together with the others (epsilon >= delta,
     K_out <= K_in): the first such end."""
-    ends = [_finite(b) for b in bounds] if isinstance(bounds, list) and len(bounds) == 2 else []
+    ends = [finite(b) for b in bounds] if isinstance(bounds, list) and len(bounds) == 2 else []
     for dof in names.model.family.dof_names:
         coefficients = names.model.coefficient_names(dof)
         if canonical not in coefficients.values():
@@ -254,7 +254,7 @@ def _plot_state_problems(state: Any, family: str) -> list[Problem]:
     states = family_of(family).state_names
     if not isinstance(state, str) or state in states:
         return []
-    return [(("plot_state",), _choice_reason(states, repr(state)))]
+    return [(("plot_state",), choice_reason(states, repr(state)))]
 
 
 def _sweep_problems(loc: Loc, spec: dict, names: Names, family: str,
@@ -272,7 +272,7 @@ def _sweep_problems(loc: Loc, spec: dict, names: Names, family: str,
             return found
         datum = names.parameter(canonical).default
         bounds = [b * datum for b in bounds] if isinstance(bounds, list) and len(bounds) == 2 \
-            and all(_finite(b) is not None for b in bounds) else bounds
+            and all(finite(b) is not None for b in bounds) else bounds
     return _range_problems(loc + ("range",), canonical, bounds, names, "swept") \
         or _range_constraint_problems(loc + ("range",), canonical, bounds, family, values)
 
@@ -284,7 +284,7 @@ def _multiples_problems(loc: Loc, canonical: str, bounds: Any, names: Names) -> 
         unit = f" {parameter.unit}" if parameter.unit not in ("", "1") else ""
         return [(loc + ("multiples",), f"the datum of {canonical} is 0{unit}: it has no "
                  f"multiples; give the range in {canonical}'s unit (multiples: false)")]
-    ends = [_finite(b) for b in bounds] if isinstance(bounds, list) and len(bounds) == 2 else []
+    ends = [finite(b) for b in bounds] if isinstance(bounds, list) and len(bounds) == 2 else []
     bad = [e for e in ends if e is not None and not e > 0]
     if bad:
         return [(loc + ("range",), f"with multiples: true the range is in multiples of the "
@@ -354,7 +354,7 @@ def _range_constraint_problems(loc: Loc, canonical: str, bounds: Any, family: st
     """A range end of ``canonical`` at which a constraint of the family breaks."""
     if not (isinstance(bounds, list) and len(bounds) == 2):
         return []
-    for end in (_finite(b) for b in bounds):
+    for end in (finite(b) for b in bounds):
         if end is None:
             continue
         for constraint in _broken(family, {**values, canonical: end}):
@@ -385,7 +385,7 @@ def _twice(name: str, other: str, canonical: str) -> str:
 def _bound_problems(loc: Loc, canonical: str, value: Any, names: Names) -> list[Problem]:
     """A value outside the parameter's physical bounds (malformed values are reported as
     structural problems)."""
-    number = _finite(value)
+    number = finite(value)
     parameter = names.parameter(canonical)
     if number is None or parameter.bounds.contains(number):
         return []
@@ -401,7 +401,7 @@ def _range_problems(loc: Loc, canonical: str, bounds: Any, names: Names,
     if parameter.bounds.integer:
         return [(loc, f"{canonical} takes whole numbers only ({parameter.bounds.text()}) and "
                  f"cannot be {swept}")]
-    ends = [_finite(b) for b in bounds] if isinstance(bounds, list) and len(bounds) == 2 else []
+    ends = [finite(b) for b in bounds] if isinstance(bounds, list) and len(bounds) == 2 else []
     outside = [e for e in ends if e is not None and not parameter.bounds.contains(e)]
     if not outside:
         return []
@@ -463,7 +463,7 @@ def _seed_problems(loc: Loc, seeds: Any, family: str) -> list[Problem]:
     states = family_of(family).state_names
     if not isinstance(seeds, list):
         return []
-    return [(loc + ("seeds", k, name), _choice_reason(states, repr(name)))
+    return [(loc + ("seeds", k, name), choice_reason(states, repr(name)))
             for k, seed in enumerate(seeds) if isinstance(seed, dict)
             for name in seed if isinstance(name, str) and name not in states]
 
@@ -473,14 +473,14 @@ def _initial_problems(loc: Loc, initial: Any, family: str) -> list[Problem]:
     states = family_of(family).state_names
     if not isinstance(initial, dict):
         return []
-    return [(loc + (name,), _choice_reason(states, repr(name)))
+    return [(loc + (name,), choice_reason(states, repr(name)))
             for name in initial if isinstance(name, str) and name not in states]
 
 
 def _state_problems(loc: Loc, name: str, family: str) -> list[Problem]:
     """A state name (``explore_section``) the model lacks."""
     states = family_of(family).state_names
-    return [] if name in states else [(loc, _choice_reason(states, repr(name)))]
+    return [] if name in states else [(loc, choice_reason(states, repr(name)))]
 
 
 def _orbits_problems(loc: Loc, item: dict, key: str = "orbits_at") -> list[Problem]:
@@ -488,11 +488,11 @@ def _orbits_problems(loc: Loc, item: dict, key: str = "orbits_at") -> list[Probl
     bounds, orbits = item.get("range"), item.get(key)
     if not (isinstance(bounds, list) and len(bounds) == 2 and isinstance(orbits, list)):
         return []
-    lower, upper = (_finite(b) for b in bounds)
+    lower, upper = (finite(b) for b in bounds)
     if lower is None or upper is None or not lower < upper:
         return []
     return [(loc + (key, k), f"{number!r} is outside the range [{lower!r}, {upper!r}]")
-            for k, number in enumerate(map(_finite, orbits))
+            for k, number in enumerate(map(finite, orbits))
             if number is not None and not lower <= number <= upper]
 
 
@@ -532,9 +532,9 @@ def _pair_problems(loc: Loc, item: dict, names: Names, family: str,
     limits = bounds[canonical[second]]
     slices = item.get("slices")
     if isinstance(limits, list) and len(limits) == 2 and isinstance(slices, list):
-        lower, upper = (_finite(b) for b in limits)
+        lower, upper = (finite(b) for b in limits)
         for k, value in enumerate(slices):
-            number = _finite(value.get("value") if isinstance(value, dict) else value)
+            number = finite(value.get("value") if isinstance(value, dict) else value)
             if None not in (lower, upper, number) and lower < upper and not (
                     lower <= number <= upper):
                 problems.append((loc + ("slices", k), f"slice {number!r} is outside the range "
@@ -547,9 +547,9 @@ def _start_problems(loc: Loc, item: dict, study_value: float) -> list[Problem]:
     bounds = item.get("range")
     if not isinstance(bounds, list) or len(bounds) != 2:
         return []
-    lower, upper = (_finite(b) for b in bounds)
+    lower, upper = (finite(b) for b in bounds)
     written = item.get("start") is not None
-    start = _finite(item["start"]) if written else study_value
+    start = finite(item["start"]) if written else study_value
     if lower is None or upper is None or start is None or not lower < upper:
         return []  # reported as a structural problem
     if lower <= start <= upper:

@@ -10,7 +10,7 @@ from typing import Any, Literal, get_args, get_origin
 from pydantic import BaseModel
 from pydantic.fields import FieldInfo
 
-from .messages import _strip, _union_members
+from ..documents.messages import strip, union_members
 from .schema import Study
 
 
@@ -34,17 +34,17 @@ def _fields(model: type[BaseModel], prefix: str) -> Iterator[tuple[str, FieldInf
     for name, field in model.model_fields.items():
         path = prefix + name
         yield path, field
-        annotation = _strip(field.annotation)
+        annotation = strip(field.annotation)
         suffix = ""
         if get_origin(annotation) is tuple and get_args(annotation)[-1:] == (Ellipsis,):
-            annotation, suffix = _strip(get_args(annotation)[0]), "[]"
-        for member in _union_members(annotation) or [annotation]:
+            annotation, suffix = strip(get_args(annotation)[0]), "[]"
+        for member in union_members(annotation) or [annotation]:
             if isinstance(member, type) and issubclass(member, BaseModel):
                 yield from _fields(member, f"{path}{suffix}.")
 
 
 def _type_text(annotation: Any) -> str:
-    annotation = _strip(annotation)
+    annotation = strip(annotation)
     origin, args = get_origin(annotation), get_args(annotation)
     simple = {bool: "true/false", int: "integer", float: "number", str: "string"}
     if annotation in simple:
@@ -52,7 +52,7 @@ def _type_text(annotation: Any) -> str:
     if origin is Literal:
         return " or ".join(f"`{a}`" for a in args)
     if origin is tuple and args[-1:] == (Ellipsis,):
-        inner = _strip(args[0])
+        inner = strip(args[0])
         if isinstance(inner, type) and issubclass(inner, BaseModel):
             return "list of mappings"
         return f"list of {_type_text(inner)}"

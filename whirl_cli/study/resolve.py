@@ -19,8 +19,8 @@ from typing import Any
 
 from pydantic import BaseModel
 
+from ..documents.values import is_number
 from ..models import LAWS, Model, Parameter, family_of, get_model, is_known
-from .values import _is_number
 
 #: Study law types: ``linear`` is the polynomial law with zero coefficients.
 LAW_TYPES = ("linear", *LAWS)
@@ -28,9 +28,9 @@ LAW_TYPES = ("linear", *LAWS)
 THESIS_NAMES = ("K1", "K2", "K3")
 
 
-def _finite(value: Any) -> float | None:
+def finite(value: Any) -> float | None:
     """``value`` as a float if it is a finite number, else None."""
-    return float(value) if _is_number(value) and math.isfinite(value) else None
+    return float(value) if is_number(value) and math.isfinite(value) else None
 
 
 def law_blocks(data: dict) -> list[tuple[tuple, Any]]:
@@ -44,7 +44,7 @@ def law_blocks(data: dict) -> list[tuple[tuple, Any]]:
     return [(("nonlinearity",), block)]
 
 
-def _is_single(data: dict) -> bool:
+def is_single(data: dict) -> bool:
     """True if the study gives its law as one mapping (or none), not as a list."""
     return not isinstance(data.get("nonlinearity"), list | tuple)
 
@@ -114,14 +114,14 @@ def names_of(family: str, laws: list[tuple[str, Any]]) -> Names | None:
     return Names(model, aliases)
 
 
-def _names_of_data(data: dict) -> Names | None:
+def names_of_data(data: dict) -> Names | None:
     """The :class:`Names` the raw study data asks for, or None when its model or laws are
     invalid (reported by the checks)."""
     family = data.get("model")
     if not is_known(family):
         return None
     blocks = law_blocks(data)
-    single = _is_single(data)
+    single = is_single(data)
     laws = []
     for _, block in blocks:
         if block is None:
@@ -137,25 +137,25 @@ def _names_of_data(data: dict) -> Names | None:
     return names_of(family, laws)
 
 
-def _study_values(data: dict, names: Names) -> dict[str, float]:
+def study_values(data: dict, names: Names) -> dict[str, float]:
     """Canonical name -> value: datum values, then valid overrides and the law coefficients
     from raw data."""
     values = names.defaults()
     known = names.known_parameter_names()
     parameters = data.get("parameters")
     for name, value in parameters.items() if isinstance(parameters, dict) else ():
-        if name in known and _finite(value) is not None:
+        if name in known and finite(value) is not None:
             values[names.canonical(name)] = float(value)
     blocks = law_blocks(data)
     for _, block in blocks:
         if not isinstance(block, dict):
             continue
         block = _with_derived_defaults(block)
-        dof = block_dof(block, data["model"], _is_single(data))
+        dof = block_dof(block, data["model"], is_single(data))
         if dof not in names.model.family.dof_names:
             continue
         for key, name in names.model.coefficient_names(dof).items():
-            if _finite(block.get(key)) is not None:
+            if finite(block.get(key)) is not None:
                 values[name] = float(block[key])
     return values
 
@@ -167,15 +167,15 @@ def _with_derived_defaults(block: Any) -> Any:
     if law is None:
         return block
     given = {key: float(value) for key, value in block.items()
-             if isinstance(key, str) and _finite(value) is not None}
+             if isinstance(key, str) and finite(value) is not None}
     return {**block, **law.derived_defaults(given)}
 
 
-def _resolved(data: dict) -> dict:
+def resolved(data: dict) -> dict:
     """``data`` with dof, law defaults, canonical parameter names and start values filled
     where possible."""
     data = _named_simulations(data)
-    names = _names_of_data(data)
+    names = names_of_data(data)
     if names is None:
         return data
     data = dict(data)
@@ -192,7 +192,7 @@ def _resolved(data: dict) -> dict:
         data["nonlinearity"] = {**block, "dof": dofs[0]}
     elif dofs and isinstance(block, BaseModel) and getattr(block, "dof", None) is None:
         data["nonlinearity"] = block.model_copy(update={"dof": dofs[0]})
-    values = _study_values(data, names)
+    values = study_values(data, names)
     items = data.get("continuations")
     if isinstance(items, list | tuple):
         data["continuations"] = [_resolved_continuation(c, names, values) for c in items]

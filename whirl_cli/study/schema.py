@@ -1,7 +1,7 @@
 """The study schema: the pydantic models of a study file.
 
 Every model forbids unknown keys and is frozen. The value checks are those of
-:mod:`whirl_cli.study.values`, the continuation specs those of the registered types
+:mod:`whirl_cli.documents.values`, the continuation specs those of the registered types
 (:mod:`whirl_cli.study.continuations`). :class:`Study` fills the model-dependent defaults
 before it validates (:mod:`whirl_cli.study.resolve`).
 """
@@ -14,6 +14,7 @@ import operator
 from typing import Annotated, Any, Literal
 
 from pydantic import (
+    AfterValidator,
     BaseModel,
     BeforeValidator,
     Field,
@@ -23,32 +24,41 @@ from pydantic import (
 )
 
 from ..continuation.numerics import Numerics
-from ..models import Model
-from ..models.laws import LAWS, POLYNOMIAL, Coefficient, Law
-from ..plots.kinds import plot_kinds
-from . import continuations
-from .continuations.one_parameter import OneParameterContinuation  # noqa: F401 - re-exported
-from .continuations.two_parameter import Slice, TwoParameterContinuation  # noqa: F401
-from .resolve import Names, _resolved, names_of
-from .values import (  # noqa: F401 - _as_number, _at_most_orbits: read from here by figures
+from ..documents.values import (
     FORTRAN_INT_MAX,
     NAME_MAX,
     Boolean,
     Integer,
-    ModelFamily,
     Name,
     Number,
     Positive,
     Range,
     Step,
+    Strict,
     Text,
-    _as_number,
-    _as_state,
-    _at_most_orbits,
-    _bound,
-    _fail,
-    _Strict,
+    as_state,
+    bound,
+    fail,
 )
+from ..models import FAMILIES, Model, is_known, is_model_file
+from ..models.laws import LAWS, POLYNOMIAL, Coefficient, Law
+from ..plots.kinds import plot_kinds
+from . import continuations
+from .continuations.one_parameter import OneParameterContinuation  # noqa: F401 - re-exported
+from .continuations.two_parameter import Slice, TwoParameterContinuation  # noqa: F401
+from .resolve import Names, names_of, resolved
+
+
+def _as_model_family(value: str) -> str:
+    if not is_known(value):
+        if is_model_file(value):
+            fail("no model file {got}")
+        fail(f"unknown model {{got}} (built-in: {', '.join(FAMILIES)}; or a model file "
+             "path ending in .yaml)")
+    return value
+
+
+ModelFamily = Annotated[Text, AfterValidator(_as_model_family)]
 
 _LINEAR_DOC = "linear springs; the polynomial law with K2 = K3 = 0"
 _DOF_DOC = (
@@ -64,7 +74,7 @@ def _type_doc() -> str:
     return f"Stiffness law: {', '.join(kinds[:-1])} or {kinds[-1]}."
 
 
-class Linear(_Strict):
+class Linear(Strict):
     """Linear springs: the polynomial law with K2 = K3 = 0 (one AUTO executable for both)."""
 
     type: Literal["linear"] = Field(description=_type_doc())
@@ -82,7 +92,7 @@ def _coefficient_field(law: Law, coefficient: Coefficient) -> tuple[Any, Any]:
     return Number, Field(coefficient.default, description=doc)
 
 
-def _law_block(law: Law) -> type[_Strict]:
+def _law_block(law: Law) -> type[Strict]:
     """The schema of a study's block of ``law``: ``type``, ``dof``, the coefficients a study
     must give, the law's own key for the dof's stiffness (if it has one), the others."""
     stiffness = {} if law.stiffness_key is None else {
@@ -93,12 +103,12 @@ def _law_block(law: Law) -> type[_Strict]:
               **stiffness,
               **{c.key: _coefficient_field(law, c) for c in law.coefficients
                  if not c.required}}
-    return create_model(law.name.capitalize(), __base__=_Strict, __module__=__name__,
+    return create_model(law.name.capitalize(), __base__=Strict, __module__=__name__,
                         __doc__=law.description, **fields)
 
 
 #: The schema of a study's block of each law of :data:`LAWS`, by ``type``.
-LAW_BLOCKS: dict[str, type[_Strict]] = {name: _law_block(law) for name, law in LAWS.items()}
+LAW_BLOCKS: dict[str, type[Strict]] = {name: _law_block(law) for name, law in LAWS.items()}
 Polynomial = LAW_BLOCKS[POLYNOMIAL.name]
 
 LawBlock = Annotated[functools.reduce(operator.or_, LAW_BLOCKS.values(), Linear),
@@ -110,7 +120,7 @@ def _as_laws(value: Any) -> Any:
     if isinstance(value, dict | BaseModel):
         return (value,)
     if not isinstance(value, list | tuple):
-        _fail("expected a mapping (one law) or a list of mappings (one law per dof), got {got}")
+        fail("expected a mapping (one law) or a list of mappings (one law per dof), got {got}")
     return value
 
 
@@ -123,14 +133,14 @@ Continuation = Annotated[functools.reduce(operator.or_, continuations.specs()),
                          Field(discriminator="type")]
 
 
-class LinearAxisSpec(_Strict):
+class LinearAxisSpec(Strict):
     """One parameter on an even grid of values: a grid axis."""
 
     parameter: Text = Field(
         description="Swept parameter, by name or alias (stored as the canonical name)."
     )
     range: Range = Field(description="[lower, upper] of the sweep, in the parameter's unit.")
-    points: Annotated[Integer, _bound(">=", 2), _bound("<=", 100000)] = Field(
+    points: Annotated[Integer, bound(">=", 2), bound("<=", 100000)] = Field(
         201, description="Number of equally spaced values, 2 to 100000."
     )
 
@@ -147,7 +157,7 @@ class LinearSweepSpec(LinearAxisSpec):
         "the datum beside them. The datum must be non-zero.")
 
 
-class LinearGridSpec(_Strict):
+class LinearGridSpec(Strict):
     """Linear stability over a grid of two parameters."""
 
     x: LinearAxisSpec = Field(description="First grid axis: parameter, range, points.")
@@ -155,7 +165,7 @@ class LinearGridSpec(_Strict):
                               "points.")
 
 
-class LinearSpec(_Strict):
+class LinearSpec(Strict):
     """Linear (eigenvalue) analysis, done with numpy, without AUTO."""
 
     sweeps: tuple[LinearSweepSpec, ...] = Field(
@@ -173,7 +183,7 @@ class LinearSpec(_Strict):
 SAMPLES_MAX = 1_000_000
 
 
-class SimulationSpec(_Strict):
+class SimulationSpec(Strict):
     """A time simulation from a stated initial state (scipy, without AUTO).
 
     After validation ``name`` is filled (``sim_<k>``, its position from 1)."""
@@ -186,11 +196,11 @@ class SimulationSpec(_Strict):
         description="Overrides for this simulation, by name or alias, in SI units, applied "
         "on top of the study's `parameters` (same rules: law coefficients go under "
         "`nonlinearity`).")
-    initial: Annotated[dict[str, float], BeforeValidator(_as_state)] = Field(
+    initial: Annotated[dict[str, float], BeforeValidator(as_state)] = Field(
         description="Initial state, state name -> value (angles in deg, rates in deg/s, other "
         "states in their unit; unnamed states 0), as the `seeds` of a continuation.")
     duration: Positive = Field(description="Simulated time, s, > 0.")
-    samples: Annotated[Integer, _bound(">=", 2), _bound("<=", SAMPLES_MAX)] = Field(
+    samples: Annotated[Integer, bound(">=", 2), bound("<=", SAMPLES_MAX)] = Field(
         2001, description=f"Output points, equally spaced from 0 to `duration`, 2 to "
         f"{SAMPLES_MAX}.")
     law: Literal["smoothed", "exact"] = Field(
@@ -203,10 +213,10 @@ class SimulationSpec(_Strict):
 _STEP_ORDER = (("step_min", "step_max"), ("step_initial", "step_max"), ("step_min", "step_initial"))
 
 
-class AutoSettings(_Strict):
+class AutoSettings(Strict):
     """AUTO-07p settings under readable names; unset ones use whirl's defaults."""
 
-    max_steps: Annotated[Integer, _bound(">=", 1), _bound("<=", FORTRAN_INT_MAX)] | None = Field(
+    max_steps: Annotated[Integer, bound(">=", 1), bound("<=", FORTRAN_INT_MAX)] | None = Field(
         None, description="Maximum continuation steps per run (AUTO NMX), >= 1; a branch "
         "that uses them up before its range ends fails the study."
     )
@@ -223,14 +233,14 @@ class AutoSettings(_Strict):
         "<= 1."
     )
     mesh_intervals: Annotated[
-        Integer, _bound(">=", 2), _bound("<=", FORTRAN_INT_MAX)] | None = Field(
+        Integer, bound(">=", 2), bound("<=", FORTRAN_INT_MAX)] | None = Field(
         None, description="Mesh intervals for periodic orbits (AUTO NTST), >= 2."
     )
-    collocation_points: Annotated[Integer, _bound(">=", 2), _bound("<=", 7)] | None = Field(
+    collocation_points: Annotated[Integer, bound(">=", 2), bound("<=", 7)] | None = Field(
         None, description="Collocation points per mesh interval (AUTO NCOL), 2 to 7."
     )
     newton_max_iterations: Annotated[
-        Integer, _bound(">=", 1), _bound("<=", FORTRAN_INT_MAX)] | None = Field(
+        Integer, bound(">=", 1), bound("<=", FORTRAN_INT_MAX)] | None = Field(
         None, description="Maximum Newton iterations per step (AUTO ITNW), >= 1."
     )
     tolerance: Positive | None = Field(
@@ -248,7 +258,7 @@ class AutoSettings(_Strict):
         for low, high in _STEP_ORDER:
             problem = _step_order_problem(self, low, high)
             if problem is not None:
-                _fail(*problem)
+                fail(*problem)
         return self
 
 
@@ -270,7 +280,7 @@ def _step_order_problem(settings: AutoSettings, low: str, high: str
     return f"must be <= {high} ({upper:g}{note}), got {{got}}", (low,)
 
 
-class Study(_Strict):
+class Study(Strict):
     """One study file, validated. ``source``, ``sha256`` and ``path`` are not YAML keys."""
 
     name: Name = Field(
@@ -329,7 +339,7 @@ class Study(_Strict):
     @model_validator(mode="before")
     @classmethod
     def _fill_model_defaults(cls, data: Any) -> Any:
-        return _resolved(data) if isinstance(data, dict) else data
+        return resolved(data) if isinstance(data, dict) else data
 
     @property
     def source(self) -> str:

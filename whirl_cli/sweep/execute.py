@@ -2,7 +2,7 @@
 
 * :func:`compute`, the task a worker process runs: :func:`whirl_cli.pipeline.run_study` with
   ``jobs=1`` in its own temporary directory; it returns the :class:`StudyResult` (frozen
-  dataclasses, picklable) and writes nothing else. :func:`_init_worker` initialises local
+  dataclasses, picklable) and writes nothing else. :func:`init_worker` initialises local
   workers and shares the cancel flag :func:`compute` reads (both here, so that they see one
   module global).
 * :func:`execute`: submits the planned studies to any ``concurrent.futures.Executor`` (a local
@@ -39,7 +39,7 @@ from .plan import INVALID, PLOT, RUN, SKIP, SweepItem
 _CANCELLED = None
 
 
-def _init_worker(cancelled) -> None:
+def init_worker(cancelled) -> None:
     """Initializer of local worker processes: :func:`whirl_cli.runtime.quiet_worker` with
     SIGTERM ignored as SIGINT is (a process group's SIGTERM, a batch system's cancel, must not
     end a worker inside the pool's queue code, where it would leave a lock held and the

@@ -15,7 +15,7 @@ from contextlib import contextmanager
 
 from ..errors import WhirlError
 from ..runtime import forking
-from .execute import _init_worker
+from .execute import init_worker
 from .plan import RUN, SweepItem
 
 DASK_HINT = "install with pip install 'whirl[dask]'"
@@ -42,7 +42,7 @@ class LocalPool(ProcessPoolExecutor):
     """A process pool of ``jobs`` workers whose studies can be interrupted.
 
     Workers ignore SIGINT and SIGTERM except inside a study (see
-    :func:`whirl_cli.sweep.execute._init_worker`);
+    :func:`whirl_cli.sweep.execute.init_worker`);
     ``interrupt`` sets the shared cancel flag (queued tasks return at once) and sends them
     SIGINT (a terminal's Ctrl-C reaches them directly, ``kill -INT`` on the parent does not).
     The pool's own cancel/terminate paths are not used after an interrupt: in Python 3.11
@@ -52,7 +52,7 @@ class LocalPool(ProcessPoolExecutor):
     def __init__(self, jobs: int) -> None:
         context = multiprocessing.get_context()
         self.cancelled = context.Event()
-        super().__init__(max_workers=jobs, mp_context=context, initializer=_init_worker,
+        super().__init__(max_workers=jobs, mp_context=context, initializer=init_worker,
                          initargs=(self.cancelled,))
         self.jobs = jobs
         self._workers: list = []
@@ -74,7 +74,7 @@ class LocalPool(ProcessPoolExecutor):
         by then they run no study. Every worker gets the whole ``timeout`` to end its study and
         remove its work directory, also in a broken pool (a worker died, its manager has sent
         the others SIGTERM, which ends a study at once but is ignored by an idle worker, see
-        :func:`whirl_cli.sweep.execute._init_worker`, so an idle one then waits to be killed).
+        :func:`whirl_cli.sweep.execute.init_worker`, so an idle one then waits to be killed).
         The shutdown waits in a thread of its own until the pool's manager thread has ended (one
         left running races Python's exit for the pool's wakeup pipe)."""
         workers = self.workers()

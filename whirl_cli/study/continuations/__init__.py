@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 from pydantic import Field
 
-from ..values import Name, _Strict
+from ...documents.values import Name, Strict
 
 if TYPE_CHECKING:
     from ...results import Boundary, ContinuationResult
@@ -30,7 +30,7 @@ RUN_NAME_DOC = (
     "repetitions at smaller smoothing).")
 
 
-class ContinuationSpec(_Strict):
+class ContinuationSpec(Strict):
     """What every continuation of a study has: a name (its ``type`` is its spec's own)."""
 
     name: Name = Field(description=RUN_NAME_DOC)

@@ -9,9 +9,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 from pydantic import AfterValidator, BeforeValidator, Field
 
-from ...kinds import ContinuationKind
-from ..resolve import Names, resolved_parameter
-from ..values import (
+from ...documents.values import (
     ORBITS_MAX,
     SEEDS_TEXT,
     Boolean,
@@ -19,10 +17,12 @@ from ..values import (
     Positive,
     Range,
     Text,
-    _as_seeds,
-    _as_state,
-    _at_most_orbits,
+    as_seeds,
+    as_state,
+    at_most_orbits,
 )
+from ...kinds import ContinuationKind
+from ..resolve import Names, resolved_parameter
 from . import ContinuationSpec, ContinuationType
 
 if TYPE_CHECKING:
@@ -73,20 +73,20 @@ class OneParameterContinuation(ContinuationSpec):
         "amplitude, both signs); each one on no computed branch starts a branch both ways "
         "(equilibria no branch point reaches, e.g. freeplay's offset ones)."
     )
-    start_state: Annotated[dict[str, float] | None, BeforeValidator(_as_state)] = Field(
+    start_state: Annotated[dict[str, float] | None, BeforeValidator(as_state)] = Field(
         None,
         description="Where Newton's method seeks the starting equilibrium at `start` when the "
         "zero state is not one: state name -> value (angles in deg, rates in deg/s, other "
         "states in their unit; unnamed states 0). Unset: from the zero state.",
     )
-    orbits_at: Annotated[tuple[Number, ...], AfterValidator(_at_most_orbits)] = Field(
+    orbits_at: Annotated[tuple[Number, ...], AfterValidator(at_most_orbits)] = Field(
         (),
         description="Parameter values (in its unit) at which every branch stores a labelled "
         "solution: orbit profiles for phase-plane plots (AUTO UZR).",
     )
-    seeds: Annotated[Any, BeforeValidator(_as_seeds)] = Field((), description=SEEDS_TEXT)
+    seeds: Annotated[Any, BeforeValidator(as_seeds)] = Field((), description=SEEDS_TEXT)
 
-    explore: Annotated[tuple[Number, ...], AfterValidator(_at_most_orbits)] = Field(
+    explore: Annotated[tuple[Number, ...], AfterValidator(at_most_orbits)] = Field(
         (),
         description="Parameter values (in its unit), each within `range`, at which the "
         "settled motion is classified by time simulation after the AUTO runs: equilibrium, "
@@ -94,7 +94,7 @@ class OneParameterContinuation(ContinuationSpec):
         "frequencies and Poincaré section (for the `poincare`, `spectrum` and "
         f"`orbit_diagram` plots); at most {ORBITS_MAX} values.",
     )
-    explore_initial: Annotated[dict[str, float] | None, BeforeValidator(_as_state)] = Field(
+    explore_initial: Annotated[dict[str, float] | None, BeforeValidator(as_state)] = Field(
         None,
         description="Initial state of the `explore` simulations, state name -> value (angles "
         "in deg, rates in deg/s, other states in their unit; unnamed states 0), as the "

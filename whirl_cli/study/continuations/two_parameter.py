@@ -9,22 +9,22 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 from pydantic import BeforeValidator, Field
 
-from ...kinds import ContinuationKind
-from ...kinds import LocusKind as Locus
-from ..resolve import Names, resolved_pair
-from ..values import (
+from ...documents.values import (
     SEEDS_TEXT,
     Integer,
     Number,
     Range,
+    Strict,
     Text,
-    _as_number,
-    _as_seeds,
-    _bound,
-    _fail,
-    _is_number,
-    _Strict,
+    as_number,
+    as_seeds,
+    bound,
+    fail,
+    is_number,
 )
+from ...kinds import ContinuationKind
+from ...kinds import LocusKind as Locus
+from ..resolve import Names, resolved_pair
 from . import ContinuationSpec, ContinuationType
 
 if TYPE_CHECKING:
@@ -33,7 +33,7 @@ if TYPE_CHECKING:
 LocusKind = Literal["hopf", "branch_point", "fold", "fold_of_cycles", "torus"]
 
 
-class Slice(_Strict):
+class Slice(Strict):
     """A slice of a two-parameter continuation: a value of its second parameter, and how
     figures name it."""
 
@@ -46,9 +46,9 @@ def _as_slice(value: Any) -> Any:
     """A slice given as a bare number is ``{value: number}``."""
     if isinstance(value, dict):
         return value
-    if not _is_number(value):
-        _fail("expected a finite number or a mapping {{value, label}}, got {got}")
-    return {"value": _as_number(value)}
+    if not is_number(value):
+        fail("expected a finite number or a mapping {{value, label}}, got {got}")
+    return {"value": as_number(value)}
 
 
 SliceEntry = Annotated[Slice, BeforeValidator(_as_slice)]
@@ -86,7 +86,7 @@ class TwoParameterContinuation(ContinuationSpec):
         "a number or `{value: number, label: text}` (`label` names it in figures); unset: its "
         "study value.",
     )
-    seeds: Annotated[Any, BeforeValidator(_as_seeds)] = Field((), description=SEEDS_TEXT)
+    seeds: Annotated[Any, BeforeValidator(as_seeds)] = Field((), description=SEEDS_TEXT)
     loci: tuple[LocusKind, ...] = Field(
         ("hopf", "branch_point", "fold", "fold_of_cycles"),
         description="Which loci to continue: `hopf`, `branch_point` (pitchfork), `fold` (of "
@@ -108,7 +108,7 @@ class TwoParameterContinuation(ContinuationSpec):
         "loci, and between the pitchfork and fold loci) or `slices` (the thesis' method: from "
         "one-parameter runs with periodic branches at every slice).",
     )
-    resolution: Annotated[Integer, _bound(">=", 3), _bound("<=", 2001)] = Field(
+    resolution: Annotated[Integer, bound(">=", 3), bound("<=", 2001)] = Field(
         101, description="Rows across the second parameter's range for the unsafe polygons."
     )
 

@@ -1,8 +1,9 @@
-"""Pydantic's validation errors as whirl's messages: (key path, reason), and the report.
+"""Pydantic's validation errors of a YAML file (a study, a sheet, a model file) as whirl's
+messages: (key path, reason), and the report.
 
-:func:`_translate` turns one pydantic error into (YAML key path, reason), with the value as
-written in the file; :func:`_report` sorts the problems by line and prints them as
-``<file>:<line>: <key.path>: <reason>``. :func:`_walk`, :func:`_strip` and their helpers read
+:func:`translate` turns one pydantic error into (YAML key path, reason), with the value as
+written in the file; :func:`report` sorts the problems by line and prints them as
+``<file>:<line>: <key.path>: <reason>``. :func:`_walk`, :func:`strip` and their helpers read
 the schema's annotations.
 """
 
@@ -13,16 +14,16 @@ from typing import Annotated, Any, Union, get_args, get_origin
 
 from pydantic import BaseModel
 
-from .schema import Study
-from .source import Loc, Problem, _Tree
+from .source import Loc, Problem, Tree
 
 
-def _report(problems: list[Problem], tree: _Tree, name: str) -> str:
-    lines = sorted((tree.line(loc), _dotted(loc), reason) for loc, reason in problems)
+def report(problems: list[Problem], tree: Tree, name: str) -> str:
+    """The problems as ``<file>:<line>: <key.path>: <reason>`` lines, sorted by line."""
+    lines = sorted((tree.line(loc), dotted(loc), reason) for loc, reason in problems)
     return "\n".join(f"{name}:{line}: {path}: {reason}" for line, path, reason in lines)
 
 
-def _dotted(loc: Loc) -> str:
+def dotted(loc: Loc) -> str:
     """``('continuations', 0, 'range')`` -> ``continuations[0].range``."""
     text = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in loc)
     return text.removeprefix(".")
@@ -33,7 +34,7 @@ _LIST_ERRORS = {"tuple_type", "list_type"}
 _LENGTH_ERRORS = {"too_short": ("min_length", "at least"), "too_long": ("max_length", "at most")}
 
 
-def _translate(error: Any, tree: _Tree, root: type[BaseModel] = Study) -> Problem:
+def translate(error: Any, tree: Tree, root: type[BaseModel]) -> Problem:
     """One pydantic error of a file validated as ``root`` as (key path, reason)."""
     loc, owner, annotation = _walk(error["loc"], root)
     if loc[:2] == ("nonlinearity", 0) and isinstance(tree.data.get("nonlinearity"), dict):
@@ -56,9 +57,9 @@ def _translate(error: Any, tree: _Tree, root: type[BaseModel] = Study) -> Proble
         loc += (error["ctx"]["discriminator"].strip("'"),)
         if loc not in tree.nodes:
             return loc, "required key is missing"
-        return loc, _choice_reason([_tag(m) for m in _union_members(annotation)], tree.shown(loc))
+        return loc, choice_reason([_tag(m) for m in union_members(annotation)], tree.shown(loc))
     if kind == "literal_error":
-        return loc, _choice_reason(get_args(annotation), tree.shown(loc))
+        return loc, choice_reason(get_args(annotation), tree.shown(loc))
     if kind in _MAPPING_ERRORS:
         return loc, f"expected a mapping, got {tree.shown(loc)}"
     if kind in _LIST_ERRORS:
@@ -66,11 +67,12 @@ def _translate(error: Any, tree: _Tree, root: type[BaseModel] = Study) -> Proble
     return loc, error["msg"]
 
 
-def _choice_reason(options: Any, got: str) -> str:
+def choice_reason(options: Any, got: str) -> str:
+    """The reason for a value not among ``options``."""
     return f"expected one of {', '.join(map(str, options))}, got {got}"
 
 
-def _walk(loc: tuple, root: type[BaseModel] = Study) -> tuple[Loc, type[BaseModel], Any]:
+def _walk(loc: tuple, root: type[BaseModel]) -> tuple[Loc, type[BaseModel], Any]:
     """A pydantic loc as (YAML key path, model owning its last key, annotation at its end).
 
     Union tags in the loc (``nonlinearity.polynomial.K2``) are not YAML keys and are dropped.
@@ -79,8 +81,8 @@ def _walk(loc: tuple, root: type[BaseModel] = Study) -> tuple[Loc, type[BaseMode
     owner: type[BaseModel] = root
     annotation: Any = root
     for part in loc:
-        annotation = _strip(annotation)
-        members = _union_members(annotation)
+        annotation = strip(annotation)
+        members = union_members(annotation)
         if members:
             annotation = next((m for m in members if _tag(m) == part), None)
             continue
@@ -92,10 +94,10 @@ def _walk(loc: tuple, root: type[BaseModel] = Study) -> tuple[Loc, type[BaseMode
         else:
             args = get_args(annotation)
             annotation = args[0] if args[-1:] == (Ellipsis,) else (args[-1] if args else None)
-    return tuple(path), owner, _strip(annotation)
+    return tuple(path), owner, strip(annotation)
 
 
-def _strip(annotation: Any) -> Any:
+def strip(annotation: Any) -> Any:
     """``annotation`` without Annotated metadata and without ``| None``."""
     while True:
         if get_origin(annotation) is Annotated:
@@ -111,7 +113,7 @@ def _is_union(annotation: Any) -> bool:
     return get_origin(annotation) in (Union, types.UnionType)
 
 
-def _union_members(annotation: Any) -> list[type[BaseModel]]:
+def union_members(annotation: Any) -> list[type[BaseModel]]:
     """The models of a discriminated union, else []."""
     return list(get_args(annotation)) if _is_union(annotation) else []
 

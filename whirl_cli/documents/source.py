@@ -1,10 +1,10 @@
-"""A study (or sheet) file as YAML: bytes -> nodes -> plain Python data, with the node and
-line of every key.
+"""A YAML file (a study, a sheet, a model file): bytes -> nodes -> plain Python data, with the
+node and line of every key.
 
-Steps 1 to 3 of :mod:`whirl_cli.study`: :func:`_read_text` (at most :data:`MAX_BYTES` of UTF-8),
-:func:`_compose` (a SafeLoader subclass, :class:`_Loader`, that records anchors, aliases and
+Steps 1 to 3 of :mod:`whirl_cli.study`: :func:`read_text` (at most :data:`MAX_BYTES` of UTF-8),
+:func:`compose` (a SafeLoader subclass, :class:`_Loader`, that records anchors, aliases and
 non-core tags as problems and stops below :data:`MAX_DEPTH` levels of nesting) and
-:class:`_Tree` (the data, the problems found building it, and the node and line of every key
+:class:`Tree` (the data, the problems found building it, and the node and line of every key
 path, for the messages). Nothing here knows the schema.
 """
 
@@ -112,7 +112,7 @@ _Loader.add_implicit_resolver(
 )
 
 
-def _read_text(path: Path, label: str, what: str = "study") -> str:
+def read_text(path: Path, label: str, what: str = "study") -> str:
     """The file's text: at most MAX_BYTES of UTF-8 (errors name the file ``label``, and call
     it a ``what`` file)."""
     try:
@@ -123,7 +123,7 @@ def _read_text(path: Path, label: str, what: str = "study") -> str:
         reason = f"cannot read the {what} file ({error.strerror or error})"
         raise StudyError(f"{label}: {reason}") from None
     if len(raw) > MAX_BYTES:
-        raise StudyError(_too_large(label, size, what))
+        raise StudyError(too_large(label, size, what))
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as error:
@@ -131,11 +131,12 @@ def _read_text(path: Path, label: str, what: str = "study") -> str:
         raise StudyError(f"{label}: {reason}") from None
 
 
-def _too_large(name: str, size: int, what: str = "study") -> str:
+def too_large(name: str, size: int, what: str = "study") -> str:
+    """The message for a file of ``size`` bytes, over :data:`MAX_BYTES`."""
     return f"{name}: the {what} file is too large ({size} bytes; the limit is {MAX_BYTES})"
 
 
-def _compose(text: str, name: str, what: str = "study") -> MappingNode:
+def compose(text: str, name: str, what: str = "study") -> MappingNode:
     """The root node of ``text``; StudyError for problems that concern the whole file
     (``what``: the kind of file, a study or a sheet)."""
     try:
@@ -164,7 +165,7 @@ def _compose(text: str, name: str, what: str = "study") -> MappingNode:
     return root
 
 
-class _Tree:
+class Tree:
     """Python data built from the composed nodes, with the node and line of every key path."""
 
     def __init__(self, root: MappingNode) -> None:

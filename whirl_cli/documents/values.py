@@ -1,7 +1,7 @@
-"""Value checks of study keys: the Annotated types (``Name``, ``Number``, ``Range``, ...) that
-attach them to fields, and the strict base of every study model. A value check rejects a value
-with the reason a message shows (``{got}`` becomes the value as written in the YAML, see
-:mod:`whirl_cli.study.messages`).
+"""Value checks of YAML keys (studies, sheets, model files): the Annotated types (``Name``,
+``Number``, ``Range``, ...) that attach them to fields, and the strict base of every model. A
+value check rejects a value with the reason a message shows (``{got}`` becomes the value as
+written in the YAML, see :mod:`whirl_cli.documents.messages`).
 """
 
 from __future__ import annotations
@@ -15,8 +15,6 @@ from typing import Annotated, Any, NoReturn
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict
 from pydantic_core import PydanticCustomError
 
-from ..models import FAMILIES, is_known, is_model_file
-
 NAME_MAX = 64
 #: Largest integer AUTO-07p reads into its (32-bit) INTEGER constants (NMX, NTST, ITNW).
 FORTRAN_INT_MAX = 2**31 - 1
@@ -28,11 +26,12 @@ _NAME_REASON = (
 )
 
 
-def _is_number(value: Any) -> bool:
+def is_number(value: Any) -> bool:
+    """True for an int or float that is not a bool."""
     return isinstance(value, int | float) and not isinstance(value, bool)
 
 
-def _fail(reason: str, at: tuple[str | int, ...] = ()) -> NoReturn:
+def fail(reason: str, at: tuple[str | int, ...] = ()) -> NoReturn:
     """Reject a value; ``{got}`` in ``reason`` becomes the value as written in the YAML.
     ``at``: the key path, below the checked value, of the part at fault (a list item, a
     mapping's key), where the message is reported."""
@@ -41,52 +40,53 @@ def _fail(reason: str, at: tuple[str | int, ...] = ()) -> NoReturn:
 
 def _as_string(value: Any) -> str:
     if not isinstance(value, str):
-        _fail("expected a string, got {got}")
+        fail("expected a string, got {got}")
     return value
 
 
-def _as_number(value: Any) -> float:
+def as_number(value: Any) -> float:
+    """``value`` as a finite float, else the reason."""
     return _number(value, ())
 
 
 def _number(value: Any, at: tuple[str | int, ...]) -> float:
     """``value`` as a finite float; else the reason, reported at ``at`` below the value."""
-    if not _is_number(value):
-        _fail("expected a number, got {got}", at)
+    if not is_number(value):
+        fail("expected a number, got {got}", at)
     if not math.isfinite(value):
-        _fail("expected a finite number, got {got}", at)
+        fail("expected a finite number, got {got}", at)
     return float(value)
 
 
 def _as_integer(value: Any) -> int:
     if isinstance(value, bool) or not isinstance(value, int):
-        _fail("expected an integer, got {got}")
+        fail("expected an integer, got {got}")
     return value
 
 
 def _as_boolean(value: Any) -> bool:
     if not isinstance(value, bool):
-        _fail("expected true or false, got {got}")
+        fail("expected true or false, got {got}")
     return value
 
 
 def _as_name(value: Any) -> str:
     if not _NAME_RE.fullmatch(_as_string(value)):
-        _fail(_NAME_REASON)
+        fail(_NAME_REASON)
     if len(value) > NAME_MAX:
-        _fail(f"must be at most {NAME_MAX} characters, got {len(value)}")
+        fail(f"must be at most {NAME_MAX} characters, got {len(value)}")
     return value
 
 
 def _as_range(value: Any) -> tuple[float, float]:
     if not isinstance(value, list | tuple) or len(value) != 2:
-        _fail("expected [lower, upper], two numbers, got {value}")
+        fail("expected [lower, upper], two numbers, got {value}")
     lower, upper = (_number(v, (k,)) for k, v in enumerate(value))
     if not lower < upper:
-        _fail("expected [lower, upper] with lower < upper, got {value}")
+        fail("expected [lower, upper] with lower < upper, got {value}")
     if not (math.isfinite(upper - lower) and math.isfinite(lower - (upper - lower))
             and math.isfinite(upper + (upper - lower))):  # AUTO's bounds lie 5 % beyond
-        _fail("the range is too wide: its width overflows double precision, got {value}")
+        fail("the range is too wide: its width overflows double precision, got {value}")
     return lower, upper
 
 
@@ -94,16 +94,16 @@ def _state(value: Any, at: tuple[str | int, ...], example: str) -> dict[str, flo
     """A mapping state name -> finite number (a seed, an initial state), each value checked at
     its key; ``example``: the mapping's shape, for the message."""
     if not isinstance(value, dict) or not all(isinstance(k, str) for k in value):
-        _fail(f"expected a mapping state -> number, e.g. {example}, got {{got}}", at)
+        fail(f"expected a mapping state -> number, e.g. {example}, got {{got}}", at)
     return {k: _number(v, (*at, k)) for k, v in value.items()}
 
 
-def _as_seeds(value: Any) -> str | tuple[dict[str, float], ...]:
+def as_seeds(value: Any) -> str | tuple[dict[str, float], ...]:
     """``auto``, or a list of mappings state name -> finite number."""
     if value == "auto":
         return value
     if not isinstance(value, list):
-        _fail("expected `auto` or a list of mappings state -> number, e.g. [{{theta: 4}}], "
+        fail("expected `auto` or a list of mappings state -> number, e.g. [{{theta: 4}}], "
               "got {got}")
     return tuple(_state(seed, (k,), "{{theta: 4}}") for k, seed in enumerate(value))
 
@@ -119,27 +119,20 @@ SEEDS_TEXT = (
     "LCOs, which no Hopf point leads to).")
 
 
-def _as_state(value: Any) -> dict[str, float]:
+def as_state(value: Any) -> dict[str, float]:
     """A mapping state name -> finite number (the names are checked against the model)."""
     return _state(value, (), "{{theta: 2}}")
 
 
-def _at_most_orbits(values: tuple) -> tuple:
+def at_most_orbits(values: tuple) -> tuple:
+    """``values`` if there are at most :data:`ORBITS_MAX` of them."""
     if len(values) > ORBITS_MAX:
-        _fail(f"at most {ORBITS_MAX} values, got {len(values)}")
+        fail(f"at most {ORBITS_MAX} values, got {len(values)}")
     return values
 
 
-def _as_model_family(value: str) -> str:
-    if not is_known(value):
-        if is_model_file(value):
-            _fail("no model file {got}")
-        _fail(f"unknown model {{got}} (built-in: {', '.join(FAMILIES)}; or a model file "
-              "path ending in .yaml)")
-    return value
 
-
-def _bound(symbol: str, limit: float) -> AfterValidator:
+def bound(symbol: str, limit: float) -> AfterValidator:
     """A check that the value is ``symbol`` (>=, >, <=) ``limit``."""
     compare: Callable[[Any, Any], bool] = {
         ">=": operator.ge,
@@ -149,7 +142,7 @@ def _bound(symbol: str, limit: float) -> AfterValidator:
 
     def check(value: Any) -> Any:
         if not compare(value, limit):
-            _fail(f"must be {symbol} {limit}, got {{got}}")
+            fail(f"must be {symbol} {limit}, got {{got}}")
         return value
 
     return AfterValidator(check)
@@ -157,15 +150,16 @@ def _bound(symbol: str, limit: float) -> AfterValidator:
 
 Text = Annotated[str, BeforeValidator(_as_string)]
 Name = Annotated[str, BeforeValidator(_as_name)]
-Number = Annotated[float, BeforeValidator(_as_number)]
+Number = Annotated[float, BeforeValidator(as_number)]
 Integer = Annotated[int, BeforeValidator(_as_integer)]
 Boolean = Annotated[bool, BeforeValidator(_as_boolean)]
 Range = Annotated[tuple[float, float], BeforeValidator(_as_range)]
-Positive = Annotated[Number, _bound(">", 0)]
+Positive = Annotated[Number, bound(">", 0)]
 #: An AUTO step, a fraction of the continuation range's width.
-Step = Annotated[Positive, _bound("<=", 1)]
-ModelFamily = Annotated[Text, AfterValidator(_as_model_family)]
+Step = Annotated[Positive, bound("<=", 1)]
 
 
-class _Strict(BaseModel):
+class Strict(BaseModel):
+    """The base of every model read from YAML: unknown keys refused, frozen."""
+
     model_config = ConfigDict(extra="forbid", frozen=True)
