@@ -615,7 +615,9 @@ def test_phase_plane_of_the_first_two_states_any_names(orbit_branch):
 def test_phase_labels_at_most_twelve_user_points_first(orbit_branch):
     """A study's phase plane draws every orbit of a short family; of a long one 12: its user
     points (orbits_at, UZ) and the others spread along the branch, first and last included."""
-    assert files.phase_labels(orbit_branch) == [3, 5]
+    small = replace(orbit_branch, orbits=tuple(
+        replace(o, states=o.states * 0.5) for o in orbit_branch.orbits))  # within 20 deg
+    assert files.phase_labels(small) == [3, 5]
     orbits = tuple(replace(orbit_branch.orbits[0], label=k + 1, index=k,
                            point_type=int(PointType.UZ) if k in (7, 8) else 0)
                    for k in range(30))

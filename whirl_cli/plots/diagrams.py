@@ -17,7 +17,6 @@ from .key import (
     BOUNDARY_KEY,
     MARKER_STYLE,
     PLOT_KEY,
-    _colours,
     _new_figure,
     _plot_styled,
     axis_label,
@@ -25,6 +24,7 @@ from .key import (
     display_unit,
     is_neutral_line,
     log_scale_if_decades,
+    next_colour,
     stability_curves,
 )
 
@@ -308,12 +308,13 @@ def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str | No
     All of ``branch.orbits`` if ``labels`` is None, else those with these AUTO labels; drawn
     (and listed in the legend) in order of the principal parameter. Each curve is closed (its
     first point repeated at the end unless already equal), drawn solid if the branch is
-    stable at the orbit's row, dotted if not and dashed where its stability is unknown, in
-    the default colour cycle, and labelled
+    stable at the orbit's row, dotted if not and dashed where its stability is unknown, each
+    in its own colour (:func:`~whirl_cli.plots.key.next_colour`), and labelled
     ``"<parameter> = <value> (stable|unstable|stability unknown)"`` with the principal
     parameter (4 significant digits). Angles in degrees, rates in deg/s unless
     ``degrees`` is False; equal aspect when both axes have the same unit. Draws on ``ax`` if
-    given, else on a new figure; returns the figure. The title is ``title`` (None: the
+    given, else on a new figure (its legend then beside the axes, clear of the orbits);
+    returns the figure. The title is ``title`` (None: the
     branch's name).
     """
     if not branch.is_periodic:
@@ -336,9 +337,11 @@ def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str | No
     ix, iy = branch.state_names.index(x), branch.state_names.index(y)
     fx, unit_x = display_unit(branch.state_units[ix], degrees)
     fy, unit_y = display_unit(branch.state_units[iy], degrees)
+    own = ax is None
     if ax is None:
         ax = _new_figure().add_subplot()
-    for orbit, colour in zip(orbits, _colours(), strict=False):
+    for orbit in orbits:
+        colour = next_colour(ax.figure)
         states = np.asarray(orbit.states, dtype=float)
         if len(states) and not np.array_equal(states[0], states[-1]):
             states = np.vstack([states, states[:1]])
@@ -352,7 +355,10 @@ def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str | No
     ax.set_ylabel(axis_label(y, unit_y))
     if unit_x == unit_y:
         ax.set_aspect("equal", adjustable="datalim")
-    if orbits:
+    if orbits and own:  # beside the axes: never over an orbit
+        ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.02, 1.0),
+                  borderaxespad=0.0)
+    elif orbits:
         ax.legend(fontsize="small")
     ax.set_title(branch.name if title is None else title)
     return ax.figure

@@ -201,11 +201,14 @@ def slice_title(caption: Captions, boundary, k: int, value: float) -> str:
 
 
 def phase_labels(branch: Branch, most: int = PHASE_ORBITS) -> list[int]:
-    """Labels of the orbits a study's phase plane of ``branch`` draws, in branch order: all of
-    them if there are at most ``most``; else every orbit stored at an ``orbits_at`` value (UZ)
+    """Labels of the orbits a study's phase plane of ``branch`` draws, in branch order: of
+    the orbits within the small-angle range (:func:`small_angle`; all of them if none is),
+    all if there are at most ``most``; else every orbit stored at an ``orbits_at`` value (UZ)
     and, up to ``most`` in all, others evenly spread along the branch (first and last
     included)."""
     orbits = sorted(branch.orbits, key=lambda o: o.index)
+    within = [o for o in orbits if small_angle(branch, o)]
+    orbits = within or orbits
     if len(orbits) <= most:
         return [o.label for o in orbits]
     asked = [o for o in orbits if o.point_type == PointType.UZ]
@@ -214,6 +217,19 @@ def phase_labels(branch: Branch, most: int = PHASE_ORBITS) -> list[int]:
     picks = np.unique(np.linspace(0, len(others) - 1, room).round().astype(int)) if room else []
     chosen = {id(o) for o in asked} | {id(others[k]) for k in picks}
     return [o.label for o in orbits if id(o) in chosen]
+
+
+SMALL_ANGLE = float(np.radians(20.0))
+"""Largest angle [rad] of the small-angle range the models assume (sin and tan of it differ
+from it by 2 % and 4 %): a study's phase plane leaves out orbits that go beyond it."""
+
+
+def small_angle(branch: Branch, orbit) -> bool:
+    """Whether every angle state (unit rad) of ``orbit`` stays within :data:`SMALL_ANGLE`."""
+    angles = [k for k, unit in enumerate(branch.state_units) if unit == "rad"]
+    states = np.asarray(orbit.states, dtype=float)
+    return bool(not angles or not states.size
+                or np.nanmax(np.abs(states[:, angles])) <= SMALL_ANGLE)
 
 
 def state_for(continuation: ContinuationResult, state: str | None) -> str | None:

@@ -1,0 +1,73 @@
+"""The study plots checked from their own artists, after a draw: no text outside the canvas,
+legends clear of the data, special-point markers on a drawn branch and above the others,
+legend entries matching visible artists."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from matplotlib.colors import to_hex
+
+from whirl_cli.plots.diagrams import phase_plane
+from whirl_cli.plots.files import SMALL_ANGLE, phase_labels
+from whirl_cli.results import BranchKind, Orbit
+
+from .plot_data import make_branch
+
+
+def _orbit(label: int, index: int, value: float, radius: float) -> Orbit:
+    """An ellipse of ``radius`` rad in theta (half that in psi), 40 samples."""
+    phase = np.linspace(0.0, 2 * np.pi, 40, endpoint=False)
+    theta, psi = radius * np.cos(phase), 0.5 * radius * np.sin(phase)
+    return Orbit(label=label, point_type=0, index=index, parameters=np.array([value, 6.7]),
+                 period=0.2, time=phase / (2 * np.pi) * 0.2,
+                 states=np.column_stack([theta, psi, 10 * psi, 10 * theta]))
+
+
+def _family(radii) -> object:
+    """A periodic family with one stored orbit per radius (rad), the parameter rising."""
+    n = len(radii)
+    branch = make_branch("periodic_1", BranchKind.PERIODIC, np.linspace(0.3, 0.5, n),
+                         radii, np.ones(n))
+    return replace(branch, orbits=tuple(_orbit(k + 1, k, 0.3 + 0.2 * k / max(n - 1, 1), r)
+                                        for k, r in enumerate(radii)))
+
+
+def _display_points(ax) -> np.ndarray:
+    """Every vertex of ``ax``'s lines, in display coordinates."""
+    points = [line.get_xydata() for line in ax.lines if len(line.get_xdata())]
+    xy = np.concatenate(points)
+    return ax.transData.transform(xy[np.isfinite(xy).all(axis=1)])
+
+
+def _inside(points: np.ndarray, box) -> np.ndarray:
+    return ((points[:, 0] > box.x0) & (points[:, 0] < box.x1)
+            & (points[:, 1] > box.y0) & (points[:, 1] < box.y1))
+
+
+def test_phase_plane_legend_lies_clear_of_every_orbit():
+    figure = phase_plane(_family(np.linspace(0.02, 0.3, 12)))
+    figure.canvas.draw()
+    ax = figure.axes[0]
+    box = ax.get_legend().get_window_extent()
+    assert not _inside(_display_points(ax), box).any()
+    canvas = figure.bbox
+    assert canvas.x0 <= box.x0 and box.x1 <= canvas.x1
+
+
+def test_phase_plane_gives_each_orbit_its_own_colour():
+    ax = phase_plane(_family(np.linspace(0.02, 0.3, 12))).axes[0]
+    colours = [to_hex(line.get_color()) for line in ax.lines]
+    assert len(colours) == 12 and len(set(colours)) == 12
+
+
+def test_study_phase_plane_leaves_out_orbits_beyond_the_small_angle_range():
+    radii = [0.05, 0.2, 0.3, 0.6, 1.2]  # rad: 0.6 and 1.2 beyond 20 deg
+    family = _family(radii)
+    assert SMALL_ANGLE < 0.6
+    assert phase_labels(family) == [1, 2, 3]
+
+
+def test_study_phase_plane_keeps_its_orbits_when_none_is_small():
+    assert phase_labels(_family([0.6, 0.9, 1.2])) == [1, 2, 3]
