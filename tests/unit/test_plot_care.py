@@ -71,3 +71,49 @@ def test_study_phase_plane_leaves_out_orbits_beyond_the_small_angle_range():
 
 def test_study_phase_plane_keeps_its_orbits_when_none_is_small():
     assert phase_labels(_family([0.6, 0.9, 1.2])) == [1, 2, 3]
+
+
+def _texts_outside(figure) -> list[str]:
+    """The visible non-empty texts of ``figure`` that reach beyond its canvas, after a draw."""
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    canvas = figure.bbox
+    hidden = {id(tick.label1) for ax in figure.axes for axis in (ax.xaxis, ax.yaxis)
+              for tick in axis.get_major_ticks() + axis.get_minor_ticks()
+              if not _in_view(tick.get_loc(), axis.get_view_interval())}
+    out = []
+    for text in figure.findobj(lambda a: hasattr(a, "get_text") and hasattr(a, "get_wrap")):
+        if not text.get_visible() or not text.get_text().strip() or id(text) in hidden:
+            continue
+        box = text.get_window_extent(renderer)
+        if (box.x0 < canvas.x0 - 0.5 or box.x1 > canvas.x1 + 0.5
+                or box.y0 < canvas.y0 - 0.5 or box.y1 > canvas.y1 + 0.5):
+            out.append(text.get_text())
+    return out
+
+
+def _in_view(value, interval) -> bool:
+    """Whether a tick at ``value`` is drawn (within the axis's view ``interval``)."""
+    low, high = sorted(interval)
+    return low - 1e-9 * abs(high - low) <= value <= high + 1e-9 * abs(high - low)
+
+
+def test_freeplay_law_title_stays_on_the_canvas():
+    from whirl_cli.models import get_model
+    from whirl_cli.output.provenance import law_curve
+    from whirl_cli.plots.laws import law_plot
+
+    model = get_model("classical", ("freeplay", "polynomial"))
+    values = {"K_theta": 0.4, "delta_theta": 0.017453292519943295,
+              "epsilon_theta": 0.00017453292519943295, "K_in_theta": 0.0}
+    figure = law_plot(law_curve(model, values, "theta"))
+    assert _texts_outside(figure) == []
+
+
+def test_a_study_figure_wraps_a_long_title_onto_the_canvas():
+    from whirl_cli.plots.files import View, _viewed
+
+    long = "freeplay-pitch-airspeed: " + ", ".join(f"$K_{{{k}}}$ = 0.{k} N m/rad"
+                                                   for k in range(1, 9))
+    figure = _viewed(phase_plane(_family([0.05, 0.1]), title=long), View())
+    assert _texts_outside(figure) == []

@@ -149,7 +149,10 @@ def study_figures(result: StudyResult, kinds: tuple[str, ...], stem: str = "",
 
 def _viewed(figure: Figure, view: View) -> Figure:
     """``figure`` with ``view``'s axis limits on every axes (an equal-aspect axes then keeps
-    its aspect by its box, not by moving the limits)."""
+    its aspect by its box, not by moving the limits), its titles wrapped at the canvas edge
+    (a long one is never clipped)."""
+    for text in _titles(figure):
+        text.set_wrap(True)
     for ax in figure.axes:
         if (view.xlim or view.ylim) and ax.get_aspect() != "auto":
             ax.set_adjustable("box")
@@ -158,6 +161,12 @@ def _viewed(figure: Figure, view: View) -> Figure:
         if view.ylim is not None:
             ax.set_ylim(*view.ylim)
     return figure
+
+
+def _titles(figure: Figure) -> list:
+    """The figure's suptitle and every axes' titles (left, centre, right)."""
+    texts = [figure._suptitle] if getattr(figure, "_suptitle", None) is not None else []
+    return texts + [t for ax in figure.axes for t in (ax.title, ax._left_title, ax._right_title)]
 
 
 def _without_artefacts(result: StudyResult) -> StudyResult:
