@@ -117,3 +117,45 @@ def test_a_study_figure_wraps_a_long_title_onto_the_canvas():
                                                    for k in range(1, 9))
     figure = _viewed(phase_plane(_family([0.05, 0.1]), title=long), View())
     assert _texts_outside(figure) == []
+
+
+def _homoclinic_ending(saddle_theta: float):
+    """A periodic family ending at a homoclinic point (stored with the saddle's theta, off the
+    family's max there) beside a fold of cycles and a torus point at the same place."""
+    from whirl_cli.results import ContinuationResult, PointType, SpecialPoint
+
+    family = make_branch("periodic_1", BranchKind.PERIODIC, [0.3, 0.35, 0.4, 0.42, 0.43],
+                         [0.1, 0.15, 0.2, 0.25, 0.3], [1, 1, 1, 1, 1])
+
+    def point(kind, row, theta):
+        return SpecialPoint(branch="periodic_1", index=row, point_type=int(kind),
+                            parameter_names=("K1", "V"),
+                            parameters=family.parameters[row].copy(),
+                            state=np.array([theta, 0.0, 0.0, 0.0]), period=0.2, stable=True)
+
+    points = (point(PointType.HOMOCLINIC, 4, saddle_theta), point(PointType.LPC, 4, 0.3),
+              point(PointType.TR, 2, 0.2), point(PointType.LPC, 2, 0.2))
+    return ContinuationResult("k1", "one-parameter", (family,), points)
+
+
+def test_a_homoclinic_marker_lies_on_the_family_it_ends():
+    from whirl_cli.plots.diagrams import bifurcation_diagram
+
+    ax = bifurcation_diagram(_homoclinic_ending(saddle_theta=0.12)).axes[0]
+    (marker,) = [line for line in ax.lines if line.get_marker() == "^"]
+    curves = np.concatenate([line.get_xydata() for line in ax.lines
+                             if line.get_marker() in ("None", "", None)])
+    for xy in marker.get_xydata():
+        assert np.isclose(curves, xy, rtol=1e-9, atol=1e-12).all(axis=1).any()
+
+
+def test_torus_and_global_markers_lie_above_a_fold_at_the_same_place():
+    from whirl_cli.plots.diagrams import bifurcation_diagram
+
+    ax = bifurcation_diagram(_homoclinic_ending(saddle_theta=0.12)).axes[0]
+    (homoclinic,) = [line for line in ax.lines if line.get_marker() == "^"]
+    (torus,) = [line for line in ax.lines if line.get_marker() == "o"
+                and line.get_markerfacecolor() == "none"]
+    (fold,) = [line for line in ax.lines if line.get_marker() == "o" and line is not torus]
+    assert torus.get_zorder() > fold.get_zorder() and homoclinic.get_zorder() > fold.get_zorder()
+    assert torus.get_markersize() > fold.get_markersize()  # a ring around the fold, not under it

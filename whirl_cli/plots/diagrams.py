@@ -128,7 +128,8 @@ def _shade_overhangs(ax: Axes, bands: list[tuple[float, float]], unit: str):
                    zorder=0)
         ax.annotate(f"{high - low:.3g} {unit}".strip(), xy=((low + high) / 2, 1.0),
                     xycoords=("data", "axes fraction"), xytext=(0, -3),
-                    textcoords="offset points", ha="center", va="top", fontsize="small")
+                    textcoords="offset points", ha="center", va="top", fontsize="small",
+                    annotation_clip=True, in_layout=False)  # inside the axes, or not drawn
     return Patch(color=style["color"], alpha=OVERHANG_ALPHA, linewidth=0)
 
 
@@ -384,8 +385,10 @@ def _draw_special_points(ax: Axes, continuation: ContinuationResult, branches: l
                          state: str, degrees: bool, first: dict) -> None:
     """Markers for special points, one artist per marker style.
 
-    A point's state is read by the state names of its branch (or of the first plotted branch if
-    its branch is not among them); points not on the x-axis parameter are skipped.
+    A point at a row of a drawn branch (:func:`_at_row`) sits on that branch's curve there (a
+    global point stores the saddle's state, not the orbit's max); any other at its own state,
+    read by the state names of its branch (or of the first plotted branch if its branch is
+    not among them). Points not on the x-axis parameter are skipped.
     """
     by_name = {b.name: b for b in branches}
     x_name = branches[0].parameter_names[0] if branches else None
@@ -397,13 +400,24 @@ def _draw_special_points(ax: Axes, continuation: ContinuationResult, branches: l
             continue
         index = branch.state_names.index(state)
         factor, _ = display_unit(branch.state_units[index], degrees)
-        xy = (float(point.parameters[0]), float(point.state[index]) * factor)
+        y = branch.state(state)[point.index] if _at_row(point, branch) else point.state[index]
+        xy = (float(point.parameters[0]), float(y) * factor)
         if np.all(np.isfinite(xy)):
             points.setdefault(style, []).append(xy)
     for style in PLOT_KEY:
         if style in points:
             xs, ys = np.array(points[style]).T
             _plot_styled(ax, xs, ys, style, first)
+
+
+def _at_row(point, branch: Branch) -> bool:
+    """Whether ``point`` lies on ``branch`` at its row ``index``: the branch is its own and
+    the row's principal parameter is the point's (to 1e-6 of the branch's span)."""
+    if point.branch != branch.name or not 0 <= point.index < len(branch):
+        return False
+    x = branch.parameters[:, 0]
+    gap = abs(float(x[point.index]) - float(point.parameters[0]))
+    return gap <= 1e-6 * max(float(np.ptp(x)), 1e-300)
 
 
 def _point_type(code: int) -> PointType | None:
