@@ -159,3 +159,67 @@ def test_torus_and_global_markers_lie_above_a_fold_at_the_same_place():
     (fold,) = [line for line in ax.lines if line.get_marker() == "o" and line is not torus]
     assert torus.get_zorder() > fold.get_zorder() and homoclinic.get_zorder() > fold.get_zorder()
     assert torus.get_markersize() > fold.get_markersize()  # a ring around the fold, not under it
+
+
+def _unseen_entries(ax) -> list[str]:
+    """The entries of ``ax``'s legend whose artist shows nothing inside the axes after a draw:
+    a line or marker with no vertex in the axes' box, an error bar narrower than a marker."""
+    from matplotlib.container import ErrorbarContainer
+    from matplotlib.lines import Line2D
+
+    ax.figure.canvas.draw()
+    box = ax.get_window_extent()
+    marker_px = 8.0 * ax.figure.dpi / 72.0
+    legend = ax.get_legend()
+    unseen = []
+    for handle, text in zip(legend.legend_handles, legend.get_texts(), strict=True):
+        artist = next((a for a in [*ax.lines, *ax.containers]
+                       if a is handle or a.get_label() in (text.get_text(),
+                                                             "_" + text.get_text())), handle)
+        if isinstance(artist, ErrorbarContainer):
+            (bars,) = artist.lines[2]
+            xy = ax.transData.transform(np.concatenate(bars.get_segments()))
+            if np.ptp(xy[:, 0]) < marker_px:
+                unseen.append(text.get_text())
+        elif isinstance(artist, Line2D) and artist.axes is ax:
+            xy = artist.get_xydata()
+            xy = ax.transData.transform(xy[np.isfinite(xy).all(axis=1)])
+            if not _inside(xy, box.expanded(1.001, 1.001)).any():
+                unseen.append(text.get_text())
+    return unseen
+
+
+def _bracketed_heteroclinic(width: float):
+    """A periodic family whose period blows up at a heteroclinic point bracketed ``width``
+    wide."""
+    from whirl_cli.results import ContinuationResult, LocateStatus, PointType, SpecialPoint
+
+    family = replace(make_branch("periodic_1", BranchKind.PERIODIC, [0.3, 0.35, 0.4, 0.42,
+                                                                     0.43],
+                                 [0.1, 0.15, 0.2, 0.25, 0.3], [1, 1, 1, 1, 1]),
+                     period=np.array([0.2, 0.3, 0.5, 1.0, 3.0]))
+    point = SpecialPoint(branch="periodic_1", index=4, point_type=int(PointType.HETEROCLINIC),
+                         parameter_names=("K1", "V"), parameters=np.array([0.43, 6.7]),
+                         state=np.zeros(4), period=np.nan, stable=False,
+                         status=LocateStatus.BRACKETED,
+                         bracket=np.array([0.43, 0.43 + width]), residual=0.01)
+    return ContinuationResult("k1", "one-parameter", (family,), (point,))
+
+
+def test_a_period_plot_lists_no_bracket_too_narrow_to_be_seen():
+    from whirl_cli.plots.diagrams import period_plot
+
+    ax = period_plot(_bracketed_heteroclinic(3e-8)).axes[0]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "heteroclinic" in labels and not any("bracket" in label for label in labels)
+    assert _unseen_entries(ax) == []
+
+
+def test_every_legend_entry_of_the_study_diagrams_shows_in_its_axes():
+    from whirl_cli.plots.diagrams import bifurcation_diagram, period_plot
+
+    wide = period_plot(_bracketed_heteroclinic(0.02)).axes[0]
+    assert any("bracket" in t.get_text() for t in wide.get_legend().get_texts())
+    for ax in (wide, bifurcation_diagram(_homoclinic_ending(0.12)).axes[0],
+               phase_plane(_family([0.05, 0.1, 0.2])).axes[0]):
+        assert _unseen_entries(ax) == []

@@ -226,7 +226,8 @@ def period_plot(continuation: ContinuationResult, title: str | None = None,
     (the branch's period at the point's row if the point has none), Hopf points with a finite
     period (where periodic branches are born), and HOMOCLINIC/HETEROCLINIC at (their parameter
     estimate, the period at the last point of their branch). A "bracketed" global point also
-    gets its bracket drawn as a horizontal error bar at the top of the data. The y-axis is
+    gets its bracket drawn as a horizontal error bar at the top of the data, if wide enough to
+    be seen beside its marker (:data:`BRACKET_VISIBLE`). The y-axis is
     logarithmic if the largest period exceeds 20 times the smallest. Without periodic branches
     the axes stay empty. Title: ``title`` (None: ``"<continuation>: period"``). Draws on ``ax``
     if given, else on a new figure; returns the figure.
@@ -243,6 +244,7 @@ def period_plot(continuation: ContinuationResult, title: str | None = None,
     periods = np.concatenate([b.period for b in periodic]) if periodic else np.array([])
     periods = periods[np.isfinite(periods) & (periods > 0)]
     points, brackets = _period_points(continuation, periodic)
+    brackets = _visible_brackets(brackets, continuation)
     for style in PLOT_KEY:
         if style in points:
             xs, ys = np.array(points[style]).T
@@ -265,6 +267,19 @@ def period_plot(continuation: ContinuationResult, title: str | None = None,
         ax.legend(handles, labels, fontsize="small")
     ax.set_title(f"{continuation.name}: period" if title is None else title)
     return ax.figure
+
+
+#: A bracket narrower than this fraction of the continuation's span is not drawn (nor listed):
+#: it would be a dot under its point's marker.
+BRACKET_VISIBLE = 0.005
+
+
+def _visible_brackets(brackets: list[tuple[float, float]], continuation: ContinuationResult
+                      ) -> list[tuple[float, float]]:
+    """The ``brackets`` wide enough to be seen beside their marker (:data:`BRACKET_VISIBLE`)."""
+    values = [b.parameters[:, 0] for b in continuation.branches if b.is_periodic and len(b)]
+    span = float(np.ptp(np.concatenate(values))) if values else 0.0
+    return [(low, high) for low, high in brackets if high - low > BRACKET_VISIBLE * span]
 
 
 def _period_points(continuation: ContinuationResult, periodic: list[Branch]
