@@ -223,3 +223,18 @@ def test_every_legend_entry_of_the_study_diagrams_shows_in_its_axes():
     for ax in (wide, bifurcation_diagram(_homoclinic_ending(0.12)).axes[0],
                phase_plane(_family([0.05, 0.1, 0.2])).axes[0]):
         assert _unseen_entries(ax) == []
+
+
+def test_sheet_captions_name_the_parameters_as_the_axes_do():
+    """whirl's axes read K_theta; a caption says K_theta too (the thesis's K1 only as such)."""
+    import re
+    from pathlib import Path
+
+    from whirl_cli.figures.sheet import load_sheet
+
+    sheets = sorted((Path(__file__).resolve().parents[2] / "sheets" / "thesis_ch3").glob(
+        "fig3_*.yaml"))
+    assert len(sheets) == 28
+    bare = {path.name: load_sheet(path).caption for path in sheets
+            if re.search(r"(?<!thesis's )\bK1\b", load_sheet(path).caption)}
+    assert bare == {}
