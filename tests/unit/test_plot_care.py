@@ -238,3 +238,34 @@ def test_sheet_captions_name_the_parameters_as_the_axes_do():
     bare = {path.name: load_sheet(path).caption for path in sheets
             if re.search(r"(?<!thesis's )\bK1\b", load_sheet(path).caption)}
     assert bare == {}
+
+
+def test_four_cuts_under_a_diagram_at_journal_width_keep_their_size():
+    """At 7.2 in (a double journal column) four phase cuts under a diagram go in one row, each
+    at least an inch on a side, instead of a 2 x 2 grid that collapses."""
+    from whirl_cli.plots.cuts import phase_cuts
+    from whirl_cli.plots.key import _new_figure
+
+    from .plot_data import hopf_continuation
+
+    figure = _new_figure(figsize=(7.2, 6.6))
+    grid = figure.add_gridspec(2, 1)
+    figure.add_subplot(grid[0]).plot([0, 1], [0, 1])
+    axes = phase_cuts(hopf_continuation(), [0.1, 0.2, 0.3, 0.45], grid[1])
+    figure.canvas.draw()
+    boxes = [ax.get_window_extent() for ax in axes]
+    inch = figure.dpi
+    assert len({round(box.y0) for box in boxes}) == 1  # one row
+    assert all(box.width >= 0.8 * inch and box.height >= 0.8 * inch for box in boxes)
+
+
+def test_the_small_panel_sheets_are_set_for_a_double_column():
+    from pathlib import Path
+
+    from whirl_cli.figures.sheet import COLUMNS, load_sheet
+
+    folder = Path(__file__).resolve().parents[2] / "sheets" / "thesis_ch3"
+    for number in ("16", "21", "24", "26"):
+        sheet = load_sheet(folder / f"fig3_{number}.yaml")
+        assert sheet.column == "double" and sheet.figure_size[0] == COLUMNS["double"]
+        assert sheet.shape[1] == 1  # the diagram above its small panels, not beside them

@@ -166,7 +166,8 @@ def _draw_bifurcation(ax: Axes, continuation: ContinuationResult, branches: list
 def projections_figure(continuation: ContinuationResult, which: Sequence[str] = ("max",),
                        degrees: bool = True, title: str | None = None,
                        region: SubplotSpec | None = None) -> Figure:
-    """One bifurcation diagram per state on a grid of ceil(n/2) x 2 axes sharing the x-axis.
+    """One bifurcation diagram per state on a grid of ceil(n/2) x 2 axes sharing the x-axis
+    (in a ``region`` wide enough for them, one row: :func:`~whirl_cli.plots.cuts.grid_columns`).
 
     The states are those common to every plotted (equilibrium or periodic) branch, in the order
     of the first; each panel is :func:`bifurcation_diagram` of one state (angles in deg, rates in
@@ -178,13 +179,18 @@ def projections_figure(continuation: ContinuationResult, which: Sequence[str] = 
     of a new figure.
     """
     states = _common_states(continuation)
-    rows = max(1, -(-len(states) // 2))
+    columns = 2
+    if region is not None:
+        from .cuts import grid_columns
+
+        columns = max(2, grid_columns(len(states), region)) if len(states) >= 4 else 2
+    rows = max(1, -(-len(states) // columns))
     if region is None:
         figure = _new_figure(figsize=(10.0, 3.2 * rows + 0.6), layout="constrained")
         grid = figure.add_gridspec(rows, 2)
     else:
         figure = region.get_gridspec().figure
-        grid = region.subgridspec(rows, 2)
+        grid = region.subgridspec(rows, columns)
     title = continuation.name if title is None else title
     if not states:
         figure.add_subplot(grid[:, :]).set_title(title)
@@ -195,11 +201,12 @@ def projections_figure(continuation: ContinuationResult, which: Sequence[str] = 
         ax.set_title("")
         if k > 0 and ax.get_legend() is not None:
             ax.get_legend().remove()
-        if k < len(states) - 2:  # another panel below in the same column
+        if k < len(states) - columns:  # another panel below in the same column
             ax.set_xlabel("")
     for ax in axes[len(states):]:
         figure.delaxes(ax)
-    if len(states) % 2 and len(states) > 1:  # lone last panel: label its neighbour's x
+    if columns == 2 and len(states) % 2 and len(states) > 1:  # lone last panel: label its
+        # neighbour's x
         axes[len(states) - 2].xaxis.set_tick_params(labelbottom=True)
         axes[len(states) - 2].set_xlabel(axes[len(states) - 1].get_xlabel())
     if region is None:
