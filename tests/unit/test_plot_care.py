@@ -269,3 +269,25 @@ def test_the_small_panel_sheets_are_set_for_a_double_column():
         sheet = load_sheet(folder / f"fig3_{number}.yaml")
         assert sheet.column == "double" and sheet.figure_size[0] == COLUMNS["double"]
         assert sheet.shape[1] == 1  # the diagram above its small panels, not beside them
+
+
+def test_a_figure_legend_lists_a_marker_drawn_alike_on_two_panels_once():
+    """Panel (a) says "heteroclinic", panel (b) "heteroclinic (whirl: ...)" for the same
+    hollow triangle: the sheet's legend lists it once, with the fuller label; a different
+    marker keeps its own entry."""
+    from whirl_cli.figures.draw import figure_legend
+    from whirl_cli.plots.key import _new_figure
+
+    figure = _new_figure()
+    left, right = figure.subplots(1, 2)
+    style = {"marker": "^", "markerfacecolor": "none", "markeredgecolor": "black",
+             "linestyle": "none"}
+    left.plot([0.1], [1.0], **style, label="heteroclinic")
+    left.plot([0.2], [1.0], marker="^", color="black", linestyle="none", label="homoclinic")
+    right.plot([0.1], [1.0], **style, label="heteroclinic (whirl: K = 0.0777)")
+    for ax in (left, right):
+        ax.legend()
+    figure_legend(figure)
+    (legend,) = figure.legends
+    assert [t.get_text() for t in legend.get_texts()] == [
+        "heteroclinic (whirl: K = 0.0777)", "homoclinic"]
