@@ -291,3 +291,40 @@ def test_a_figure_legend_lists_a_marker_drawn_alike_on_two_panels_once():
     (legend,) = figure.legends
     assert [t.get_text() for t in legend.get_texts()] == [
         "heteroclinic (whirl: K = 0.0777)", "homoclinic"]
+
+
+def _crowded(axes_count: int):
+    """A figure of ``axes_count`` axes, each filled by a dense grid of points and a legend."""
+    from whirl_cli.plots.key import _new_figure
+
+    figure = _new_figure()
+    grid = np.linspace(0.0, 1.0, 30)
+    xs, ys = np.meshgrid(grid, grid)
+    for ax in figure.subplots(1, axes_count, squeeze=False).ravel():
+        ax.plot(xs.ravel(), ys.ravel(), ".", label="every point")
+        ax.plot(grid, grid, "-", label="a line")
+        ax.legend()
+    return figure
+
+
+def test_a_study_figure_moves_a_legend_off_its_data_beside_its_axes():
+    from whirl_cli.plots.files import View, _viewed
+
+    figure = _viewed(_crowded(1), View())
+    figure.canvas.draw()
+    ax = figure.axes[0]
+    box = ax.get_legend().get_window_extent()
+    assert not _inside(_display_points(ax), box).any()
+    assert box.x1 <= figure.bbox.x1 and _texts_outside(figure) == []
+
+
+def test_a_study_figure_of_several_axes_gathers_covering_legends_below_them():
+    from whirl_cli.plots.files import View, _viewed
+
+    figure = _viewed(_crowded(2), View())
+    figure.canvas.draw()
+    assert all(ax.get_legend() is None for ax in figure.axes)
+    (legend,) = figure.legends
+    box = legend.get_window_extent()
+    assert all(box.y1 <= ax.get_window_extent().y0 for ax in figure.axes)
+    assert _texts_outside(figure) == []

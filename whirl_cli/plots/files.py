@@ -150,7 +150,7 @@ def study_figures(result: StudyResult, kinds: tuple[str, ...], stem: str = "",
 def _viewed(figure: Figure, view: View) -> Figure:
     """``figure`` with ``view``'s axis limits on every axes (an equal-aspect axes then keeps
     its aspect by its box, not by moving the limits), its titles wrapped at the canvas edge
-    (a long one is never clipped)."""
+    (a long one is never clipped) and its legends off the data (:func:`legends_off_data`)."""
     for text in _titles(figure):
         text.set_wrap(True)
     for ax in figure.axes:
@@ -160,7 +160,58 @@ def _viewed(figure: Figure, view: View) -> Figure:
             ax.set_xlim(*view.xlim)
         if view.ylim is not None:
             ax.set_ylim(*view.ylim)
+    legends_off_data(figure)
     return figure
+
+
+def legends_off_data(figure: Figure) -> None:
+    """Move every axes legend that lies over drawn data (a vertex of a line, a point of a
+    collection, found by drawing ``figure`` once) off it: beside the axes if the figure has
+    one axes, else below all of them as one legend of the figure (each entry once)."""
+    legends = [(ax, ax.get_legend()) for ax in figure.axes if ax.get_legend() is not None]
+    if not legends:
+        return
+    figure.canvas.draw()
+    covering = [(ax, legend) for ax, legend in legends if _over_data(ax, legend)]
+    if len(figure.axes) == 1:
+        for ax, legend in covering:
+            legend.set_loc("upper left")
+            legend.set_bbox_to_anchor((_right_of_texts(ax) + 0.02, 1.0),
+                                      transform=ax.transAxes)
+        return
+    entries: dict[str, object] = {}
+    for _, legend in covering:
+        for handle, text in zip(legend.legend_handles, legend.get_texts(), strict=False):
+            entries.setdefault(text.get_text(), handle)
+        legend.remove()
+    if entries:
+        figure.legend(list(entries.values()), list(entries), loc="outside lower center",
+                      fontsize="small", ncols=min(len(entries), 3), frameon=False)
+
+
+def _right_of_texts(ax) -> float:
+    """The right edge, in axes fractions, of ``ax`` and of its texts drawn beside it (labels
+    of the cases of a boundary map), 1.0 if none is."""
+    box = ax.get_window_extent()
+    right = max([box.x1, *(t.get_window_extent().x1 for t in ax.texts if t.get_visible())])
+    return 1.0 + (right - box.x1) / max(box.width, 1.0)
+
+
+def _over_data(ax, legend) -> bool:
+    """Whether ``legend`` (drawn) covers a vertex of ``ax``'s lines or a point of its
+    collections."""
+    box = legend.get_window_extent()
+    drawn = [(line.get_transform(), line.get_xydata()) for line in ax.lines
+             if line.get_visible() and len(line.get_xdata())]
+    drawn += [(c.get_offset_transform(), c.get_offsets()) for c in ax.collections
+              if c.get_visible() and len(c.get_offsets())]
+    for transform, data in drawn:
+        xy = np.asarray(data, dtype=float).reshape(-1, 2)
+        xy = transform.transform(xy[np.isfinite(xy).all(axis=1)])
+        if ((xy[:, 0] > box.x0) & (xy[:, 0] < box.x1) & (xy[:, 1] > box.y0)
+                & (xy[:, 1] < box.y1)).any():
+            return True
+    return False
 
 
 def _titles(figure: Figure) -> list:
