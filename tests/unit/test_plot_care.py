@@ -328,3 +328,20 @@ def test_a_study_figure_of_several_axes_gathers_covering_legends_below_them():
     box = legend.get_window_extent()
     assert all(box.y1 <= ax.get_window_extent().y0 for ax in figure.axes)
     assert _texts_outside(figure) == []
+
+
+def test_the_letters_of_close_cuts_do_not_overlap_on_a_short_diagram():
+    """Three cuts within 2 % of the axis (3.26: 0.075, 0.0777, 0.09 of 0.8) on a 2 in tall
+    diagram: their letters' boxes are disjoint."""
+    from whirl_cli.plots.cuts import mark_cuts
+    from whirl_cli.plots.key import _new_figure
+
+    ax = _new_figure(figsize=(7.2, 2.0)).add_subplot()
+    ax.plot([-0.3, 0.5], [-10.0, 10.0])
+    mark_cuts(ax, [0.075, 0.0777, 0.09])
+    ax.figure.canvas.draw()
+    boxes = [text.get_window_extent() for text in ax.texts]
+    assert len(boxes) == 3
+    for a in range(3):
+        for b in range(a + 1, 3):
+            assert not boxes[a].overlaps(boxes[b])

@@ -250,10 +250,19 @@ def grid_columns(count: int, region) -> int:
 
 def mark_cuts(ax: Axes, values: Sequence[float]) -> None:
     """Each cut as a thin dashed vertical line on a diagram, lettered at its foot (the letters
-    of neighbouring cuts at staggered heights)."""
+    of cuts next to each other along the axis a line of text apart, in turn on three
+    levels)."""
+    from matplotlib.font_manager import FontProperties
+
+    line = _CUT_LABEL_LINES * FontProperties(size="small").get_size_in_points()
+    order = np.argsort(np.asarray(values, dtype=float), kind="stable")
+    level = {int(k): rank % 3 for rank, k in enumerate(order)}
     for k, value in enumerate(values):
         ax.axvline(float(value), color="dimgrey", linestyle=(0, (4, 3)), linewidth=0.8,
                    zorder=1, label="_cut")
-        ax.annotate(f"({_LETTERS[k % 26]})", xy=(float(value), 0.045 * (k % 3)),
-                    xycoords=("data", "axes fraction"), xytext=(2, 3),
+        ax.annotate(f"({_LETTERS[k % 26]})", xy=(float(value), 0.0),
+                    xycoords=("data", "axes fraction"), xytext=(2, 3 + line * level[k]),
                     textcoords="offset points", fontsize="small", ha="left", va="bottom")
+
+
+_CUT_LABEL_LINES = 1.2  # the step between the levels of the cuts' letters, lines of text
