@@ -11,7 +11,7 @@ from matplotlib.colors import to_hex
 
 from whirl_cli.plots.diagrams import phase_plane
 from whirl_cli.plots.files import SMALL_ANGLE, phase_labels
-from whirl_cli.results import BranchKind, Orbit
+from whirl_cli.results import BranchKind, Orbit, PointType
 
 from .plot_data import make_branch
 
@@ -67,6 +67,10 @@ def test_study_phase_plane_leaves_out_orbits_beyond_the_small_angle_range():
     family = _family(radii)
     assert SMALL_ANGLE < 0.6
     assert phase_labels(family) == [1, 2, 3]
+    asked = replace(family, orbits=tuple(
+        replace(o, point_type=int(PointType.UZ)) if o.label == 5 else o
+        for o in family.orbits))
+    assert phase_labels(asked) == [1, 2, 3, 5]  # an orbit orbits_at asked for stays
 
 
 def test_study_phase_plane_keeps_its_orbits_when_none_is_small():

@@ -262,12 +262,12 @@ def slice_title(caption: Captions, boundary, k: int, value: float) -> str:
 
 def phase_labels(branch: Branch, most: int = PHASE_ORBITS) -> list[int]:
     """Labels of the orbits a study's phase plane of ``branch`` draws, in branch order: of
-    the orbits within the small-angle range (:func:`small_angle`; all of them if none is),
-    all if there are at most ``most``; else every orbit stored at an ``orbits_at`` value (UZ)
-    and, up to ``most`` in all, others evenly spread along the branch (first and last
-    included)."""
+    the orbits within the small-angle range (:func:`small_angle`; all of them if none is)
+    and those stored at an ``orbits_at`` value (UZ), all if there are at most ``most``; else
+    every UZ orbit and, up to ``most`` in all, others evenly spread along the branch (first
+    and last included)."""
     orbits = sorted(branch.orbits, key=lambda o: o.index)
-    within = [o for o in orbits if small_angle(branch, o)]
+    within = [o for o in orbits if o.point_type == PointType.UZ or small_angle(branch, o)]
     orbits = within or orbits
     if len(orbits) <= most:
         return [o.label for o in orbits]
