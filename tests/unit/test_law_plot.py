@@ -42,7 +42,7 @@ def test_freeplay_law_smoothed_exact_and_their_largest_difference():
     ax = figure.axes[0]
     assert ax.get_xlabel() == "$\\theta$ [deg]"
     assert ax.get_ylabel() == "restoring force on theta [N m]"
-    assert "freeplay law on theta" in ax.get_title()
+    assert "freeplay law on $\\theta$" in ax.get_title()
 
 
 def test_numeric_smoothed_law_is_the_symbolic_one():
@@ -65,7 +65,7 @@ def test_polynomial_law_and_which_laws_a_result_draws():
     x = np.radians(lines["law"].get_xdata())
     np.testing.assert_allclose(lines["law"].get_ydata(), 0.2 * x + 10 * x**3 + 350 * x**5,
                                rtol=1e-12)
-    np.testing.assert_allclose(lines["linear spring (K_theta = 0.2)"].get_ydata(), 0.2 * x)
+    np.testing.assert_allclose(lines["linear spring ($K_{\\theta}$ = 0.2)"].get_ydata(), 0.2 * x)
     study = ("name: s\nmodel: classical\nnonlinearity: {type: polynomial, dof: psi, K2: 5}\n")
     result = StudyResult("s", "classical_poly", (), (), (),
                          provenance=provenance(validate_text(study)))

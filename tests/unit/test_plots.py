@@ -615,7 +615,9 @@ def test_phase_plane_of_the_first_two_states_any_names(orbit_branch):
 def test_phase_labels_at_most_twelve_user_points_first(orbit_branch):
     """A study's phase plane draws every orbit of a short family; of a long one 12: its user
     points (orbits_at, UZ) and the others spread along the branch, first and last included."""
-    assert files.phase_labels(orbit_branch) == [3, 5]
+    small = replace(orbit_branch, orbits=tuple(
+        replace(o, states=o.states * 0.5) for o in orbit_branch.orbits))  # within 20 deg
+    assert files.phase_labels(small) == [3, 5]
     orbits = tuple(replace(orbit_branch.orbits[0], label=k + 1, index=k,
                            point_type=int(PointType.UZ) if k in (7, 8) else 0)
                    for k in range(30))
@@ -768,12 +770,26 @@ def test_boundary_plot_case_lines_and_labels():
     assert all(line_style(line)[0] == "black" for line in dotted)
     labels = {text.get_text(): text for text in ax.texts}
     assert sorted(labels) == [f"case {k}" for k in range(1, 6)]
-    heights = [labels[f"case {k}"].get_position()[1] for k in range(1, 6)]
-    assert heights[:3] == pytest.approx([0.8, 0.6, 0.4])  # axes fractions of 0.4, 0.3, 0.2
-    assert all(x > 1.0 for x, _ in (text.get_position() for text in ax.texts))  # right edge
-    assert heights[0] > heights[1] > heights[2] > heights[3] > heights[4]
-    assert heights[3] - heights[4] >= 0.04 - 1e-12  # close cases pushed apart
+    ax.figure.canvas.draw()
+    boxes = [labels[f"case {k}"].get_window_extent() for k in range(1, 6)]
+    centres = [(box.y0 + box.y1) / 2 for box in boxes]
+    at_case = ax.transData.transform([(0.0, v) for v in CASES[:3]])[:, 1]
+    assert centres[:3] == pytest.approx(at_case, abs=0.5)  # 0.4, 0.3, 0.2 at their lines
+    assert all(box.x0 > ax.get_window_extent().x1 for box in boxes)  # right of the axes
+    assert all(low.y1 <= high.y0 for low, high in zip(boxes[1:], boxes, strict=False))
     assert "case" not in " ".join(legend_labels(ax))
+
+
+def test_close_case_labels_stay_apart_on_a_short_panel():
+    """On a short sheet panel the labels of cases 4 and 5 (0.05 and 0.037) do not overlap."""
+    from whirl_cli.plots.key import _new_figure
+
+    ax = _new_figure(figsize=(6.0, 2.2)).add_subplot()
+    boundary_plot(make_boundary(), make_grid(), cases=CASES, ax=ax)
+    ax.figure.canvas.draw()
+    boxes = sorted((text.get_window_extent() for text in ax.texts), key=lambda box: box.y0)
+    assert len(boxes) == 5
+    assert all(low.y1 <= high.y0 for low, high in zip(boxes, boxes[1:], strict=False))
 
 
 def test_boundary_plot_cases_outside_limits_are_not_labelled():

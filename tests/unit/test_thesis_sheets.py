@@ -169,6 +169,24 @@ def test_3_12_arrows_point_the_way_k_theta_increases_and_the_axes_lie_under_the_
     assert any("increasing" in t.get_text() for t in ax.texts)
 
 
+def test_3_12_arrows_keep_clear_of_the_crossing_and_coalescence_markers():
+    """No arrow of 3.12 (main axes or zoom) passes within a marker's size (8 pt) plus a bit
+    of a crossing square or the coalescence diamond, measured on the figure as drawn."""
+    figure = drawn("3.12")
+    figure.canvas.draw()
+    reach = 10.0 * figure.dpi / 72.0  # pixels
+    ax = figure.axes[0]
+    for axes in (ax, *ax.child_axes):
+        marks = np.concatenate([_marked(axes, "s"), _marked(axes, "D")])
+        centres = axes.transData.transform(marks)
+        for arrow in (t for t in axes.texts if getattr(t, "arrow_patch", None) is not None):
+            tail, head = axes.transData.transform([arrow.xyann, arrow.xy])
+            along = head - tail
+            t = np.clip((centres - tail) @ along / max(float(along @ along), 1e-300), 0, 1)
+            gaps = np.hypot(*(centres - (tail + t[:, None] * along)).T)
+            assert gaps.min() >= reach
+
+
 def _mode_sense(values: dict, highest: bool) -> int:
     """+1 (counterclockwise) or -1: the sense in which the hub, (y, z) = (-psi, -theta),
     turns in the plane drawn y right, z up, for the lower (or ``highest``) oscillatory mode

@@ -90,9 +90,39 @@ def figure_legend(figure: Figure) -> None:
         legend.remove()
     if not entries:
         return
+    entries = _one_per_style(entries)
     columns = _legend_columns(list(entries), figure.get_size_inches()[0])
     figure.legend(list(entries.values()), list(entries), loc="outside lower center",
                   ncols=columns, fontsize="small", frameon=False)
+
+
+def _one_per_style(entries: dict[str, object]) -> dict[str, object]:
+    """``entries`` (label -> handle) with one entry per marker style: of two markers drawn
+    alike (one panel's "heteroclinic", another's "heteroclinic (whirl: ...)"), the entry
+    whose label extends the other's, in the first one's place."""
+    kept: dict[str, object] = {}
+    for label, handle in entries.items():
+        twin = next((k for k, h in kept.items() if _same_marker(h, handle)
+                     and (label.startswith(k) or k.startswith(label))), None)
+        if twin is None:
+            kept[label] = handle
+        elif len(label) > len(twin):
+            kept = {label if k == twin else k: handle if k == twin else h
+                    for k, h in kept.items()}
+    return kept
+
+
+def _same_marker(a, b) -> bool:
+    """Whether ``a`` and ``b`` are marker handles drawn alike (marker, face and edge)."""
+    from matplotlib.colors import same_color
+    from matplotlib.lines import Line2D
+
+    if not (isinstance(a, Line2D) and isinstance(b, Line2D)) or a.get_marker() in (
+            "None", "", None):
+        return False
+    return (a.get_marker() == b.get_marker()
+            and str(a.get_markerfacecolor()) == str(b.get_markerfacecolor())
+            and same_color(a.get_markeredgecolor(), b.get_markeredgecolor()))
 
 
 def share_limits(axes, share: str) -> None:

@@ -75,18 +75,23 @@ def mark_events(ax: Axes, events: LocusEvents) -> None:
                 **COALESCENCE_STYLE, label="real roots coalesce")
 
 
-def direction_arrows(ax: Axes, sweep: LinearSweep, label: str = "") -> list:
+def direction_arrows(ax: Axes, sweep: LinearSweep, label: str = "",
+                     events: LocusEvents | None = None) -> list:
     """An arrow along the upper half of each oscillatory mode, in the sense of the increasing
-    parameter, at the middle of its longest complex stretch, ``label`` written left of the
-    last (the highest mode's, usually clear of the axes). Returns the arrows' annotations."""
+    parameter, on its longest complex stretch: at its middle, or the row nearest it whose
+    arrow keeps :data:`_ARROW_CLEARANCE` (on the axes as sized now) from every marked
+    event of ``events`` and lies within the limits (:func:`_arrow_row`); ``label`` written
+    beside the last (the highest mode's, usually clear of the axes). Returns the arrows'
+    annotations."""
     roots = np.asarray(sweep.eigenvalues)
+    marks = _event_points(events)
     arrows = []
     for column in range(roots.shape[1]):
         run = _longest_run(roots[:, column].imag > 0)
         if run is None or run[1] - run[0] < 4:
             continue
-        middle = (run[0] + run[1]) // 2
         step = max(1, (run[1] - run[0]) // 10)
+        middle = _arrow_row(ax, roots[:, column], run, step, marks)
         start, end = roots[middle, column], roots[min(middle + step, run[1] - 1), column]
         if start == end:
             continue
@@ -103,6 +108,51 @@ def direction_arrows(ax: Axes, sweep: LinearSweep, label: str = "") -> list:
                     textcoords="offset points", ha="center", va="bottom",
                     fontsize="small", zorder=5)
     return arrows
+
+
+_ARROW_CLEARANCE = 12.0  # least distance of an arrow from an event marker's centre, points
+
+
+def _event_points(events: LocusEvents | None) -> np.ndarray:
+    """The marked events as (Re, Im) points: crossings at (0, Im), coalescences at (Re, 0)."""
+    if events is None:
+        return np.empty((0, 2))
+    points = [(0.0, im) for _, im in events.crossings] + [(re, 0.0)
+                                                          for _, re in events.coalescences]
+    return np.array(points, dtype=float).reshape(-1, 2)
+
+
+def _arrow_row(ax: Axes, roots: np.ndarray, run: tuple[int, int], step: int,
+               marks: np.ndarray) -> int:
+    """The row of ``run`` (a stretch of one mode's ``roots``) where its arrow (to ``step``
+    rows on) starts: the middle, or the row nearest it whose arrow lies within ``ax``'s
+    limits and :data:`_ARROW_CLEARANCE` clear of ``marks``; the middle if none is."""
+    middle = (run[0] + run[1]) // 2
+    if not len(marks):
+        return middle
+    rows = np.arange(run[0], run[1] - 1)
+    ends = np.minimum(rows + step, run[1] - 1)
+    limits = ax.transLimits
+    starts = limits.transform(np.column_stack([roots[rows].real, roots[rows].imag]))
+    heads = limits.transform(np.column_stack([roots[ends].real, roots[ends].imag]))
+    inside = ((starts >= 0) & (starts <= 1) & (heads >= 0) & (heads <= 1)).all(axis=1)
+    size = np.array([ax.bbox.width, ax.bbox.height]) * 72.0 / ax.figure.dpi  # points
+    gaps = _segment_gaps(starts * size, heads * size, limits.transform(marks) * size)
+    clear = inside & (gaps >= _ARROW_CLEARANCE)
+    if not clear.any():
+        return middle
+    candidates = rows[clear]
+    return int(candidates[np.argmin(np.abs(candidates - middle))])
+
+
+def _segment_gaps(starts: np.ndarray, heads: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """For each segment (``starts[k]`` to ``heads[k]``), its least distance to ``points``."""
+    along = heads - starts
+    length2 = np.maximum((along ** 2).sum(axis=1), 1e-300)[:, None]
+    offset = points[None, :, :] - starts[:, None, :]
+    t = np.clip((offset * along[:, None, :]).sum(axis=2) / length2, 0.0, 1.0)
+    nearest = starts[:, None, :] + t[:, :, None] * along[:, None, :]
+    return np.hypot(*(points[None, :, :] - nearest).transpose(2, 0, 1)).min(axis=1)
 
 
 def _longest_run(mask: np.ndarray) -> tuple[int, int] | None:
@@ -187,9 +237,9 @@ def draw_zoom(ax: Axes, sweep: LinearSweep, events: LocusEvents, draw_roots
     inset = ax.inset_axes([x0, y0, ZOOM_SIZE, ZOOM_SIZE])
     draw_roots(inset)
     mark_events(inset, events)
-    direction_arrows(inset, sweep)
     inset.set_xlim(*box[0])
     inset.set_ylim(*box[1])
+    direction_arrows(inset, sweep, events=events)
     inset.tick_params(labelsize="x-small")
     ax.indicate_inset_zoom(inset, edgecolor="black", alpha=0.6)
     return x0, y0

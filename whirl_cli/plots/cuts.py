@@ -213,11 +213,12 @@ def _arrow(ax: Axes, xs: np.ndarray, ys: np.ndarray, colour: str) -> None:
 
 def phase_cuts(continuation: ContinuationResult, values: Sequence[float], region,
                degrees: bool = True) -> list[Axes]:
-    """One :func:`phase_cut` per value on a grid in ``region`` (a SubplotSpec; two columns
-    for four or more cuts, else one row), sharing both axes."""
+    """One :func:`phase_cut` per value on a grid in ``region`` (a SubplotSpec; one row, or
+    two columns for four or more cuts where the region is not wide enough:
+    :func:`grid_columns`), sharing both axes."""
     if not values:
         raise WhirlError("no cuts to draw")
-    columns = 2 if len(values) >= 4 else len(values)
+    columns = grid_columns(len(values), region)
     rows = -(-len(values) // columns)
     axes = region.subgridspec(rows, columns).subplots(sharex=True, sharey=True,
                                                       squeeze=False).ravel()
@@ -229,12 +230,39 @@ def phase_cuts(continuation: ContinuationResult, values: Sequence[float], region
     return list(axes[:len(values)])
 
 
+#: Least width over height of a panel in a row of panels (the phase cuts are drawn with equal
+#: aspect: narrower, they collapse).
+ROW_ASPECT = 0.5
+
+
+def grid_columns(count: int, region) -> int:
+    """Columns of a grid of ``count`` small panels in ``region`` (a SubplotSpec): one row if
+    fewer than four, or if the region is wide enough for a row of panels at least
+    :data:`ROW_ASPECT` as wide as high; else two."""
+    if count < 4:
+        return count
+    figure = region.get_gridspec().figure
+    box = region.get_position(figure)
+    width, height = figure.get_size_inches()
+    wide = box.width * width >= ROW_ASPECT * count * box.height * height
+    return count if wide else 2
+
+
 def mark_cuts(ax: Axes, values: Sequence[float]) -> None:
     """Each cut as a thin dashed vertical line on a diagram, lettered at its foot (the letters
-    of neighbouring cuts at staggered heights)."""
+    of cuts next to each other along the axis a line of text apart, in turn on three
+    levels)."""
+    from matplotlib.font_manager import FontProperties
+
+    line = _CUT_LABEL_LINES * FontProperties(size="small").get_size_in_points()
+    order = np.argsort(np.asarray(values, dtype=float), kind="stable")
+    level = {int(k): rank % 3 for rank, k in enumerate(order)}
     for k, value in enumerate(values):
         ax.axvline(float(value), color="dimgrey", linestyle=(0, (4, 3)), linewidth=0.8,
                    zorder=1, label="_cut")
-        ax.annotate(f"({_LETTERS[k % 26]})", xy=(float(value), 0.045 * (k % 3)),
-                    xycoords=("data", "axes fraction"), xytext=(2, 3),
+        ax.annotate(f"({_LETTERS[k % 26]})", xy=(float(value), 0.0),
+                    xycoords=("data", "axes fraction"), xytext=(2, 3 + line * level[k]),
                     textcoords="offset points", fontsize="small", ha="left", va="bottom")
+
+
+_CUT_LABEL_LINES = 1.2  # the step between the levels of the cuts' letters, lines of text

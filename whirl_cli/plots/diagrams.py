@@ -17,7 +17,6 @@ from .key import (
     BOUNDARY_KEY,
     MARKER_STYLE,
     PLOT_KEY,
-    _colours,
     _new_figure,
     _plot_styled,
     axis_label,
@@ -25,6 +24,7 @@ from .key import (
     display_unit,
     is_neutral_line,
     log_scale_if_decades,
+    next_colour,
     stability_curves,
 )
 
@@ -128,7 +128,8 @@ def _shade_overhangs(ax: Axes, bands: list[tuple[float, float]], unit: str):
                    zorder=0)
         ax.annotate(f"{high - low:.3g} {unit}".strip(), xy=((low + high) / 2, 1.0),
                     xycoords=("data", "axes fraction"), xytext=(0, -3),
-                    textcoords="offset points", ha="center", va="top", fontsize="small")
+                    textcoords="offset points", ha="center", va="top", fontsize="small",
+                    annotation_clip=True, in_layout=False)  # inside the axes, or not drawn
     return Patch(color=style["color"], alpha=OVERHANG_ALPHA, linewidth=0)
 
 
@@ -165,7 +166,8 @@ def _draw_bifurcation(ax: Axes, continuation: ContinuationResult, branches: list
 def projections_figure(continuation: ContinuationResult, which: Sequence[str] = ("max",),
                        degrees: bool = True, title: str | None = None,
                        region: SubplotSpec | None = None) -> Figure:
-    """One bifurcation diagram per state on a grid of ceil(n/2) x 2 axes sharing the x-axis.
+    """One bifurcation diagram per state on a grid of ceil(n/2) x 2 axes sharing the x-axis
+    (in a ``region`` wide enough for them, one row: :func:`~whirl_cli.plots.cuts.grid_columns`).
 
     The states are those common to every plotted (equilibrium or periodic) branch, in the order
     of the first; each panel is :func:`bifurcation_diagram` of one state (angles in deg, rates in
@@ -177,13 +179,18 @@ def projections_figure(continuation: ContinuationResult, which: Sequence[str] = 
     of a new figure.
     """
     states = _common_states(continuation)
-    rows = max(1, -(-len(states) // 2))
+    columns = 2
+    if region is not None:
+        from .cuts import grid_columns
+
+        columns = max(2, grid_columns(len(states), region)) if len(states) >= 4 else 2
+    rows = max(1, -(-len(states) // columns))
     if region is None:
         figure = _new_figure(figsize=(10.0, 3.2 * rows + 0.6), layout="constrained")
         grid = figure.add_gridspec(rows, 2)
     else:
         figure = region.get_gridspec().figure
-        grid = region.subgridspec(rows, 2)
+        grid = region.subgridspec(rows, columns)
     title = continuation.name if title is None else title
     if not states:
         figure.add_subplot(grid[:, :]).set_title(title)
@@ -194,11 +201,12 @@ def projections_figure(continuation: ContinuationResult, which: Sequence[str] = 
         ax.set_title("")
         if k > 0 and ax.get_legend() is not None:
             ax.get_legend().remove()
-        if k < len(states) - 2:  # another panel below in the same column
+        if k < len(states) - columns:  # another panel below in the same column
             ax.set_xlabel("")
     for ax in axes[len(states):]:
         figure.delaxes(ax)
-    if len(states) % 2 and len(states) > 1:  # lone last panel: label its neighbour's x
+    if columns == 2 and len(states) % 2 and len(states) > 1:  # lone last panel: label its
+        # neighbour's x
         axes[len(states) - 2].xaxis.set_tick_params(labelbottom=True)
         axes[len(states) - 2].set_xlabel(axes[len(states) - 1].get_xlabel())
     if region is None:
@@ -225,7 +233,8 @@ def period_plot(continuation: ContinuationResult, title: str | None = None,
     (the branch's period at the point's row if the point has none), Hopf points with a finite
     period (where periodic branches are born), and HOMOCLINIC/HETEROCLINIC at (their parameter
     estimate, the period at the last point of their branch). A "bracketed" global point also
-    gets its bracket drawn as a horizontal error bar at the top of the data. The y-axis is
+    gets its bracket drawn as a horizontal error bar at the top of the data, if wide enough to
+    be seen beside its marker (:data:`BRACKET_VISIBLE`). The y-axis is
     logarithmic if the largest period exceeds 20 times the smallest. Without periodic branches
     the axes stay empty. Title: ``title`` (None: ``"<continuation>: period"``). Draws on ``ax``
     if given, else on a new figure; returns the figure.
@@ -242,6 +251,7 @@ def period_plot(continuation: ContinuationResult, title: str | None = None,
     periods = np.concatenate([b.period for b in periodic]) if periodic else np.array([])
     periods = periods[np.isfinite(periods) & (periods > 0)]
     points, brackets = _period_points(continuation, periodic)
+    brackets = _visible_brackets(brackets, continuation)
     for style in PLOT_KEY:
         if style in points:
             xs, ys = np.array(points[style]).T
@@ -264,6 +274,19 @@ def period_plot(continuation: ContinuationResult, title: str | None = None,
         ax.legend(handles, labels, fontsize="small")
     ax.set_title(f"{continuation.name}: period" if title is None else title)
     return ax.figure
+
+
+#: A bracket narrower than this fraction of the continuation's span is not drawn (nor listed):
+#: it would be a dot under its point's marker.
+BRACKET_VISIBLE = 0.005
+
+
+def _visible_brackets(brackets: list[tuple[float, float]], continuation: ContinuationResult
+                      ) -> list[tuple[float, float]]:
+    """The ``brackets`` wide enough to be seen beside their marker (:data:`BRACKET_VISIBLE`)."""
+    values = [b.parameters[:, 0] for b in continuation.branches if b.is_periodic and len(b)]
+    span = float(np.ptp(np.concatenate(values))) if values else 0.0
+    return [(low, high) for low, high in brackets if high - low > BRACKET_VISIBLE * span]
 
 
 def _period_points(continuation: ContinuationResult, periodic: list[Branch]
@@ -308,12 +331,13 @@ def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str | No
     All of ``branch.orbits`` if ``labels`` is None, else those with these AUTO labels; drawn
     (and listed in the legend) in order of the principal parameter. Each curve is closed (its
     first point repeated at the end unless already equal), drawn solid if the branch is
-    stable at the orbit's row, dotted if not and dashed where its stability is unknown, in
-    the default colour cycle, and labelled
+    stable at the orbit's row, dotted if not and dashed where its stability is unknown, each
+    in its own colour (:func:`~whirl_cli.plots.key.next_colour`), and labelled
     ``"<parameter> = <value> (stable|unstable|stability unknown)"`` with the principal
     parameter (4 significant digits). Angles in degrees, rates in deg/s unless
     ``degrees`` is False; equal aspect when both axes have the same unit. Draws on ``ax`` if
-    given, else on a new figure; returns the figure. The title is ``title`` (None: the
+    given, else on a new figure (its legend then beside the axes, clear of the orbits);
+    returns the figure. The title is ``title`` (None: the
     branch's name).
     """
     if not branch.is_periodic:
@@ -336,9 +360,11 @@ def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str | No
     ix, iy = branch.state_names.index(x), branch.state_names.index(y)
     fx, unit_x = display_unit(branch.state_units[ix], degrees)
     fy, unit_y = display_unit(branch.state_units[iy], degrees)
+    own = ax is None
     if ax is None:
         ax = _new_figure().add_subplot()
-    for orbit, colour in zip(orbits, _colours(), strict=False):
+    for orbit in orbits:
+        colour = next_colour(ax.figure)
         states = np.asarray(orbit.states, dtype=float)
         if len(states) and not np.array_equal(states[0], states[-1]):
             states = np.vstack([states, states[:1]])
@@ -352,7 +378,10 @@ def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str | No
     ax.set_ylabel(axis_label(y, unit_y))
     if unit_x == unit_y:
         ax.set_aspect("equal", adjustable="datalim")
-    if orbits:
+    if orbits and own:  # beside the axes: never over an orbit
+        ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.02, 1.0),
+                  borderaxespad=0.0)
+    elif orbits:
         ax.legend(fontsize="small")
     ax.set_title(branch.name if title is None else title)
     return ax.figure
@@ -378,8 +407,10 @@ def _draw_special_points(ax: Axes, continuation: ContinuationResult, branches: l
                          state: str, degrees: bool, first: dict) -> None:
     """Markers for special points, one artist per marker style.
 
-    A point's state is read by the state names of its branch (or of the first plotted branch if
-    its branch is not among them); points not on the x-axis parameter are skipped.
+    A point at a row of a drawn branch (:func:`_at_row`) sits on that branch's curve there (a
+    global point stores the saddle's state, not the orbit's max); any other at its own state,
+    read by the state names of its branch (or of the first plotted branch if its branch is
+    not among them). Points not on the x-axis parameter are skipped.
     """
     by_name = {b.name: b for b in branches}
     x_name = branches[0].parameter_names[0] if branches else None
@@ -391,13 +422,24 @@ def _draw_special_points(ax: Axes, continuation: ContinuationResult, branches: l
             continue
         index = branch.state_names.index(state)
         factor, _ = display_unit(branch.state_units[index], degrees)
-        xy = (float(point.parameters[0]), float(point.state[index]) * factor)
+        y = branch.state(state)[point.index] if _at_row(point, branch) else point.state[index]
+        xy = (float(point.parameters[0]), float(y) * factor)
         if np.all(np.isfinite(xy)):
             points.setdefault(style, []).append(xy)
     for style in PLOT_KEY:
         if style in points:
             xs, ys = np.array(points[style]).T
             _plot_styled(ax, xs, ys, style, first)
+
+
+def _at_row(point, branch: Branch) -> bool:
+    """Whether ``point`` lies on ``branch`` at its row ``index``: the branch is its own and
+    the row's principal parameter is the point's (to 1e-6 of the branch's span)."""
+    if point.branch != branch.name or not 0 <= point.index < len(branch):
+        return False
+    x = branch.parameters[:, 0]
+    gap = abs(float(x[point.index]) - float(point.parameters[0]))
+    return gap <= 1e-6 * max(float(np.ptp(x)), 1e-300)
 
 
 def _point_type(code: int) -> PointType | None:

@@ -149,7 +149,10 @@ def study_figures(result: StudyResult, kinds: tuple[str, ...], stem: str = "",
 
 def _viewed(figure: Figure, view: View) -> Figure:
     """``figure`` with ``view``'s axis limits on every axes (an equal-aspect axes then keeps
-    its aspect by its box, not by moving the limits)."""
+    its aspect by its box, not by moving the limits), its titles wrapped at the canvas edge
+    (a long one is never clipped) and its legends off the data (:func:`legends_off_data`)."""
+    for text in _titles(figure):
+        text.set_wrap(True)
     for ax in figure.axes:
         if (view.xlim or view.ylim) and ax.get_aspect() != "auto":
             ax.set_adjustable("box")
@@ -157,7 +160,64 @@ def _viewed(figure: Figure, view: View) -> Figure:
             ax.set_xlim(*view.xlim)
         if view.ylim is not None:
             ax.set_ylim(*view.ylim)
+    legends_off_data(figure)
     return figure
+
+
+def legends_off_data(figure: Figure) -> None:
+    """Move every axes legend that lies over drawn data (a vertex of a line, a point of a
+    collection, found by drawing ``figure`` once) off it: beside the axes if the figure has
+    one axes, else below all of them as one legend of the figure (each entry once)."""
+    legends = [(ax, ax.get_legend()) for ax in figure.axes if ax.get_legend() is not None]
+    if not legends:
+        return
+    figure.canvas.draw()
+    covering = [(ax, legend) for ax, legend in legends if _over_data(ax, legend)]
+    if len(figure.axes) == 1:
+        for ax, legend in covering:
+            legend.set_loc("upper left")
+            legend.set_bbox_to_anchor((_right_of_texts(ax) + 0.02, 1.0),
+                                      transform=ax.transAxes)
+        return
+    entries: dict[str, object] = {}
+    for _, legend in covering:
+        for handle, text in zip(legend.legend_handles, legend.get_texts(), strict=False):
+            entries.setdefault(text.get_text(), handle)
+        legend.remove()
+    if entries:
+        figure.legend(list(entries.values()), list(entries), loc="outside lower center",
+                      fontsize="small", ncols=min(len(entries), 3), frameon=False)
+
+
+def _right_of_texts(ax) -> float:
+    """The right edge, in axes fractions, of ``ax`` and of its texts drawn beside it (labels
+    of the cases of a boundary map), 1.0 if none is."""
+    box = ax.get_window_extent()
+    right = max([box.x1, *(t.get_window_extent().x1 for t in ax.texts if t.get_visible())])
+    return 1.0 + (right - box.x1) / max(box.width, 1.0)
+
+
+def _over_data(ax, legend) -> bool:
+    """Whether ``legend`` (drawn) covers a vertex of ``ax``'s lines or a point of its
+    collections."""
+    box = legend.get_window_extent()
+    drawn = [(line.get_transform(), line.get_xydata()) for line in ax.lines
+             if line.get_visible() and len(line.get_xdata())]
+    drawn += [(c.get_offset_transform(), c.get_offsets()) for c in ax.collections
+              if c.get_visible() and len(c.get_offsets())]
+    for transform, data in drawn:
+        xy = np.asarray(data, dtype=float).reshape(-1, 2)
+        xy = transform.transform(xy[np.isfinite(xy).all(axis=1)])
+        if ((xy[:, 0] > box.x0) & (xy[:, 0] < box.x1) & (xy[:, 1] > box.y0)
+                & (xy[:, 1] < box.y1)).any():
+            return True
+    return False
+
+
+def _titles(figure: Figure) -> list:
+    """The figure's suptitle and every axes' titles (left, centre, right)."""
+    texts = [figure._suptitle] if getattr(figure, "_suptitle", None) is not None else []
+    return texts + [t for ax in figure.axes for t in (ax.title, ax._left_title, ax._right_title)]
 
 
 def _without_artefacts(result: StudyResult) -> StudyResult:
@@ -201,11 +261,14 @@ def slice_title(caption: Captions, boundary, k: int, value: float) -> str:
 
 
 def phase_labels(branch: Branch, most: int = PHASE_ORBITS) -> list[int]:
-    """Labels of the orbits a study's phase plane of ``branch`` draws, in branch order: all of
-    them if there are at most ``most``; else every orbit stored at an ``orbits_at`` value (UZ)
-    and, up to ``most`` in all, others evenly spread along the branch (first and last
-    included)."""
+    """Labels of the orbits a study's phase plane of ``branch`` draws, in branch order: of
+    the orbits within the small-angle range (:func:`small_angle`; all of them if none is)
+    and those stored at an ``orbits_at`` value (UZ), all if there are at most ``most``; else
+    every UZ orbit and, up to ``most`` in all, others evenly spread along the branch (first
+    and last included)."""
     orbits = sorted(branch.orbits, key=lambda o: o.index)
+    within = [o for o in orbits if o.point_type == PointType.UZ or small_angle(branch, o)]
+    orbits = within or orbits
     if len(orbits) <= most:
         return [o.label for o in orbits]
     asked = [o for o in orbits if o.point_type == PointType.UZ]
@@ -214,6 +277,19 @@ def phase_labels(branch: Branch, most: int = PHASE_ORBITS) -> list[int]:
     picks = np.unique(np.linspace(0, len(others) - 1, room).round().astype(int)) if room else []
     chosen = {id(o) for o in asked} | {id(others[k]) for k in picks}
     return [o.label for o in orbits if id(o) in chosen]
+
+
+SMALL_ANGLE = float(np.radians(20.0))
+"""Largest angle [rad] of the small-angle range the models assume (sin and tan of it differ
+from it by 2 % and 4 %): a study's phase plane leaves out orbits that go beyond it."""
+
+
+def small_angle(branch: Branch, orbit) -> bool:
+    """Whether every angle state (unit rad) of ``orbit`` stays within :data:`SMALL_ANGLE`."""
+    angles = [k for k, unit in enumerate(branch.state_units) if unit == "rad"]
+    states = np.asarray(orbit.states, dtype=float)
+    return bool(not angles or not states.size
+                or np.nanmax(np.abs(states[:, angles])) <= SMALL_ANGLE)
 
 
 def state_for(continuation: ContinuationResult, state: str | None) -> str | None:

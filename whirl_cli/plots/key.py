@@ -288,12 +288,24 @@ def log_scale_if_decades(ax: Axes, axis: str, values) -> bool:
     return True
 
 
+MARKER_ON_TOP: dict[str, dict[str, object]] = {
+    "homoclinic": {"zorder": 5, "markersize": 1.4 * _MARKER_SIZE, "markeredgecolor": "white",
+                   "markeredgewidth": 0.8},
+    "heteroclinic": {"zorder": 5, "markersize": 1.4 * _MARKER_SIZE, "markeredgewidth": 1.5},
+    "torus": {"zorder": 5, "markersize": 1.4 * _MARKER_SIZE, "markeredgewidth": 1.5},
+}
+"""Markers drawn above the folds and Hopf points (zorder 3) that often sit beside them, and
+larger: the global points (the filled one edged in white) and the torus point as a ring, so
+that a fold at the same place neither hides them nor is hidden."""
+
+
 def _plot_styled(ax: Axes, x: np.ndarray, y: np.ndarray, style: str, first: dict) -> None:
     """Plot with ``PLOT_KEY[style]``; remember the first artist of each style for the legend."""
     kwargs = dict(PLOT_KEY[style])
     kwargs["label"] = "_" + str(kwargs["label"])  # legend is assembled from ``first``
     if "marker" in kwargs:
         kwargs.update(linestyle="none", markersize=_MARKER_SIZE, zorder=3)
+        kwargs.update(MARKER_ON_TOP.get(style, {}))
     (line,) = ax.plot(x, y, **kwargs)
     first.setdefault(style, line)
 

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..results import LawCurve, StudyResult
-from .key import _new_figure, axis_label, display_unit
+from .key import _new_figure, axis_label, display_unit, symbol
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -28,12 +28,12 @@ def law_plot(curve: LawCurve, ax: Axes | None = None, title: str | None = None) 
     spring K x of the dof's stiffness (dotted); the breakpoints as thin vertical lines. x in
     degrees for angles; M in the stiffness's unit times the dof's (N m for an angle with K in
     N m/rad). Draws on ``ax`` if given, else on a new figure; returns the figure. Title:
-    ``title`` (None: the law and its coefficients)."""
+    ``title`` (None: the law and its coefficients), wrapped at the canvas edge."""
     factor, unit = display_unit(curve.dof_unit, True)
     if ax is None:
         ax = _new_figure().add_subplot()
     x, k = curve.x, curve.stiffness_value
-    ax.plot(factor * x, k * x, label=f"linear spring ({curve.stiffness} = {k:g})",
+    ax.plot(factor * x, k * x, label=f"linear spring ({symbol(curve.stiffness)} = {k:g})",
             **LINEAR_STYLE)
     ax.plot(factor * x, curve.force,
             label="as continued (smoothed)" if curve.exact is not None else "law", **LAW_STYLE)
@@ -44,8 +44,10 @@ def law_plot(curve: LawCurve, ax: Axes | None = None, title: str | None = None) 
     _labels(ax, curve, unit)
     ax.axhline(0.0, color="black", linewidth=0.5, zorder=0)
     ax.legend(fontsize="small")
-    shown = ", ".join(f"{key} = {value:g}" for key, value in curve.coefficients.items())
-    ax.set_title(f"{curve.law} law on {curve.dof}: {shown}" if title is None else title)
+    shown = ", ".join(f"{symbol(key)} = {value:.3g}"
+                      for key, value in curve.coefficients.items())
+    ax.set_title(f"{curve.law} law on {symbol(curve.dof)}: {shown}" if title is None else title,
+                 wrap=True)
     return ax.figure
 
 

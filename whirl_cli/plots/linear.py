@@ -131,7 +131,7 @@ def root_locus_plot(sweep: LinearSweep, title: str | None = None, ax: Axes | Non
     scale = _draw_roots(ax, sweep)
     events = locus_events(sweep)
     mark_events(ax, events)
-    direction_arrows(ax, sweep, f"{symbol(sweep.parameter)} increasing")
+    direction_arrows(ax, sweep, f"{symbol(sweep.parameter)} increasing", events)
     if scale is not None:
         figure.colorbar(scale, ax=ax, label=axis_label(sweep.parameter, sweep.unit))
     corner = draw_zoom(ax, sweep, events, lambda inset: _draw_roots(inset, sweep))

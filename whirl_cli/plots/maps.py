@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import replace
+from functools import partial
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -30,7 +31,7 @@ if TYPE_CHECKING:
 _LOCUS_KINDS = ("hopf", "branch_point", "fold", "fold_of_cycles", "torus")
 _SLICE_TOLERANCE = 1e-12  # slice values equal within this are the same slice
 _BAND_ALPHA = 0.25  # unsafe bands of overhang diagrams
-_CASE_LABEL_GAP = 0.04  # least distance of case labels, in axes fractions
+_CASE_LABEL_LINES = 1.15  # least distance of case labels, in lines of their text
 _LINEAR_FRACTION = 0.01  # of the surface's largest magnitude: its colour scale's linear part
 _LIMIT_MARGIN = 0.02  # fraction of the data span added around loci-derived axis limits
 
@@ -243,12 +244,30 @@ def _draw_cases(ax: Axes, cases: Sequence[float], labels: Sequence[str] = ()) ->
     low, high = sorted((bottom, top))
     shown = sorted(((float(v) - bottom) / (top - bottom) if top != bottom else 0.5, k)
                    for k, v in enumerate(cases, 1) if low <= float(v) <= high)
-    position = -np.inf
-    for fraction, k in shown:  # in axes fractions, pushed up to keep close labels apart
-        position = max(fraction, position + _CASE_LABEL_GAP)
+    values = [float(cases[k - 1]) for _, k in shown]
+    for n, (_, k) in enumerate(shown):
         label = labels[k - 1] if k <= len(labels) and labels[k - 1] else f"case {k}"
-        ax.text(1.01, position, label, transform=ax.transAxes, ha="left", va="center",
-                fontsize="small")
+        ax.annotate(label, xy=(1.01, values[n]), ha="left", va="center", fontsize="small",
+                    xycoords=partial(_case_label_place, ax, values, n),
+                    annotation_clip=False)
+
+
+def _case_label_place(ax: Axes, values: list[float], n: int, renderer):
+    """The transform placing case label ``n`` (x in axes fractions, y in data): at its case
+    ``values[n]`` (``values`` in the order drawn bottom to top), or pushed up to stay
+    :data:`_CASE_LABEL_LINES` lines of its text above the label below it, measured on the
+    axes as drawn (after the layout and any shared limits)."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.transforms import Affine2D, blended_transform_factory
+
+    heights = ax.transData.transform([(0.0, v) for v in values])[:, 1]
+    gap = (_CASE_LABEL_LINES * FontProperties(size="small").get_size_in_points()
+           * ax.figure.dpi / 72.0)
+    position = -np.inf
+    for height in heights[:n + 1]:
+        position = max(height, position + gap)
+    place = blended_transform_factory(ax.transAxes, ax.transData)
+    return place + Affine2D().translate(0.0, position - heights[n])
 
 
 def slice_continuation(continuation: ContinuationResult, index: int) -> ContinuationResult:

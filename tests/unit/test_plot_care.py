@@ -1,0 +1,351 @@
+"""The study plots checked from their own artists, after a draw: no text outside the canvas,
+legends clear of the data, special-point markers on a drawn branch and above the others,
+legend entries matching visible artists."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from matplotlib.colors import to_hex
+
+from whirl_cli.plots.diagrams import phase_plane
+from whirl_cli.plots.files import SMALL_ANGLE, phase_labels
+from whirl_cli.results import BranchKind, Orbit, PointType
+
+from .plot_data import make_branch
+
+
+def _orbit(label: int, index: int, value: float, radius: float) -> Orbit:
+    """An ellipse of ``radius`` rad in theta (half that in psi), 40 samples."""
+    phase = np.linspace(0.0, 2 * np.pi, 40, endpoint=False)
+    theta, psi = radius * np.cos(phase), 0.5 * radius * np.sin(phase)
+    return Orbit(label=label, point_type=0, index=index, parameters=np.array([value, 6.7]),
+                 period=0.2, time=phase / (2 * np.pi) * 0.2,
+                 states=np.column_stack([theta, psi, 10 * psi, 10 * theta]))
+
+
+def _family(radii) -> object:
+    """A periodic family with one stored orbit per radius (rad), the parameter rising."""
+    n = len(radii)
+    branch = make_branch("periodic_1", BranchKind.PERIODIC, np.linspace(0.3, 0.5, n),
+                         radii, np.ones(n))
+    return replace(branch, orbits=tuple(_orbit(k + 1, k, 0.3 + 0.2 * k / max(n - 1, 1), r)
+                                        for k, r in enumerate(radii)))
+
+
+def _display_points(ax) -> np.ndarray:
+    """Every vertex of ``ax``'s lines, in display coordinates."""
+    points = [line.get_xydata() for line in ax.lines if len(line.get_xdata())]
+    xy = np.concatenate(points)
+    return ax.transData.transform(xy[np.isfinite(xy).all(axis=1)])
+
+
+def _inside(points: np.ndarray, box) -> np.ndarray:
+    return ((points[:, 0] > box.x0) & (points[:, 0] < box.x1)
+            & (points[:, 1] > box.y0) & (points[:, 1] < box.y1))
+
+
+def test_phase_plane_legend_lies_clear_of_every_orbit():
+    figure = phase_plane(_family(np.linspace(0.02, 0.3, 12)))
+    figure.canvas.draw()
+    ax = figure.axes[0]
+    box = ax.get_legend().get_window_extent()
+    assert not _inside(_display_points(ax), box).any()
+    canvas = figure.bbox
+    assert canvas.x0 <= box.x0 and box.x1 <= canvas.x1
+
+
+def test_phase_plane_gives_each_orbit_its_own_colour():
+    ax = phase_plane(_family(np.linspace(0.02, 0.3, 12))).axes[0]
+    colours = [to_hex(line.get_color()) for line in ax.lines]
+    assert len(colours) == 12 and len(set(colours)) == 12
+
+
+def test_study_phase_plane_leaves_out_orbits_beyond_the_small_angle_range():
+    radii = [0.05, 0.2, 0.3, 0.6, 1.2]  # rad: 0.6 and 1.2 beyond 20 deg
+    family = _family(radii)
+    assert SMALL_ANGLE < 0.6
+    assert phase_labels(family) == [1, 2, 3]
+    asked = replace(family, orbits=tuple(
+        replace(o, point_type=int(PointType.UZ)) if o.label == 5 else o
+        for o in family.orbits))
+    assert phase_labels(asked) == [1, 2, 3, 5]  # an orbit orbits_at asked for stays
+
+
+def test_study_phase_plane_keeps_its_orbits_when_none_is_small():
+    assert phase_labels(_family([0.6, 0.9, 1.2])) == [1, 2, 3]
+
+
+def _texts_outside(figure) -> list[str]:
+    """The visible non-empty texts of ``figure`` that reach beyond its canvas, after a draw."""
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    canvas = figure.bbox
+    hidden = {id(tick.label1) for ax in figure.axes for axis in (ax.xaxis, ax.yaxis)
+              for tick in axis.get_major_ticks() + axis.get_minor_ticks()
+              if not _in_view(tick.get_loc(), axis.get_view_interval())}
+    out = []
+    for text in figure.findobj(lambda a: hasattr(a, "get_text") and hasattr(a, "get_wrap")):
+        if not text.get_visible() or not text.get_text().strip() or id(text) in hidden:
+            continue
+        box = text.get_window_extent(renderer)
+        if (box.x0 < canvas.x0 - 0.5 or box.x1 > canvas.x1 + 0.5
+                or box.y0 < canvas.y0 - 0.5 or box.y1 > canvas.y1 + 0.5):
+            out.append(text.get_text())
+    return out
+
+
+def _in_view(value, interval) -> bool:
+    """Whether a tick at ``value`` is drawn (within the axis's view ``interval``)."""
+    low, high = sorted(interval)
+    return low - 1e-9 * abs(high - low) <= value <= high + 1e-9 * abs(high - low)
+
+
+def test_freeplay_law_title_stays_on_the_canvas():
+    from whirl_cli.models import get_model
+    from whirl_cli.output.provenance import law_curve
+    from whirl_cli.plots.laws import law_plot
+
+    model = get_model("classical", ("freeplay", "polynomial"))
+    values = {"K_theta": 0.4, "delta_theta": 0.017453292519943295,
+              "epsilon_theta": 0.00017453292519943295, "K_in_theta": 0.0}
+    figure = law_plot(law_curve(model, values, "theta"))
+    assert _texts_outside(figure) == []
+
+
+def test_a_study_figure_wraps_a_long_title_onto_the_canvas():
+    from whirl_cli.plots.files import View, _viewed
+
+    long = "freeplay-pitch-airspeed: " + ", ".join(f"$K_{{{k}}}$ = 0.{k} N m/rad"
+                                                   for k in range(1, 9))
+    figure = _viewed(phase_plane(_family([0.05, 0.1]), title=long), View())
+    assert _texts_outside(figure) == []
+
+
+def _homoclinic_ending(saddle_theta: float):
+    """A periodic family ending at a homoclinic point (stored with the saddle's theta, off the
+    family's max there) beside a fold of cycles and a torus point at the same place."""
+    from whirl_cli.results import ContinuationResult, PointType, SpecialPoint
+
+    family = make_branch("periodic_1", BranchKind.PERIODIC, [0.3, 0.35, 0.4, 0.42, 0.43],
+                         [0.1, 0.15, 0.2, 0.25, 0.3], [1, 1, 1, 1, 1])
+
+    def point(kind, row, theta):
+        return SpecialPoint(branch="periodic_1", index=row, point_type=int(kind),
+                            parameter_names=("K1", "V"),
+                            parameters=family.parameters[row].copy(),
+                            state=np.array([theta, 0.0, 0.0, 0.0]), period=0.2, stable=True)
+
+    points = (point(PointType.HOMOCLINIC, 4, saddle_theta), point(PointType.LPC, 4, 0.3),
+              point(PointType.TR, 2, 0.2), point(PointType.LPC, 2, 0.2))
+    return ContinuationResult("k1", "one-parameter", (family,), points)
+
+
+def test_a_homoclinic_marker_lies_on_the_family_it_ends():
+    from whirl_cli.plots.diagrams import bifurcation_diagram
+
+    ax = bifurcation_diagram(_homoclinic_ending(saddle_theta=0.12)).axes[0]
+    (marker,) = [line for line in ax.lines if line.get_marker() == "^"]
+    curves = np.concatenate([line.get_xydata() for line in ax.lines
+                             if line.get_marker() in ("None", "", None)])
+    for xy in marker.get_xydata():
+        assert np.isclose(curves, xy, rtol=1e-9, atol=1e-12).all(axis=1).any()
+
+
+def test_torus_and_global_markers_lie_above_a_fold_at_the_same_place():
+    from whirl_cli.plots.diagrams import bifurcation_diagram
+
+    ax = bifurcation_diagram(_homoclinic_ending(saddle_theta=0.12)).axes[0]
+    (homoclinic,) = [line for line in ax.lines if line.get_marker() == "^"]
+    (torus,) = [line for line in ax.lines if line.get_marker() == "o"
+                and line.get_markerfacecolor() == "none"]
+    (fold,) = [line for line in ax.lines if line.get_marker() == "o" and line is not torus]
+    assert torus.get_zorder() > fold.get_zorder() and homoclinic.get_zorder() > fold.get_zorder()
+    assert torus.get_markersize() > fold.get_markersize()  # a ring around the fold, not under it
+
+
+def _unseen_entries(ax) -> list[str]:
+    """The entries of ``ax``'s legend whose artist shows nothing inside the axes after a draw:
+    a line or marker with no vertex in the axes' box, an error bar narrower than a marker."""
+    from matplotlib.container import ErrorbarContainer
+    from matplotlib.lines import Line2D
+
+    ax.figure.canvas.draw()
+    box = ax.get_window_extent()
+    marker_px = 8.0 * ax.figure.dpi / 72.0
+    legend = ax.get_legend()
+    unseen = []
+    for handle, text in zip(legend.legend_handles, legend.get_texts(), strict=True):
+        artist = next((a for a in [*ax.lines, *ax.containers]
+                       if a is handle or a.get_label() in (text.get_text(),
+                                                             "_" + text.get_text())), handle)
+        if isinstance(artist, ErrorbarContainer):
+            (bars,) = artist.lines[2]
+            xy = ax.transData.transform(np.concatenate(bars.get_segments()))
+            if np.ptp(xy[:, 0]) < marker_px:
+                unseen.append(text.get_text())
+        elif isinstance(artist, Line2D) and artist.axes is ax:
+            xy = artist.get_xydata()
+            xy = ax.transData.transform(xy[np.isfinite(xy).all(axis=1)])
+            if not _inside(xy, box.expanded(1.001, 1.001)).any():
+                unseen.append(text.get_text())
+    return unseen
+
+
+def _bracketed_heteroclinic(width: float):
+    """A periodic family whose period blows up at a heteroclinic point bracketed ``width``
+    wide."""
+    from whirl_cli.results import ContinuationResult, LocateStatus, PointType, SpecialPoint
+
+    family = replace(make_branch("periodic_1", BranchKind.PERIODIC, [0.3, 0.35, 0.4, 0.42,
+                                                                     0.43],
+                                 [0.1, 0.15, 0.2, 0.25, 0.3], [1, 1, 1, 1, 1]),
+                     period=np.array([0.2, 0.3, 0.5, 1.0, 3.0]))
+    point = SpecialPoint(branch="periodic_1", index=4, point_type=int(PointType.HETEROCLINIC),
+                         parameter_names=("K1", "V"), parameters=np.array([0.43, 6.7]),
+                         state=np.zeros(4), period=np.nan, stable=False,
+                         status=LocateStatus.BRACKETED,
+                         bracket=np.array([0.43, 0.43 + width]), residual=0.01)
+    return ContinuationResult("k1", "one-parameter", (family,), (point,))
+
+
+def test_a_period_plot_lists_no_bracket_too_narrow_to_be_seen():
+    from whirl_cli.plots.diagrams import period_plot
+
+    ax = period_plot(_bracketed_heteroclinic(3e-8)).axes[0]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "heteroclinic" in labels and not any("bracket" in label for label in labels)
+    assert _unseen_entries(ax) == []
+
+
+def test_every_legend_entry_of_the_study_diagrams_shows_in_its_axes():
+    from whirl_cli.plots.diagrams import bifurcation_diagram, period_plot
+
+    wide = period_plot(_bracketed_heteroclinic(0.02)).axes[0]
+    assert any("bracket" in t.get_text() for t in wide.get_legend().get_texts())
+    for ax in (wide, bifurcation_diagram(_homoclinic_ending(0.12)).axes[0],
+               phase_plane(_family([0.05, 0.1, 0.2])).axes[0]):
+        assert _unseen_entries(ax) == []
+
+
+def test_sheet_captions_name_the_parameters_as_the_axes_do():
+    """whirl's axes read K_theta; a caption says K_theta too (the thesis's K1 only as such)."""
+    import re
+    from pathlib import Path
+
+    from whirl_cli.figures.sheet import load_sheet
+
+    sheets = sorted((Path(__file__).resolve().parents[2] / "sheets" / "thesis_ch3").glob(
+        "fig3_*.yaml"))
+    assert len(sheets) == 28
+    bare = {path.name: load_sheet(path).caption for path in sheets
+            if re.search(r"(?<!thesis's )\bK1\b", load_sheet(path).caption)}
+    assert bare == {}
+
+
+def test_four_cuts_under_a_diagram_at_journal_width_keep_their_size():
+    """At 7.2 in (a double journal column) four phase cuts under a diagram go in one row, each
+    at least an inch on a side, instead of a 2 x 2 grid that collapses."""
+    from whirl_cli.plots.cuts import phase_cuts
+    from whirl_cli.plots.key import _new_figure
+
+    from .plot_data import hopf_continuation
+
+    figure = _new_figure(figsize=(7.2, 6.6))
+    grid = figure.add_gridspec(2, 1)
+    figure.add_subplot(grid[0]).plot([0, 1], [0, 1])
+    axes = phase_cuts(hopf_continuation(), [0.1, 0.2, 0.3, 0.45], grid[1])
+    figure.canvas.draw()
+    boxes = [ax.get_window_extent() for ax in axes]
+    inch = figure.dpi
+    assert len({round(box.y0) for box in boxes}) == 1  # one row
+    assert all(box.width >= 0.8 * inch and box.height >= 0.8 * inch for box in boxes)
+
+
+def test_the_small_panel_sheets_are_set_for_a_double_column():
+    from pathlib import Path
+
+    from whirl_cli.figures.sheet import COLUMNS, load_sheet
+
+    folder = Path(__file__).resolve().parents[2] / "sheets" / "thesis_ch3"
+    for number in ("16", "21", "24", "26"):
+        sheet = load_sheet(folder / f"fig3_{number}.yaml")
+        assert sheet.column == "double" and sheet.figure_size[0] == COLUMNS["double"]
+        assert sheet.shape[1] == 1  # the diagram above its small panels, not beside them
+
+
+def test_a_figure_legend_lists_a_marker_drawn_alike_on_two_panels_once():
+    """Panel (a) says "heteroclinic", panel (b) "heteroclinic (whirl: ...)" for the same
+    hollow triangle: the sheet's legend lists it once, with the fuller label; a different
+    marker keeps its own entry."""
+    from whirl_cli.figures.draw import figure_legend
+    from whirl_cli.plots.key import _new_figure
+
+    figure = _new_figure()
+    left, right = figure.subplots(1, 2)
+    style = {"marker": "^", "markerfacecolor": "none", "markeredgecolor": "black",
+             "linestyle": "none"}
+    left.plot([0.1], [1.0], **style, label="heteroclinic")
+    left.plot([0.2], [1.0], marker="^", color="black", linestyle="none", label="homoclinic")
+    right.plot([0.1], [1.0], **style, label="heteroclinic (whirl: K = 0.0777)")
+    for ax in (left, right):
+        ax.legend()
+    figure_legend(figure)
+    (legend,) = figure.legends
+    assert [t.get_text() for t in legend.get_texts()] == [
+        "heteroclinic (whirl: K = 0.0777)", "homoclinic"]
+
+
+def _crowded(axes_count: int):
+    """A figure of ``axes_count`` axes, each filled by a dense grid of points and a legend."""
+    from whirl_cli.plots.key import _new_figure
+
+    figure = _new_figure()
+    grid = np.linspace(0.0, 1.0, 30)
+    xs, ys = np.meshgrid(grid, grid)
+    for ax in figure.subplots(1, axes_count, squeeze=False).ravel():
+        ax.plot(xs.ravel(), ys.ravel(), ".", label="every point")
+        ax.plot(grid, grid, "-", label="a line")
+        ax.legend()
+    return figure
+
+
+def test_a_study_figure_moves_a_legend_off_its_data_beside_its_axes():
+    from whirl_cli.plots.files import View, _viewed
+
+    figure = _viewed(_crowded(1), View())
+    figure.canvas.draw()
+    ax = figure.axes[0]
+    box = ax.get_legend().get_window_extent()
+    assert not _inside(_display_points(ax), box).any()
+    assert box.x1 <= figure.bbox.x1 and _texts_outside(figure) == []
+
+
+def test_a_study_figure_of_several_axes_gathers_covering_legends_below_them():
+    from whirl_cli.plots.files import View, _viewed
+
+    figure = _viewed(_crowded(2), View())
+    figure.canvas.draw()
+    assert all(ax.get_legend() is None for ax in figure.axes)
+    (legend,) = figure.legends
+    box = legend.get_window_extent()
+    assert all(box.y1 <= ax.get_window_extent().y0 for ax in figure.axes)
+    assert _texts_outside(figure) == []
+
+
+def test_the_letters_of_close_cuts_do_not_overlap_on_a_short_diagram():
+    """Three cuts within 2 % of the axis (3.26: 0.075, 0.0777, 0.09 of 0.8) on a 2 in tall
+    diagram: their letters' boxes are disjoint."""
+    from whirl_cli.plots.cuts import mark_cuts
+    from whirl_cli.plots.key import _new_figure
+
+    ax = _new_figure(figsize=(7.2, 2.0)).add_subplot()
+    ax.plot([-0.3, 0.5], [-10.0, 10.0])
+    mark_cuts(ax, [0.075, 0.0777, 0.09])
+    ax.figure.canvas.draw()
+    boxes = [text.get_window_extent() for text in ax.texts]
+    assert len(boxes) == 3
+    for a in range(3):
+        for b in range(a + 1, 3):
+            assert not boxes[a].overlaps(boxes[b])
