@@ -372,7 +372,7 @@ def _write_boundary(group: h5py.Group, boundary: Boundary) -> None:
     pair = {"names": list(boundary.parameter_names), "units": list(boundary.parameter_units)}
     for name, (kind, curve) in boundary.loci.items():
         data = _collection(group, "loci").create_dataset(name, data=curve.reshape(-1, 2))
-        data.attrs.update(kind=kind, **pair)
+        data.attrs.update(kind=str(kind), **pair)  # the word, as text (h5py: no enums)
         if name in boundary.bounding_ends:
             data.attrs["bounding_ends"] = np.array(boundary.bounding_ends[name], dtype=np.int8)
     for k, polygon in enumerate(boundary.polygons):
