@@ -32,44 +32,34 @@ def _per_continuation(figures: Figures, suffix: str, draw) -> list[FigureJob]:
             for c in figures.result.continuations if _explored(c)]
 
 
-def _poincare_files(figures: Figures) -> list[FigureJob]:
-    from ..motion import poincare_plot
+def _drawn_by(name: str):
+    """The function of :mod:`whirl_cli.plots.motion` named ``name`` (imported when drawing)."""
+    from .. import motion
 
-    return _per_continuation(figures, "poincare",
-                             lambda c, title: poincare_plot(c, title=title))
-
-
-def _poincare_panel(result, ax, choice, caption) -> list[Axes]:
-    from ..motion import poincare_plot
-    from ..panels import continuation_title, pick_continuation
-
-    continuation = pick_continuation(result, choice.continuation, "poincare")
-    poincare_plot(continuation, ax=ax, title=continuation_title(continuation, choice, caption))
-    return [ax]
+    return getattr(motion, name)
 
 
-POINCARE = PlotKind("poincare", 130, _poincare_panel, missing=_not_explored,
-                    figures=_poincare_files, fits=_explored, need="explored values")
+def _whole_figure_kind(kind: str, rank: int, draw: str) -> PlotKind:
+    """A kind drawn by ``motion.<draw>(continuation, ax=None, title=...)``: one file per
+    explored continuation, or one panel."""
+    def files(figures: Figures) -> list[FigureJob]:
+        return _per_continuation(figures, kind,
+                                 lambda c, title: _drawn_by(draw)(c, title=title))
+
+    def panel(result, ax, choice, caption) -> list[Axes]:
+        from ..panels import continuation_title, pick_continuation
+
+        continuation = pick_continuation(result, choice.continuation, kind)
+        _drawn_by(draw)(continuation, ax=ax,
+                        title=continuation_title(continuation, choice, caption))
+        return [ax]
+
+    return PlotKind(kind, rank, panel, missing=_not_explored, figures=files, fits=_explored,
+                    need="explored values")
 
 
-def _spectrum_files(figures: Figures) -> list[FigureJob]:
-    from ..motion import spectrum_plot
-
-    return _per_continuation(figures, "spectrum",
-                             lambda c, title: spectrum_plot(c, title=title))
-
-
-def _spectrum_panel(result, ax, choice, caption) -> list[Axes]:
-    from ..motion import spectrum_plot
-    from ..panels import continuation_title, pick_continuation
-
-    continuation = pick_continuation(result, choice.continuation, "spectrum")
-    spectrum_plot(continuation, ax=ax, title=continuation_title(continuation, choice, caption))
-    return [ax]
-
-
-SPECTRUM = PlotKind("spectrum", 140, _spectrum_panel, missing=_not_explored,
-                    figures=_spectrum_files, fits=_explored, need="explored values")
+POINCARE = _whole_figure_kind("poincare", 130, "poincare_plot")
+SPECTRUM = _whole_figure_kind("spectrum", 140, "spectrum_plot")
 
 
 def _orbit_diagram_files(figures: Figures) -> list[FigureJob]:
