@@ -131,12 +131,7 @@ def hub_path(simulation: Simulation, ax: Axes | None = None, degrees: bool = Tru
     ax.autoscale_view()
     if len(path) > 2:
         sense_arrows(ax, path)
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlabel(axis_label("hub y", unit))
-    ax.set_ylabel(axis_label("hub z", unit))
-    ax.legend(fontsize="small", loc="upper right")
-    ax.set_title(_with_status(simulation, title))
-    return ax.figure
+    return _finish_hub_axes(ax, unit, simulation, title)
 
 
 SPIN_SENSE = 1
@@ -228,6 +223,12 @@ def whirl_snapshots(simulation: Simulation, count: int = 8, ax: Axes | None = No
         ax.text(y + 0.09 * reach * y / norm, z + 0.09 * reach * z / norm, str(k + 1),
                 ha="center", va="center", fontsize="small", zorder=4)
     sense_arrows(ax, turn)
+    return _finish_hub_axes(ax, unit, simulation, title)
+
+
+def _finish_hub_axes(ax: Axes, unit: str, simulation: Simulation, title: str | None) -> Figure:
+    """Equal axes of the hub's y and z in ``unit``, the legend, the title (with the
+    simulation's status); returns the figure."""
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(axis_label("hub y", unit))
     ax.set_ylabel(axis_label("hub z", unit))
