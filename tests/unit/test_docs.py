@@ -61,6 +61,16 @@ def test_study_doc_example_is_the_shipped_study():
     assert block == (ROOT / name).read_text()
 
 
+def test_nothing_a_user_gets_points_outside_the_repository():
+    """The package, the shipped studies, sheets and examples name no file outside the
+    repository (the developers' notes in ../shared are not shipped)."""
+    shipped = [p for folder in ("whirl_cli", "studies", "sheets", "examples")
+               for p in sorted((ROOT / folder).rglob("*"))
+               if p.suffix in (".py", ".yaml", ".ipynb") and "__pycache__" not in p.parts]
+    assert shipped
+    assert [str(p.relative_to(ROOT)) for p in shipped if "../shared" in p.read_text()] == []
+
+
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
 def test_links_lead_inside_the_repository(page):
     text = page.read_text()

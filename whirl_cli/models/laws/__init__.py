@@ -14,7 +14,7 @@ is the registry by study ``type``, of the laws declared here and in the modules 
 
 * ``polynomial`` (here): K x + K2 x^3 + K3 x^5;
 * ``freeplay`` (:mod:`~whirl_cli.models.laws.freeplay`): whirl's smoothed deadband
-  (``../shared/models.md`` section 7), with its exact piecewise-linear form.
+  (docs/models.md, "Freeplay: whirl's law"), with its exact piecewise-linear form.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Freeplay: whirl's smoothed deadband law (``../shared/models.md`` section 7, "whirl's law").
+"""Freeplay: whirl's smoothed deadband law (docs/models.md, "Freeplay: whirl's law").
 
 The exact law: stiffness K_in inside a gap of half-width delta around zero, K_out outside, no
 preload (x the dof, in its unit: rad for the classical model's angles)::
