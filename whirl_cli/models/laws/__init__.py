@@ -19,9 +19,6 @@ is the registry by study ``type``, of the laws declared here and in the modules 
 
 from __future__ import annotations
 
-import importlib
-import os
-
 from .base import Coefficient, Law, LawProblem
 from .freeplay import FREEPLAY
 
@@ -50,16 +47,9 @@ POLYNOMIAL = Law(
 def _declared() -> dict[str, Law]:
     """The laws declared here and in this package's modules, by name: this module's first,
     then module by module in name order."""
-    found: dict[str, Law] = {POLYNOMIAL.name: POLYNOMIAL}
-    names = sorted({entry.name.removesuffix(".py") for folder in __path__
-                    for entry in os.scandir(folder)
-                    if entry.name.endswith(".py") and not entry.name.startswith("_")})
-    for name in names:
-        module = importlib.import_module(f"{__name__}.{name}")
-        for value in vars(module).values():
-            if isinstance(value, Law) and found.setdefault(value.name, value) is not value:
-                raise ValueError(f"stiffness law {value.name!r} declared twice")
-    return found
+    from ...registries import declared
+
+    return declared(__name__, __path__, Law, "stiffness law", {POLYNOMIAL.name: POLYNOMIAL})
 
 
 LAWS: dict[str, Law] = _declared()

@@ -9,8 +9,6 @@ matplotlib) inside their functions, so the command line can list the kinds at st
 
 from __future__ import annotations
 
-import importlib
-import os
 from collections.abc import Callable
 from functools import cache
 from typing import TYPE_CHECKING, Any, NamedTuple
@@ -79,20 +77,9 @@ class PlotKind(NamedTuple):
 @cache
 def registry() -> dict[str, PlotKind]:
     """Every kind declared in this package's modules, by name, in rank order."""
-    found: dict[str, PlotKind] = {}
-    for name in _module_names():
-        loaded = importlib.import_module(f"{__name__}.{name}")
-        for value in vars(loaded).values():
-            if isinstance(value, PlotKind) and found.setdefault(value.name, value) is not value:
-                raise ValueError(f"plot kind {value.name!r} declared twice")
-    return dict(sorted(found.items(), key=lambda item: (item[1].rank, item[0])))
+    from ...registries import by_rank, declared
 
-
-def _module_names() -> list[str]:
-    """The modules of this package (the ``.py`` files of its directories), by name."""
-    return sorted({entry.name.removesuffix(".py") for folder in __path__
-                   for entry in os.scandir(folder)
-                   if entry.name.endswith(".py") and not entry.name.startswith("_")})
+    return by_rank(declared(__name__, __path__, PlotKind, "plot kind"))
 
 
 def get(name: str) -> PlotKind | None:

@@ -10,8 +10,6 @@ The modules are light: they import their recipe, checks and AUTO code inside fun
 
 from __future__ import annotations
 
-import importlib
-import os
 from collections.abc import Callable
 from functools import cache
 from typing import TYPE_CHECKING, Any, NamedTuple
@@ -69,21 +67,9 @@ class ContinuationType(NamedTuple):
 @cache
 def registry() -> dict[str, ContinuationType]:
     """Every type declared in this package's modules, by name, in rank order."""
-    found: dict[str, ContinuationType] = {}
-    for name in _module_names():
-        loaded = importlib.import_module(f"{__name__}.{name}")
-        for value in vars(loaded).values():
-            if isinstance(value, ContinuationType) and \
-                    found.setdefault(value.name, value) is not value:
-                raise ValueError(f"continuation type {value.name!r} declared twice")
-    return dict(sorted(found.items(), key=lambda item: (item[1].rank, item[0])))
+    from ...registries import by_rank, declared
 
-
-def _module_names() -> list[str]:
-    """The modules of this package (the ``.py`` files of its directories), by name."""
-    return sorted({entry.name.removesuffix(".py") for folder in __path__
-                   for entry in os.scandir(folder)
-                   if entry.name.endswith(".py") and not entry.name.startswith("_")})
+    return by_rank(declared(__name__, __path__, ContinuationType, "continuation type"))
 
 
 def get(name: Any) -> ContinuationType | None:
