@@ -215,16 +215,9 @@ def private_imports(path: Path) -> list[tuple[int, str]]:
     return found
 
 
-#: plots is being reorganised behind its kinds' registry: the drawing helpers its modules
-#: share (and figures borrows, the figure and the file check) keep their underscore until then.
-PRIVATE_IMPORTS_ALLOWED = ("whirl_cli.plots.",)
-
-
 def test_no_module_imports_a_private_name_of_another():
     found = [f"{name}:{line}: {target}" for name, path in modules().items()
-             if not name.startswith(PRIVATE_IMPORTS_ALLOWED)
-             for line, target in private_imports(path)
-             if not target.startswith(PRIVATE_IMPORTS_ALLOWED)]
+             for line, target in private_imports(path)]
     assert found == []
 
 

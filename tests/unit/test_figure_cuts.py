@@ -11,7 +11,7 @@ from matplotlib.text import Text
 from whirl_cli.figures.draw import figure_legend, share_limits
 from whirl_cli.plots.cuts import mark_cuts, phase_cuts, solutions_at
 from whirl_cli.plots.diagrams import bifurcation_diagram
-from whirl_cli.plots.key import _new_figure, symbol
+from whirl_cli.plots.key import new_figure, symbol
 from whirl_cli.results import (
     Branch,
     BranchKind,
@@ -89,7 +89,7 @@ def cut_continuation() -> ContinuationResult:
 
 
 def drawn_cuts(continuation, values):
-    figure = _new_figure(figsize=(12, 5))
+    figure = new_figure(figsize=(12, 5))
     grid = figure.add_gridspec(1, 2)
     diagram = figure.add_subplot(grid[0, 0])
     bifurcation_diagram(continuation, ax=diagram)
@@ -185,7 +185,7 @@ def test_no_text_outside_the_canvas(cut_continuation):
 
 
 def test_shared_limits_join_axes_of_one_quantity():
-    figure = _new_figure()
+    figure = new_figure()
     left, right, other = figure.subplots(1, 3)
     left.plot([0, 1], [0, 1])
     right.plot([0, 5], [-2, 1])

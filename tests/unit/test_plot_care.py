@@ -248,11 +248,11 @@ def test_four_cuts_under_a_diagram_at_journal_width_keep_their_size():
     """At 7.2 in (a double journal column) four phase cuts under a diagram go in one row, each
     at least an inch on a side, instead of a 2 x 2 grid that collapses."""
     from whirl_cli.plots.cuts import phase_cuts
-    from whirl_cli.plots.key import _new_figure
+    from whirl_cli.plots.key import new_figure
 
     from .plot_data import hopf_continuation
 
-    figure = _new_figure(figsize=(7.2, 6.6))
+    figure = new_figure(figsize=(7.2, 6.6))
     grid = figure.add_gridspec(2, 1)
     figure.add_subplot(grid[0]).plot([0, 1], [0, 1])
     axes = phase_cuts(hopf_continuation(), [0.1, 0.2, 0.3, 0.45], grid[1])
@@ -280,9 +280,9 @@ def test_a_figure_legend_lists_a_marker_drawn_alike_on_two_panels_once():
     hollow triangle: the sheet's legend lists it once, with the fuller label; a different
     marker keeps its own entry."""
     from whirl_cli.figures.draw import figure_legend
-    from whirl_cli.plots.key import _new_figure
+    from whirl_cli.plots.key import new_figure
 
-    figure = _new_figure()
+    figure = new_figure()
     left, right = figure.subplots(1, 2)
     style = {"marker": "^", "markerfacecolor": "none", "markeredgecolor": "black",
              "linestyle": "none"}
@@ -299,9 +299,9 @@ def test_a_figure_legend_lists_a_marker_drawn_alike_on_two_panels_once():
 
 def _crowded(axes_count: int):
     """A figure of ``axes_count`` axes, each filled by a dense grid of points and a legend."""
-    from whirl_cli.plots.key import _new_figure
+    from whirl_cli.plots.key import new_figure
 
-    figure = _new_figure()
+    figure = new_figure()
     grid = np.linspace(0.0, 1.0, 30)
     xs, ys = np.meshgrid(grid, grid)
     for ax in figure.subplots(1, axes_count, squeeze=False).ravel():
@@ -338,9 +338,9 @@ def test_the_letters_of_close_cuts_do_not_overlap_on_a_short_diagram():
     """Three cuts within 2 % of the axis (3.26: 0.075, 0.0777, 0.09 of 0.8) on a 2 in tall
     diagram: their letters' boxes are disjoint."""
     from whirl_cli.plots.cuts import mark_cuts
-    from whirl_cli.plots.key import _new_figure
+    from whirl_cli.plots.key import new_figure
 
-    ax = _new_figure(figsize=(7.2, 2.0)).add_subplot()
+    ax = new_figure(figsize=(7.2, 2.0)).add_subplot()
     ax.plot([-0.3, 0.5], [-10.0, 10.0])
     mark_cuts(ax, [0.075, 0.0777, 0.09])
     ax.figure.canvas.draw()

@@ -24,8 +24,8 @@ from whirl_cli.plots.diagrams import (
 from whirl_cli.plots.files import PLOT_KINDS, save_study_plots
 from whirl_cli.plots.key import (
     POSITION_STEP,
-    _new_figure,
     _round_positions,
+    new_figure,
     stability_curves,
     stability_segments,
 )
@@ -148,7 +148,7 @@ def test_a_neutral_line_of_equilibria_is_one_neutral_line():
 # -- the layout ----------------------------------------------------------------------------------
 
 def test_layout_rounds_axes_positions_and_keeps_managing_them():
-    figure = _new_figure()
+    figure = new_figure()
     ax = figure.add_subplot()
     ax.plot([0.0, 1.0], [0.0, 123456.0])
     ax.set_title("a title")
@@ -169,7 +169,7 @@ def test_positions_a_few_ulps_apart_round_to_the_same():
     bounds = (0.1362022084780088, 0.5086851851851851, 0.19539487485532367, 0.4279758078703704)
     rounded = []
     for noise in (0.0, 7.8e-16, -7.8e-16):
-        figure = _new_figure()
+        figure = new_figure()
         ax = figure.add_subplot()
         ax.set_position([v + noise for v in bounds], which="both")
         ax.set_in_layout(True)
@@ -310,7 +310,7 @@ def test_all_markers_of_the_key():
 
 
 def test_draws_on_given_axes(continuation):
-    figure = _new_figure()
+    figure = new_figure()
     ax = figure.add_subplot()
     assert bifurcation_diagram(continuation, ax=ax) is figure
     assert len(figure.axes) == 1 and ax.lines
@@ -587,7 +587,7 @@ def test_phase_plane_legend_sorted_by_parameter_whatever_the_order_asked(orbit_b
 
 
 def test_phase_plane_draws_on_given_axes(orbit_branch):
-    figure = _new_figure()
+    figure = new_figure()
     ax = figure.add_subplot()
     assert phase_plane(orbit_branch, ax=ax) is figure and len(ax.lines) == 2
 
@@ -782,9 +782,9 @@ def test_boundary_plot_case_lines_and_labels():
 
 def test_close_case_labels_stay_apart_on_a_short_panel():
     """On a short sheet panel the labels of cases 4 and 5 (0.05 and 0.037) do not overlap."""
-    from whirl_cli.plots.key import _new_figure
+    from whirl_cli.plots.key import new_figure
 
-    ax = _new_figure(figsize=(6.0, 2.2)).add_subplot()
+    ax = new_figure(figsize=(6.0, 2.2)).add_subplot()
     boundary_plot(make_boundary(), make_grid(), cases=CASES, ax=ax)
     ax.figure.canvas.draw()
     boxes = sorted((text.get_window_extent() for text in ax.texts), key=lambda box: box.y0)
@@ -841,7 +841,7 @@ def test_boundary_plot_rejects_bad_input():
 
 
 def test_boundary_plot_draws_on_given_axes():
-    figure = _new_figure()
+    figure = new_figure()
     ax = figure.add_subplot()
     assert boundary_plot(make_boundary(), None, ax=ax) is figure
     assert len(figure.axes) == 1 and ax.lines
@@ -953,7 +953,7 @@ def test_save_study_plots_boundary_ignores_grid_of_other_parameters(tmp_path, mo
 
     def fake(boundary, grid, cases=(), ax=None, **view):
         seen.append((boundary, grid, tuple(cases)))
-        return _new_figure()
+        return new_figure()
 
     monkeypatch.setattr(maps, "boundary_plot", fake)
     boundary = replace(make_boundary(), slices=())

@@ -15,7 +15,7 @@ from whirl_cli.errors import StudyError, WhirlError
 from whirl_cli.figures.draw import draw_sheet
 from whirl_cli.figures.index import Entry, index_html
 from whirl_cli.figures.sheet import load_sheet
-from whirl_cli.plots.key import _new_figure
+from whirl_cli.plots.key import new_figure
 from whirl_cli.plots.panels import PANEL_KINDS, PanelChoice, differing_labels, draw, draw_overlay
 
 
@@ -124,7 +124,7 @@ def test_every_panel_kind_draws_or_names_what_is_missing(continuation):  # noqa:
     result = result_with(continuation, 10.0)
     drawn = {}
     for kind in PANEL_KINDS:
-        ax = _new_figure().add_subplot()
+        ax = new_figure().add_subplot()
         try:
             drawn[kind] = draw(result, kind, ax)
         except WhirlError as error:
@@ -145,7 +145,7 @@ def test_every_panel_kind_draws_or_names_what_is_missing(continuation):  # noqa:
 
 def test_panel_choices_are_checked(continuation):  # noqa: F811
     result = result_with(continuation, 10.0)
-    ax = _new_figure().add_subplot()
+    ax = new_figure().add_subplot()
     with pytest.raises(WhirlError, match="no one-parameter continuation 'nope'"):
         draw(result, "bifurcation", ax, PanelChoice(continuation="nope"))
     with pytest.raises(WhirlError, match="no linear sweep of 'V'"):
@@ -157,7 +157,7 @@ def test_panel_choices_are_checked(continuation):  # noqa: F811
 def test_overlay_one_colour_per_result_labelled_by_what_differs(continuation):  # noqa: F811
     results = [result_with(continuation, k2, f"s{k2:g}") for k2 in (5.0, 10.0, 20.0)]
     assert differing_labels(results) == [f"K2_theta = {k:g} N m/rad^3" for k in (5, 10, 20)]
-    ax = _new_figure().add_subplot()
+    ax = new_figure().add_subplot()
     draw_overlay(results, "bifurcation", ax, labels=[None, "datum K2"])
     legend = [t.get_text() for t in ax.get_legend().get_texts()]
     assert legend[:3] == ["K2_theta = 5 N m/rad^3", "datum K2", "K2_theta = 20 N m/rad^3"]
@@ -226,7 +226,7 @@ def test_damping_multiples_overlay_style_per_result_colour_per_parameter(continu
     sweep = replace(make_sweep(), datum=0.25)
     results = [replace(result_with(continuation, k2), linear_sweeps=(sweep,))
                for k2 in (5.0, 10.0)]
-    ax = _new_figure().add_subplot()
+    ax = new_figure().add_subplot()
     damping, frequency = draw_overlay(results, "damping_multiples", ax, ["on", "off"])
     for panel in (damping, frequency):
         lines = [line for line in panel.lines if not line.get_label().startswith("_")]
@@ -247,14 +247,14 @@ def test_simulation_panels_one_axes_per_dof_and_a_hub_path(continuation):  # noq
                             ("rad", "rad", "rad/s", "rad/s"), states[0], time, states,
                             -states[:, [1, 0]], "rad", 0, "ok")
     result = replace(result_with(continuation, 10.0), simulations=(simulation,))
-    history = draw(result, "time_history", _new_figure().add_subplot(),
+    history = draw(result, "time_history", new_figure().add_subplot(),
                    PanelChoice(simulation="kick"))
     assert [ax.get_ylabel() for ax in history] == ["$\\theta$ [deg]", "$\\psi$ [deg]"]
     np.testing.assert_allclose(history[0].lines[0].get_ydata(), np.degrees(states[:, 0]))
-    (hub,) = draw(result, "hub_path", _new_figure().add_subplot())
+    (hub,) = draw(result, "hub_path", new_figure().add_subplot())
     assert hub.get_xlabel() == "hub y [deg]"
     with pytest.raises(WhirlError, match="no simulation 'other' \\(simulations: kick\\)"):
-        draw(result, "hub_path", _new_figure().add_subplot(), PanelChoice(simulation="other"))
+        draw(result, "hub_path", new_figure().add_subplot(), PanelChoice(simulation="other"))
 
 
 @pytest.mark.parametrize("size, font", [(7.2, 8.0), (12.0, 10.0)])
@@ -268,7 +268,7 @@ def test_figure_legend_takes_as_many_columns_as_its_labels_fit(size, font):
     labels = ["stable equilibrium", "neutral equilibria (zero eigenvalue)",
               "damping ratio 0 ($K_\\theta$ = 0.08071 N m/rad)", "Hopf (HB)", "BW", "FW"]
     with rc_context({"font.size": font}):
-        figure = _new_figure(figsize=(size, 4.0))
+        figure = new_figure(figsize=(size, 4.0))
         for k, ax in enumerate(figure.subplots(1, 2)):
             for label in labels[3 * k:3 * k + 3]:
                 ax.plot([0, 1], [0, k], label=label)

@@ -270,20 +270,20 @@ def test_time_history_draws_one_panel_per_dof_in_degrees(model):
 def test_time_history_and_hub_path_of_another_model_and_given_axes():
     """No state names assumed: the oscillators model's dofs q1..q3 in m, its hub (q1, q2);
     drawn on axes the caller gives."""
-    from whirl_cli.plots.key import _new_figure
+    from whirl_cli.plots.key import new_figure
 
     model = get_model("oscillators")
     params = model.parameter_vector({})
     found = simulate.simulation(model, params, np.r_[0.1, 0.0, -0.05, np.zeros(3)], 1.0, 101)
-    figure = _new_figure()
+    figure = new_figure()
     axes = figure.subplots(3, 1)
     assert time_history(found, axes=list(axes)) is figure
     assert [ax.get_ylabel() for ax in axes] == ["q1 [m]", "q2 [m]", "q3 [m]"]
     assert axes[0].get_title() == found.name
-    single = _new_figure().add_subplot()
+    single = new_figure().add_subplot()
     time_history(found, states=["dq2"], axes=single)
     assert single.get_ylabel() == "dq2 [m/s]"
-    ax = _new_figure().add_subplot()
+    ax = new_figure().add_subplot()
     hub_path(found, ax=ax)
     assert (ax.get_xlabel(), ax.get_ylabel()) == ("hub y [m]", "hub z [m]")
     segments = ax.collections[0].get_segments()

@@ -16,7 +16,7 @@ from tests.unit.plot_data import (
     blowup_family,
 )
 from whirl_cli.plots.blowup import approach, blowup_plot, fit_blowup
-from whirl_cli.plots.key import _new_figure
+from whirl_cli.plots.key import new_figure
 from whirl_cli.plots.laws import laws_plot
 from whirl_cli.plots.linear import (
     STABLE_COLOURS,
@@ -107,7 +107,7 @@ def test_laws_side_by_side_with_the_linear_spring():
     for name in ("hardening_case2", "softening_case2", "combined_case2"):
         study = load_study(ROOT / "studies" / "thesis_ch3" / f"{name}.yaml")
         entries.append((law_curve(study.variant(), study.parameter_values(), "theta"), name))
-    ax = _new_figure().add_subplot()
+    ax = new_figure().add_subplot()
     laws_plot(entries, ax=ax)
     lines = {line.get_label(): line for line in ax.lines}
     assert [t.get_text() for t in ax.get_legend().get_texts()] == [

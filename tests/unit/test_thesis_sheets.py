@@ -22,7 +22,7 @@ from whirl_cli.models import get_model
 from whirl_cli.plots.blowup import blowup_plot, fit_blowup
 from whirl_cli.plots.cuts import phase_cut
 from whirl_cli.plots.files import rendered_formats
-from whirl_cli.plots.key import _new_figure
+from whirl_cli.plots.key import new_figure
 from whirl_cli.plots.linear import root_locus_plot
 from whirl_cli.results import BranchKind, ContinuationResult, PointType
 
@@ -316,7 +316,7 @@ def test_saddles_at_a_cut_are_marked_apart_from_other_unstable_equilibria():
                             [name == "stable"] * 5),
                 eigenvalues=np.tile(np.asarray(roots[name], complex), (5, 1)))
         for name, theta in (("stable", 0.0), ("saddle", 0.1), ("focus", -0.1)))
-    ax = _new_figure().add_subplot()
+    ax = new_figure().add_subplot()
     phase_cut(ContinuationResult("k1", "one-parameter", branches, ()), 0.1, ax)
     marks = {line.get_label().split()[0]: np.asarray(line.get_xydata()) for line in ax.lines}
     theta_deg = np.degrees(0.1)

@@ -280,14 +280,14 @@ class _Artist:
         """Publish the sheet's files, the vector ones first, the PNG (whose key says the
         figure is up to date) last."""
         from ..output.atomic import publish
-        from ..plots.files import _own
+        from ..plots.files import replaceable_image
 
         if files is None:
             return FigureOutcome(sheet, None, problem)
         _make_folder(self.out_dir)
         for suffix in sorted(files, key=lambda s: s == "png"):
             publish(files[suffix], self.out_dir / f"{sheet.stem}.{suffix}", overwrite=True,
-                    what="the figure", own=_own(suffix))
+                    what="the figure", own=replaceable_image(suffix))
         return FigureOutcome(sheet, self.out_dir / f"{sheet.stem}.png")
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..errors import WhirlError
-from ..plots.key import _new_figure
+from ..plots.key import new_figure
 from ..plots.panels import PanelChoice, draw, draw_overlay
 from ..results import StudyResult
 from .sheet import PanelSpec, Sheet
@@ -39,7 +39,7 @@ def draw_sheet(sheet: Sheet, results: Mapping[Path, StudyResult]) -> Figure:
     A panel that cannot be drawn is a :class:`WhirlError` naming the sheet and the panel."""
     rows, columns = sheet.shape
     size = sheet.figure_size
-    figure = _new_figure(figsize=size)
+    figure = new_figure(figsize=size)
     grid = figure.add_gridspec(rows, columns)
     for k, panel in enumerate(sheet.panels):
         ax = figure.add_subplot(grid[k // columns, k % columns])

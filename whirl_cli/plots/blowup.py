@@ -16,11 +16,11 @@ from ..results import Branch, ContinuationResult, PointType
 from .key import (
     MARKER_STYLE,
     PLOT_KEY,
-    _new_figure,
-    _plot_styled,
     axis_label,
     branch_style,
     log_scale_if_decades,
+    new_figure,
+    plot_styled,
     stability_curves,
     symbol,
 )
@@ -156,7 +156,7 @@ def blowup_plot(continuation: ContinuationResult, branch: str | None = None,
     figure; returns the figure. Title: ``title`` (None: the family's name)."""
     family, global_point = blowup_family(continuation, branch)
     if ax is None:
-        ax = _new_figure().add_subplot()
+        ax = new_figure().add_subplot()
     x, period = family.parameters[:, 0], family.period
     first: dict[str, object] = {}
     _draw_family(ax, continuation, family, global_point, first)
@@ -200,7 +200,7 @@ def _draw_family(ax: Axes, continuation: ContinuationResult, family: Branch, glo
     """The family's period by stability and its points (:func:`_family_points`)."""
     for xs, ys, stable in stability_curves(family.parameters[:, 0], family.period,
                                            family.stable, family.stability_known):
-        _plot_styled(ax, xs, ys, branch_style(family.kind, stable), first)
+        plot_styled(ax, xs, ys, branch_style(family.kind, stable), first)
     _family_points(ax, continuation, family, global_point, first)
 
 
@@ -281,7 +281,7 @@ def _family_points(ax: Axes, continuation: ContinuationResult, family: Branch, g
     for style in PLOT_KEY:
         if style in points:
             xs, ys = np.array(points[style]).T
-            _plot_styled(ax, xs, ys, style, first)
+            plot_styled(ax, xs, ys, style, first)
             if style in ("homoclinic", "heteroclinic"):  # on top of the fold beside it
                 hollow = PLOT_KEY[style].get("markerfacecolor") == "none"
                 first[style].set(zorder=5, markersize=11, markeredgewidth=1.4 if hollow

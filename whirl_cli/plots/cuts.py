@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import WhirlError
 from ..results import Branch, BranchKind, ContinuationResult, PointType
-from .key import _BLACK, axis_label, display_unit, next_colour, symbol
+from .key import BLACK, axis_label, display_unit, next_colour, symbol
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -23,12 +23,12 @@ _GLOBAL = {PointType.HOMOCLINIC: "homoclinic", PointType.HETEROCLINIC: "heterocl
 _EXACT = 1e-6  # an orbit stored at a cut (orbits_at): within this fraction of the span
 _NEAR = 2e-3  # a cut at a global bifurcation: within this fraction of the span
 _LETTERS = "abcdefghijklmnopqrstuvwxyz"
-_STABLE_POINT = {"marker": "x", "markersize": 8, "markeredgewidth": 1.8, "color": _BLACK,
+_STABLE_POINT = {"marker": "x", "markersize": 8, "markeredgewidth": 1.8, "color": BLACK,
                  "label": "stable fixed point (cross)"}
 _UNSTABLE_POINT = {"marker": "x", "markersize": 7, "markeredgewidth": 1.0, "color": "grey",
                    "label": "unstable fixed point (cross)"}
 _SADDLE_POINT = {"marker": "X", "markersize": 10, "markeredgewidth": 0.8, "color": "dimgrey",
-                 "markeredgecolor": _BLACK, "label": "saddle (cross, a real eigenvalue > 0)"}
+                 "markeredgecolor": BLACK, "label": "saddle (cross, a real eigenvalue > 0)"}
 _REAL = 1e-9  # |Im| of an eigenvalue counted as real, relative to its modulus
 
 

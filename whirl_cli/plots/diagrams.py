@@ -12,19 +12,19 @@ import numpy as np
 from ..errors import WhirlError
 from ..results import Branch, ContinuationResult, Criticality, LocateStatus, PointType
 from .key import (
-    _BLACK,
-    _PLOTTED_KINDS,
+    BLACK,
     BOUNDARY_KEY,
     MARKER_STYLE,
     PLOT_KEY,
-    _new_figure,
-    _plot_styled,
+    PLOTTED_KINDS,
     axis_label,
     branch_style,
     display_unit,
     is_neutral_line,
     log_scale_if_decades,
+    new_figure,
     next_colour,
+    plot_styled,
     stability_curves,
 )
 
@@ -56,10 +56,10 @@ def bifurcation_diagram(continuation: ContinuationResult, state: str | None = No
     its width written at its top. The legend lists only styles present; the title is
     ``title`` (None: the continuation's name).
     """
-    which, branches, state = _checked_branches(continuation, state, which)
+    which, branches, state = checked_branches(continuation, state, which)
     if ax is None:
-        ax = _new_figure().add_subplot()
-    handles, labels = _draw_bifurcation(ax, continuation, branches, state, which, degrees)
+        ax = new_figure().add_subplot()
+    handles, labels = draw_bifurcation(ax, continuation, branches, state, which, degrees)
     bands = overhangs(continuation)
     if bands:
         unit = branches[0].parameter_units[0] if branches else ""
@@ -133,14 +133,14 @@ def _shade_overhangs(ax: Axes, bands: list[tuple[float, float]], unit: str):
     return Patch(color=style["color"], alpha=OVERHANG_ALPHA, linewidth=0)
 
 
-def _checked_branches(continuation: ContinuationResult, state: str | None,
+def checked_branches(continuation: ContinuationResult, state: str | None,
                       which: Sequence[str]) -> tuple[tuple[str, ...], list[Branch], str]:
     """``which`` as a tuple, the plotted branches and the state drawn (``state``, or the first
     state of the first plotted branch if None); WhirlError if an argument is bad."""
     which = tuple(which)
     if not which or not set(which) <= {"max", "min"}:
         raise WhirlError(f"which must be a non-empty subset of ('max', 'min'), got {which}")
-    branches = [b for b in continuation.branches if b.kind in _PLOTTED_KINDS]
+    branches = [b for b in continuation.branches if b.kind in PLOTTED_KINDS]
     if state is None:
         state = branches[0].state_names[0] if branches else ""
     for branch in branches:
@@ -150,15 +150,15 @@ def _checked_branches(continuation: ContinuationResult, state: str | None,
     return which, branches, state
 
 
-def _draw_bifurcation(ax: Axes, continuation: ContinuationResult, branches: list[Branch],
+def draw_bifurcation(ax: Axes, continuation: ContinuationResult, branches: list[Branch],
                       state: str, which: tuple[str, ...], degrees: bool
                       ) -> tuple[list, list[str]]:
     """Branches, special points and axis labels of a bifurcation diagram; legend entries."""
     first: dict[str, object] = {}  # style -> first artist drawn with it (legend handle)
     for branch in branches:
         _draw_branch(ax, branch, state, which, degrees, first)
-    _draw_special_points(ax, continuation, branches, state, degrees, first)
-    _label_axes(ax, continuation, branches, state, which, degrees)
+    draw_special_points(ax, continuation, branches, state, degrees, first)
+    label_axes(ax, continuation, branches, state, which, degrees)
     return ([first[key] for key in PLOT_KEY if key in first],
             [str(PLOT_KEY[key]["label"]) for key in PLOT_KEY if key in first])
 
@@ -186,7 +186,7 @@ def projections_figure(continuation: ContinuationResult, which: Sequence[str] = 
         columns = max(2, grid_columns(len(states), region)) if len(states) >= 4 else 2
     rows = max(1, -(-len(states) // columns))
     if region is None:
-        figure = _new_figure(figsize=(10.0, 3.2 * rows + 0.6), layout="constrained")
+        figure = new_figure(figsize=(10.0, 3.2 * rows + 0.6), layout="constrained")
         grid = figure.add_gridspec(rows, 2)
     else:
         figure = region.get_gridspec().figure
@@ -218,7 +218,7 @@ def projections_figure(continuation: ContinuationResult, which: Sequence[str] = 
 
 def _common_states(continuation: ContinuationResult) -> tuple[str, ...]:
     """States on every plotted branch, in the order of the first (``()`` without branches)."""
-    branches = [b for b in continuation.branches if b.kind in _PLOTTED_KINDS]
+    branches = [b for b in continuation.branches if b.kind in PLOTTED_KINDS]
     if not branches:
         return ()
     return tuple(s for s in branches[0].state_names if all(s in b.state_names for b in branches))
@@ -240,14 +240,14 @@ def period_plot(continuation: ContinuationResult, title: str | None = None,
     if given, else on a new figure; returns the figure.
     """
     if ax is None:
-        ax = _new_figure().add_subplot()
+        ax = new_figure().add_subplot()
     periodic = [b for b in continuation.branches if b.is_periodic]
     first: dict[str, object] = {}
     for branch in periodic:
         x = branch.parameters[:, 0]
         for xs, ys, stable in stability_curves(x, branch.period, branch.stable,
                                                  branch.stability_known):
-            _plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)
+            plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)
     periods = np.concatenate([b.period for b in periodic]) if periodic else np.array([])
     periods = periods[np.isfinite(periods) & (periods > 0)]
     points, brackets = _period_points(continuation, periodic)
@@ -255,14 +255,14 @@ def period_plot(continuation: ContinuationResult, title: str | None = None,
     for style in PLOT_KEY:
         if style in points:
             xs, ys = np.array(points[style]).T
-            _plot_styled(ax, xs, ys, style, first)
+            plot_styled(ax, xs, ys, style, first)
     handles = [first[key] for key in PLOT_KEY if key in first]
     labels = [str(PLOT_KEY[key]["label"]) for key in PLOT_KEY if key in first]
     if brackets and periods.size:
         top = float(np.max(periods))
         for low, high in brackets:
             bar = ax.errorbar([(low + high) / 2], [top], xerr=[(high - low) / 2], fmt="none",
-                              ecolor=_BLACK, elinewidth=1.2, capsize=4, zorder=4,
+                              ecolor=BLACK, elinewidth=1.2, capsize=4, zorder=4,
                               label="_bracket")
         handles.append(bar)
         labels.append("bracket (global bifurcation)")
@@ -362,7 +362,7 @@ def phase_plane(branch: Branch, labels: Sequence[int] | None = None, x: str | No
     fy, unit_y = display_unit(branch.state_units[iy], degrees)
     own = ax is None
     if ax is None:
-        ax = _new_figure().add_subplot()
+        ax = new_figure().add_subplot()
     for orbit in orbits:
         colour = next_colour(ax.figure)
         states = np.asarray(orbit.states, dtype=float)
@@ -396,14 +396,14 @@ def _draw_branch(ax: Axes, branch: Branch, state: str, which: tuple[str, ...], d
     for table in tables:
         y = branch.state(state, table) * factor
         if not branch.is_periodic and is_neutral_line(x, branch.stable):
-            _plot_styled(ax, x, y, "neutral_equilibrium", first)
+            plot_styled(ax, x, y, "neutral_equilibrium", first)
             continue
         for xs, ys, stable in stability_curves(x, y, branch.stable,
                                                  branch.stability_known):
-            _plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)
+            plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)
 
 
-def _draw_special_points(ax: Axes, continuation: ContinuationResult, branches: list[Branch],
+def draw_special_points(ax: Axes, continuation: ContinuationResult, branches: list[Branch],
                          state: str, degrees: bool, first: dict) -> None:
     """Markers for special points, one artist per marker style.
 
@@ -429,7 +429,7 @@ def _draw_special_points(ax: Axes, continuation: ContinuationResult, branches: l
     for style in PLOT_KEY:
         if style in points:
             xs, ys = np.array(points[style]).T
-            _plot_styled(ax, xs, ys, style, first)
+            plot_styled(ax, xs, ys, style, first)
 
 
 def _at_row(point, branch: Branch) -> bool:
@@ -449,7 +449,7 @@ def _point_type(code: int) -> PointType | None:
         return None
 
 
-def _label_axes(ax: Axes, continuation: ContinuationResult, branches: list[Branch], state: str,
+def label_axes(ax: Axes, continuation: ContinuationResult, branches: list[Branch], state: str,
                 which: tuple[str, ...], degrees: bool) -> None:
     """Axis labels with units from the first plotted branch (nothing if there is none)."""
     if not branches:

@@ -18,7 +18,7 @@ from ..errors import OutputError, WhirlError
 from ..output.guard import PLOT_CHARACTERS, plot_stem
 from ..results import Branch, ContinuationResult, PointType, StudyResult
 from .captions import Captions, Fixed, captions
-from .key import _PLOTTED_KINDS
+from .key import PLOTTED_KINDS
 from .kinds import Figures, plot_kinds, registry
 
 if TYPE_CHECKING:
@@ -92,9 +92,9 @@ def save_study_plots(result: StudyResult, kinds: tuple[str, ...], out_dir: Path,
         if name.endswith(".png"):
             check_plot(out_dir / name, result_file or out_dir / f"{stem}.h5", overwrite=True)
         else:
-            check(out_dir / name, _own(Path(name).suffix[1:]), overwrite=True)
+            check(out_dir / name, replaceable_image(Path(name).suffix[1:]), overwrite=True)
     return sorted(publish(data, out_dir / name, overwrite=True, what="the plot",
-                          own=_own(Path(name).suffix[1:])) for name, data in rendered)
+                          own=replaceable_image(Path(name).suffix[1:])) for name, data in rendered)
 
 
 def plot_names(result: StudyResult, kinds: tuple[str, ...], stem: str,
@@ -294,7 +294,7 @@ def small_angle(branch: Branch, orbit) -> bool:
 
 def state_for(continuation: ContinuationResult, state: str | None) -> str | None:
     """``state`` if every plotted branch has it, else None (the first state)."""
-    branches = [b for b in continuation.branches if b.kind in _PLOTTED_KINDS]
+    branches = [b for b in continuation.branches if b.kind in PLOTTED_KINDS]
     if state is None or not branches or all(state in b.state_names for b in branches):
         return state
     return None
@@ -321,7 +321,7 @@ VECTOR_RC = {"pdf.fonttype": 42, "svg.fonttype": "path", "svg.hashsalt": "whirl"
 bitmaps), SVG text drawn as paths (no font needed to view it), SVG ids the same each run."""
 
 
-def _own(suffix: str):
+def replaceable_image(suffix: str):
     """The kind of file (:class:`whirl_cli.output.guard.Own`) a figure of ``suffix`` may
     replace: a PNG, PDF or SVG file."""
     from ..output.guard import IMAGE, Own, starting
@@ -398,7 +398,7 @@ def _png(figure: Figure, dpi: int, metadata: dict[str, str] | None = None,
     buffer = io.BytesIO()
     try:
         canvas = figure.canvas
-        if not isinstance(canvas, FigureCanvasAgg):  # not from _new_figure
+        if not isinstance(canvas, FigureCanvasAgg):  # not from new_figure
             canvas = FigureCanvasAgg(figure)
         figure.set_dpi(dpi)
         canvas.draw()

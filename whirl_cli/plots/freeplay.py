@@ -10,11 +10,11 @@ import numpy as np
 from ..results import ContinuationResult
 from .key import (
     PLOT_KEY,
-    _new_figure,
-    _plot_styled,
     axis_label,
     branch_style,
     log_scale_if_decades,
+    new_figure,
+    plot_styled,
     stability_curves,
 )
 
@@ -37,7 +37,7 @@ def amplitude_diagram(continuation: ContinuationResult, ax: Axes | None = None) 
     freeplay amplitudes the axes stay empty. Draws on ``ax`` if given, else on a new figure;
     returns the figure."""
     if ax is None:
-        ax = _new_figure().add_subplot()
+        ax = new_figure().add_subplot()
     by_name = {b.name: b for b in continuation.branches}
     first: dict[str, object] = {}
     estimate = None
@@ -54,7 +54,7 @@ def amplitude_diagram(continuation: ContinuationResult, ax: Axes | None = None) 
         x_label = axis_label(branch.parameter_names[0], branch.parameter_units[0])
         for xs, ys, stable in stability_curves(branch.parameters[:, 0], found.amplitude_ratio,
                                                  branch.stable, branch.stability_known):
-            _plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)
+            plot_styled(ax, xs, ys, branch_style(branch.kind, stable), first)
         if len(found.estimate_ratio):
             (estimate,) = ax.plot(found.estimate_parameter, found.estimate_ratio,
                                   label="_estimate", **ESTIMATE_STYLE)

@@ -24,7 +24,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-_BLACK = "black"
+BLACK = "black"
 _MARKER_SIZE = 8.0
 
 PLOT_KEY: dict[str, dict[str, object]] = {
@@ -39,19 +39,19 @@ PLOT_KEY: dict[str, dict[str, object]] = {
     "stable_periodic": {"color": "blue", "linestyle": "-", "label": "stable periodic"},
     "unstable_periodic": {"color": "red", "linestyle": ":", "label": "unstable periodic"},
     # special points
-    "hopf": {"marker": "s", "markerfacecolor": "none", "markeredgecolor": _BLACK,
+    "hopf": {"marker": "s", "markerfacecolor": "none", "markeredgecolor": BLACK,
              "label": "Hopf (HB)"},
-    "branch_point": {"marker": "*", "markerfacecolor": _BLACK, "markeredgecolor": _BLACK,
+    "branch_point": {"marker": "*", "markerfacecolor": BLACK, "markeredgecolor": BLACK,
                      "label": "branch point (BP, BPC)"},
-    "fold": {"marker": "o", "markerfacecolor": _BLACK, "markeredgecolor": _BLACK,
+    "fold": {"marker": "o", "markerfacecolor": BLACK, "markeredgecolor": BLACK,
              "label": "fold (LP, LPC)"},
-    "homoclinic": {"marker": "^", "markerfacecolor": _BLACK, "markeredgecolor": _BLACK,
+    "homoclinic": {"marker": "^", "markerfacecolor": BLACK, "markeredgecolor": BLACK,
                    "label": "homoclinic"},
-    "heteroclinic": {"marker": "^", "markerfacecolor": "none", "markeredgecolor": _BLACK,
+    "heteroclinic": {"marker": "^", "markerfacecolor": "none", "markeredgecolor": BLACK,
                      "label": "heteroclinic"},
-    "torus": {"marker": "o", "markerfacecolor": "none", "markeredgecolor": _BLACK,
+    "torus": {"marker": "o", "markerfacecolor": "none", "markeredgecolor": BLACK,
               "label": "torus (TR)"},
-    "period_doubling": {"marker": "D", "markerfacecolor": _BLACK, "markeredgecolor": _BLACK,
+    "period_doubling": {"marker": "D", "markerfacecolor": BLACK, "markeredgecolor": BLACK,
                         "label": "period doubling (PD)"},
 }
 """Semantic style -> Line2D keyword arguments (including ``label``). Do not mutate."""
@@ -70,18 +70,18 @@ MARKER_STYLE: dict[PointType, str] = {
 """Point type -> key of :data:`PLOT_KEY`; types not listed (REGULAR, RG, UZ, EP, MX, ...) get
 no marker."""
 
-_UNSAFE_LABEL = "unsafe (overhang)"
+UNSAFE_LABEL = "unsafe (overhang)"
 BOUNDARY_KEY: dict[str, dict[str, object]] = {
     # linear analysis over a grid
     "linearly_unstable": {"color": "lightgrey", "label": "linearly unstable"},
-    "linear_flutter": {"color": _BLACK, "linestyle": "-", "linewidth": 0.8,
+    "linear_flutter": {"color": BLACK, "linestyle": "-", "linewidth": 0.8,
                        "label": "linear boundary (flutter)"},
-    "linear_divergence": {"color": _BLACK, "linestyle": "--", "linewidth": 0.8,
+    "linear_divergence": {"color": BLACK, "linestyle": "--", "linewidth": 0.8,
                           "label": "linear boundary (divergence)"},
     # loci of the two-parameter continuation, by Boundary.loci kind
     "hopf": {"color": "darkblue", "linestyle": "-", "linewidth": 1.5,
              "label": "Hopf locus (flutter)"},
-    "branch_point": {"color": _BLACK, "linestyle": "--", "linewidth": 1.5,
+    "branch_point": {"color": BLACK, "linestyle": "--", "linewidth": 1.5,
                      "label": "branch point locus (divergence)"},
     "fold": {"color": "grey", "linestyle": "-.", "linewidth": 1.5, "label": "fold locus (LP)"},
     "fold_of_cycles": {"color": "orange", "linestyle": "-", "linewidth": 1.5,
@@ -91,13 +91,13 @@ BOUNDARY_KEY: dict[str, dict[str, object]] = {
               "markerfacecolor": "none", "markeredgecolor": "green", "markersize": 5,
               "markevery": 0.08, "label": "torus locus (TR)"},
     # the unsafe region
-    "unsafe": {"color": "red", "alpha": 0.5, "label": _UNSAFE_LABEL},
+    "unsafe": {"color": "red", "alpha": 0.5, "label": UNSAFE_LABEL},
 }
 """Stability-map style -> keyword arguments (``Line2D`` for lines, patch colour/alpha for the
 "linearly_unstable" shading and the "unsafe" polygons), including the legend ``label``. The
 locus entries are keyed by the kinds of :attr:`Boundary.loci`. Do not mutate."""
 
-_PLOTTED_KINDS = (BranchKind.EQUILIBRIUM, BranchKind.PERIODIC)
+PLOTTED_KINDS = (BranchKind.EQUILIBRIUM, BranchKind.PERIODIC)
 
 
 def branch_style(kind: str, stable: bool) -> str:
@@ -174,7 +174,7 @@ def _broken(pieces: list[np.ndarray], gap: np.ndarray) -> np.ndarray:
     return np.concatenate([part for piece in pieces for part in (piece, gap)][:-1])
 
 
-def _new_figure(**kwargs) -> Figure:
+def new_figure(**kwargs) -> Figure:
     """A Figure on an Agg canvas, outside pyplot (needs no display, no closing), laid out by
     :func:`_settled_layout_class` (constrained layout, its axes positions rounded) and drawn
     with fresh font objects: matplotlib's cached ones keep state between texts, so an axes edge
@@ -299,7 +299,7 @@ larger: the global points (the filled one edged in white) and the torus point as
 that a fold at the same place neither hides them nor is hidden."""
 
 
-def _plot_styled(ax: Axes, x: np.ndarray, y: np.ndarray, style: str, first: dict) -> None:
+def plot_styled(ax: Axes, x: np.ndarray, y: np.ndarray, style: str, first: dict) -> None:
     """Plot with ``PLOT_KEY[style]``; remember the first artist of each style for the legend."""
     kwargs = dict(PLOT_KEY[style])
     kwargs["label"] = "_" + str(kwargs["label"])  # legend is assembled from ``first``
@@ -310,7 +310,7 @@ def _plot_styled(ax: Axes, x: np.ndarray, y: np.ndarray, style: str, first: dict
     first.setdefault(style, line)
 
 
-def _colours() -> Iterator[str]:
+def colour_cycle() -> Iterator[str]:
     """Endless cycle of the default matplotlib line colours."""
     from matplotlib import rcParams
 
@@ -332,7 +332,7 @@ def next_colour(figure) -> str:
     return FIGURE_COLOURS[taken % len(FIGURE_COLOURS)]
 
 
-def _patch_proxy(style: dict[str, object]):
+def patch_proxy(style: dict[str, object]):
     """A legend handle for a filled area of ``style``'s colour (and alpha)."""
     from matplotlib.patches import Patch
 

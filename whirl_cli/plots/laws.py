@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..results import LawCurve, StudyResult
-from .key import _new_figure, axis_label, display_unit, symbol
+from .key import axis_label, display_unit, new_figure, symbol
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -31,7 +31,7 @@ def law_plot(curve: LawCurve, ax: Axes | None = None, title: str | None = None) 
     ``title`` (None: the law and its coefficients), wrapped at the canvas edge."""
     factor, unit = display_unit(curve.dof_unit, True)
     if ax is None:
-        ax = _new_figure().add_subplot()
+        ax = new_figure().add_subplot()
     x, k = curve.x, curve.stiffness_value
     ax.plot(factor * x, k * x, label=f"linear spring ({symbol(curve.stiffness)} = {k:g})",
             **LINEAR_STYLE)
@@ -73,7 +73,7 @@ def laws_plot(entries, ax: Axes | None = None, title: str | None = None) -> Figu
     from matplotlib import rcParams
 
     if ax is None:
-        ax = _new_figure().add_subplot()
+        ax = new_figure().add_subplot()
     colours = rcParams["axes.prop_cycle"].by_key()["color"]
     springs: dict[float, str] = {}
     span = None

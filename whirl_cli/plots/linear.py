@@ -12,7 +12,7 @@ import numpy as np
 
 from ..results import LinearSweep
 from ..units import HZ_PER_RAD_S
-from .key import _colours, _new_figure, axis_label
+from .key import axis_label, colour_cycle, new_figure
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -35,7 +35,7 @@ def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = 
     (frequency, damping) if given, else on a new figure; returns the figure.
     """
     if axes is None:
-        axes = _new_figure(figsize=(6.4, 6.4)).subplots(2, 1, sharex=True)
+        axes = new_figure(figsize=(6.4, 6.4)).subplots(2, 1, sharex=True)
     ax_freq, ax_damp = axes
     figure = ax_freq.figure
     scale = HZ_PER_RAD_S if hz else 1.0
@@ -126,7 +126,7 @@ def root_locus_plot(sweep: LinearSweep, title: str | None = None, ax: Axes | Non
     from .key import symbol
 
     if ax is None:
-        ax = _new_figure().add_subplot()
+        ax = new_figure().add_subplot()
     figure = ax.figure
     scale = _draw_roots(ax, sweep)
     events = locus_events(sweep)
@@ -214,13 +214,13 @@ def damping_multiples_plot(sweeps: Sequence[LinearSweep],
     ``title`` (None: ``"least-damped mode vs parameter multiples"``).
     """
     if axes is None:
-        figure = _new_figure(figsize=(6.4, 6.4))
+        figure = new_figure(figsize=(6.4, 6.4))
         ax_damp, ax_freq = figure.subplots(2, 1, sharex=True)
     else:
         ax_damp, ax_freq = axes
         figure = ax_damp.figure
     scale = HZ_PER_RAD_S if hz else 1.0
-    colours = _colours()
+    colours = colour_cycle()
     drawn = 0
     for sweep in sweeps:
         datum = sweep_datum(sweep, datums)

@@ -13,15 +13,15 @@ import numpy as np
 
 from ..errors import WhirlError
 from ..results import Boundary, ContinuationKind, ContinuationResult, LinearGrid, on_slice
-from .diagrams import _checked_branches, _draw_bifurcation
+from .diagrams import checked_branches, draw_bifurcation
 from .key import (
-    _BLACK,
-    _UNSAFE_LABEL,
+    BLACK,
     BOUNDARY_KEY,
-    _new_figure,
-    _patch_proxy,
+    UNSAFE_LABEL,
     axis_label,
     log_scale_if_decades,
+    new_figure,
+    patch_proxy,
 )
 
 if TYPE_CHECKING:
@@ -71,14 +71,14 @@ def boundary_plot(boundary: Boundary | None, grid: LinearGrid | None,
     if boundary is None and grid is None:
         raise WhirlError("boundary_plot needs a boundary, a linear grid or both")
     if boundary is not None and grid is not None:
-        oriented = _oriented_grid(grid, boundary.parameter_names)
+        oriented = oriented_grid(grid, boundary.parameter_names)
         if oriented is None:
             raise WhirlError(f"linear grid over ({grid.x_parameter}, {grid.y_parameter}) does "
                              f"not match boundary {boundary.name!r} over "
                              f"({', '.join(boundary.parameter_names)})")
         grid = oriented
     if ax is None:
-        ax = _new_figure().add_subplot()
+        ax = new_figure().add_subplot()
     first: dict[str, object] = {}
     if grid is not None:
         _draw_grid(ax, grid, first, surface=boundary is None)
@@ -112,7 +112,7 @@ def boundary_plot(boundary: Boundary | None, grid: LinearGrid | None,
     return ax.figure
 
 
-def _oriented_grid(grid: LinearGrid, names: Sequence[str]) -> LinearGrid | None:
+def oriented_grid(grid: LinearGrid, names: Sequence[str]) -> LinearGrid | None:
     """``grid`` with x = ``names[0]`` and y = ``names[1]`` (transposed if needed), else None."""
     if (grid.x_parameter, grid.y_parameter) == tuple(names):
         return grid
@@ -162,7 +162,7 @@ def _draw_grid(ax: Axes, grid: LinearGrid, first: dict, surface: bool = False) -
         style = BOUNDARY_KEY["linearly_unstable"]
         ax.contourf(grid.x, grid.y, max_real, levels=[0.0, np.inf], colors=[style["color"]],
                     zorder=0)
-        first["linearly_unstable"] = _patch_proxy(style)
+        first["linearly_unstable"] = patch_proxy(style)
     for key, lines in (("linear_flutter", grid.flutter), ("linear_divergence", grid.divergence)):
         for line in lines:
             _plot_polyline(ax, line, key, first, zorder=1)
@@ -172,7 +172,7 @@ def _hatch_proxy():
     """A legend handle for the hatched unstable region of a surface."""
     from matplotlib.patches import Patch
 
-    return Patch(facecolor="none", edgecolor=_BLACK, hatch="//",
+    return Patch(facecolor="none", edgecolor=BLACK, hatch="//",
                  label=BOUNDARY_KEY["linearly_unstable"]["label"])
 
 
@@ -238,7 +238,7 @@ def _draw_cases(ax: Axes, cases: Sequence[float], labels: Sequence[str] = ()) ->
     """Dotted horizontal lines at the case values, labelled right of the axes by ``labels``
     ("case k" where there is none)."""
     for k, value in enumerate(cases, 1):
-        ax.axhline(float(value), color=_BLACK, linestyle=":", linewidth=0.8, zorder=1,
+        ax.axhline(float(value), color=BLACK, linestyle=":", linewidth=0.8, zorder=1,
                    label=f"_case {k}")
     bottom, top = ax.get_ylim()
     low, high = sorted((bottom, top))
@@ -318,10 +318,10 @@ def overhang_diagram(continuation: ContinuationResult, boundary: Boundary | None
         diagram = slice_continuation(continuation, slice_index(boundary, slice_value))
     else:
         diagram = continuation
-    which, branches, state = _checked_branches(diagram, state, which)
+    which, branches, state = checked_branches(diagram, state, which)
     if ax is None:
-        ax = _new_figure().add_subplot()
-    handles, labels = _draw_bifurcation(ax, diagram, branches, state, which, degrees)
+        ax = new_figure().add_subplot()
+    handles, labels = draw_bifurcation(ax, diagram, branches, state, which, degrees)
     band = None
     intervals = () if boundary is None else boundary.intervals
     for interval in intervals:
@@ -331,7 +331,7 @@ def overhang_diagram(continuation: ContinuationResult, boundary: Boundary | None
             band = band or span
     if band is not None:
         handles.append(band)
-        labels.append(_UNSAFE_LABEL)
+        labels.append(UNSAFE_LABEL)
     if handles:
         ax.legend(handles, labels, fontsize="small")
     if title is None:

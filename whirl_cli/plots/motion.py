@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import WhirlError
 from ..results import ContinuationResult, Exploration, MotionKind
-from .key import _PLOTTED_KINDS, _new_figure, axis_label, display_unit
+from .key import PLOTTED_KINDS, axis_label, display_unit, new_figure
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -64,7 +64,7 @@ def poincare_plot(continuation: ContinuationResult, x: str | None = None,
     new figure; returns the figure. Title ``title`` (None: the continuation's name)."""
     found = _explorations(continuation)
     if ax is None:
-        ax = _new_figure(figsize=(6.8, 5.6)).add_subplot()
+        ax = new_figure(figsize=(6.8, 5.6)).add_subplot()
     first = found[0]
     ix, iy = _column(first, x, 0), _column(first, y, 1 if len(first.state_names) > 1 else 0)
     fx, ux = display_unit(first.state_units[ix], degrees)
@@ -88,7 +88,7 @@ def spectrum_plot(continuation: ContinuationResult, ax: Axes | None = None,
     (:data:`KIND_COLOURS`). Draws on ``ax`` if given, else on a new figure; returns it."""
     found = _explorations(continuation)
     if ax is None:
-        ax = _new_figure().add_subplot()
+        ax = new_figure().add_subplot()
     peaks = [(item.value, f) for item in found for f in np.atleast_1d(item.peaks)]
     if peaks:
         ax.plot(*np.array(peaks).T, linestyle="none", marker=".", color="0.6", markersize=4,
@@ -122,12 +122,12 @@ def orbit_diagram(continuation: ContinuationResult, state: str | None = None,
     returns the figure. Title ``title`` (None: the continuation's name)."""
     found = _explorations(continuation)
     if ax is None:
-        ax = _new_figure().add_subplot()
+        ax = new_figure().add_subplot()
     first = found[0]
     column = _column(first, state, 0)
     name = first.state_names[column]
     handles, labels = [], []
-    if branches and any(b.kind in _PLOTTED_KINDS and name in b.state_names
+    if branches and any(b.kind in PLOTTED_KINDS and name in b.state_names
                         for b in continuation.branches):
         from .diagrams import bifurcation_diagram
 

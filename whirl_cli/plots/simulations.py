@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import WhirlError
 from ..results import Simulation
-from .key import _BLACK, _new_figure, axis_label, display_unit, next_colour, symbol
+from .key import BLACK, axis_label, display_unit, new_figure, next_colour, symbol
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -42,7 +42,7 @@ def time_history(simulation: Simulation, states: Sequence[str] | None = None,
         raise WhirlError(f"state(s) {', '.join(unknown) or '(none)'} not in simulation "
                          f"{simulation.name!r} (states: {', '.join(simulation.state_names)})")
     if axes is None:
-        figure = _new_figure(figsize=(8.0, 1.0 + 2.2 * len(names)))
+        figure = new_figure(figsize=(8.0, 1.0 + 2.2 * len(names)))
         axes = figure.subplots(len(names), 1, sharex=True, squeeze=False)[:, 0]
     elif not isinstance(axes, Sequence | np.ndarray):
         axes = [axes]
@@ -60,7 +60,7 @@ def time_history(simulation: Simulation, states: Sequence[str] | None = None,
         else:
             ax.plot(simulation.time, values, color=colour, linewidth=0.8, label=name)
         ax.set_ylabel(axis_label(name, unit))
-        ax.axhline(0.0, color=_BLACK, linewidth=0.5, zorder=0)
+        ax.axhline(0.0, color=BLACK, linewidth=0.5, zorder=0)
     axes[-1].set_xlabel(axis_label("t", "s"))
     axes[0].set_title(_with_status(simulation, title))
     return axes[0].figure
@@ -113,7 +113,7 @@ def hub_path(simulation: Simulation, ax: Axes | None = None, degrees: bool = Tru
     from matplotlib.collections import LineCollection
 
     if ax is None:
-        ax = _new_figure(figsize=(6.4, 5.6)).add_subplot()
+        ax = new_figure(figsize=(6.4, 5.6)).add_subplot()
     factor, unit = display_unit(simulation.hub_unit, degrees)
     path = factor * np.asarray(simulation.hub, dtype=float).reshape(-1, 2)
     time = np.asarray(simulation.time, dtype=float)
@@ -124,9 +124,9 @@ def hub_path(simulation: Simulation, ax: Axes | None = None, degrees: bool = Tru
         ax.add_collection(lines)
         ax.figure.colorbar(lines, ax=ax, label=axis_label("t", "s"))
     if len(path):
-        ax.plot(*path[0], marker="o", markerfacecolor="none", markeredgecolor=_BLACK,
+        ax.plot(*path[0], marker="o", markerfacecolor="none", markeredgecolor=BLACK,
                 linestyle="none", markersize=8, zorder=3, label="start")
-        ax.plot(*path[-1], marker="x", color=_BLACK, linestyle="none", markersize=8,
+        ax.plot(*path[-1], marker="x", color=BLACK, linestyle="none", markersize=8,
                 zorder=3, label=f"end (t = {time[-1]:.3g} s)")
     ax.autoscale_view()
     if len(path) > 2:
@@ -173,7 +173,7 @@ def sense_arrows(ax: Axes, path: np.ndarray) -> list:
         a, b = (radius * np.array([np.cos(e), np.sin(e)]) for e in ends)
         arrow = FancyArrowPatch(a, b, connectionstyle=f"arc3,rad={0.22 * sense}",
                                 arrowstyle="-|>", mutation_scale=16, linewidth=1.4,
-                                color=_BLACK, zorder=4, gid=text.split()[0],
+                                color=BLACK, zorder=4, gid=text.split()[0],
                                 label=f"_{text}",
                                 linestyle="-" if text.startswith("whirl") else "--")
         ax.add_patch(arrow)
@@ -198,7 +198,7 @@ def whirl_snapshots(simulation: Simulation, count: int = 8, ax: Axes | None = No
     from matplotlib import colormaps
 
     if ax is None:
-        ax = _new_figure(figsize=(6.4, 5.6)).add_subplot()
+        ax = new_figure(figsize=(6.4, 5.6)).add_subplot()
     factor, unit = display_unit(simulation.hub_unit, degrees)
     path = factor * np.asarray(simulation.hub, dtype=float).reshape(-1, 2)
     time = np.asarray(simulation.time, dtype=float)
@@ -208,7 +208,7 @@ def whirl_snapshots(simulation: Simulation, count: int = 8, ax: Axes | None = No
     times = time[len(path) - len(turn):]
     ax.plot(turn[:, 0], turn[:, 1], color="grey", linewidth=0.8, zorder=1,
             label=f"hub path, last turn (t = {times[0]:.3g} to {times[-1]:.3g} s)")
-    ax.plot([0.0], [0.0], marker="+", color=_BLACK, markersize=10, linestyle="none",
+    ax.plot([0.0], [0.0], marker="+", color=BLACK, markersize=10, linestyle="none",
             zorder=3, label="pivot")
     instants = times[0] + (times[-1] - times[0]) * np.arange(count) / count
     shades = colormaps[TIME_MAP](np.linspace(0.0, 0.85, count))

@@ -61,25 +61,25 @@ def _bifurcation_panel(result, ax, choice, caption) -> list[Axes]:
 def _overlay_bifurcations(results: Sequence[StudyResult], names: Sequence[str], ax: Axes,
                           choice: PanelChoice, title: str | None) -> list[Axes]:
     """Every result's bifurcation diagram on ``ax``, one colour per result."""
-    from ..diagrams import _checked_branches, _draw_special_points, _label_axes
-    from ..key import PLOT_KEY, _colours
+    from ..diagrams import checked_branches, draw_special_points, label_axes
+    from ..key import PLOT_KEY, colour_cycle
     from ..panels import pick_continuation
 
     first: dict[str, object] = {}
     handles = []
     state = choice.state
-    for result, label, colour in zip(results, names, _colours(), strict=False):
+    for result, label, colour in zip(results, names, colour_cycle(), strict=False):
         continuation = pick_continuation(result, choice.continuation)
-        which, branches, state = _checked_branches(continuation, state, ("max",))
+        which, branches, state = checked_branches(continuation, state, ("max",))
         handle = None
         for branch in branches:
             handle = _draw_coloured(ax, branch, state, colour) or handle
         if handle is not None:
             handle.set_label(label)
             handles.append(handle)
-        _draw_special_points(ax, continuation, branches, state, True, first)
+        draw_special_points(ax, continuation, branches, state, True, first)
         if branches and not ax.get_xlabel():
-            _label_axes(ax, continuation, branches, state, which, True)
+            label_axes(ax, continuation, branches, state, which, True)
     markers = [first[key] for key in PLOT_KEY if key in first]
     ax.legend(handles + markers,
               [h.get_label() for h in handles] + [str(PLOT_KEY[k]["label"]) for k in PLOT_KEY

@@ -27,7 +27,7 @@ def _boundary_files(figures: Figures) -> list[FigureJob]:
     is no boundary."""
     from ...results import ContinuationResult
     from ..files import slice_title, state_for
-    from ..maps import _oriented_grid, boundary_plot, overhang_diagram, slice_continuation
+    from ..maps import boundary_plot, oriented_grid, overhang_diagram, slice_continuation
 
     result, stem, state, view, caption = (figures.result, figures.stem, figures.state,
                                           figures.view, figures.caption)
@@ -40,7 +40,7 @@ def _boundary_files(figures: Figures) -> list[FigureJob]:
             xlim=view.xlim, ylim=view.ylim))]
     jobs: list[FigureJob] = []
     for boundary in result.boundaries:
-        matched = None if grid is None else _oriented_grid(grid, boundary.parameter_names)
+        matched = None if grid is None else oriented_grid(grid, boundary.parameter_names)
         jobs.append((f"{stem}_{boundary.name}_boundary.png",
                      lambda b=boundary, g=matched: boundary_plot(
                          b, g, cases=b.slices, case_labels=caption().case_labels(b),
@@ -60,7 +60,7 @@ def _boundary_files(figures: Figures) -> list[FigureJob]:
 
 
 def _boundary_panel(result, ax, choice, caption) -> list[Axes]:
-    from ..maps import _oriented_grid, boundary_plot
+    from ..maps import boundary_plot, oriented_grid
 
     grid = result.linear_grid
     if not result.boundaries and grid is not None:
@@ -68,7 +68,7 @@ def _boundary_panel(result, ax, choice, caption) -> list[Axes]:
             {grid.x_parameter, grid.y_parameter}))
         return [ax]
     boundary = _chosen_boundary(result, choice, " and no linear grid")
-    matched = None if grid is None else _oriented_grid(grid, boundary.parameter_names)
+    matched = None if grid is None else oriented_grid(grid, boundary.parameter_names)
     boundary_plot(boundary, matched, cases=boundary.slices,
                   case_labels=caption.case_labels(boundary), ax=ax,
                   title=choice.title or caption.title(boundary.parameter_names))
