@@ -155,7 +155,7 @@ def test_the_amplitude_diagram_marks_the_linear_onset():
                  if len(set(line.get_xdata())) == 1 and line.get_linestyle() == "-."]
     assert [line.get_xdata()[0] for line in verticals] == pytest.approx([linear_onset()])
     labels = [t.get_text() for t in figure.axes[0].get_legend().get_texts()]
-    assert "linear onset (stiffness K_out)" in labels
+    assert "linear onset (stiffness $K_{out}$)" in labels
     assert "describing function (one harmonic)" in labels
 
 

@@ -16,6 +16,7 @@ from .key import (
     new_figure,
     plot_styled,
     stability_curves,
+    symbol,
 )
 
 if TYPE_CHECKING:
@@ -68,11 +69,12 @@ def amplitude_diagram(continuation: ContinuationResult, ax: Axes | None = None) 
         line = ax.axvline(value, **ONSET_STYLE)
         if k == 0:
             handles.append(line)
-            labels.append("linear onset (stiffness K_out)")
+            labels.append("linear onset (stiffness $K_{out}$)")
     if dofs:
         ax.axhline(1.0, color="grey", linestyle=":", linewidth=0.8)
         ax.set_xlabel(x_label)
-        ax.set_ylabel(axis_label(f"A/delta of {', '.join(sorted(set(dofs)))}", "1"))
+        named = ", ".join(symbol(dof) for dof in sorted(set(dofs)))
+        ax.set_ylabel(axis_label(f"$A/\\delta$ of {named}", "1"))
         if not log_scale_if_decades(ax, "y", np.concatenate(ratios)):
             ax.set_ylim(bottom=0.0)
     if handles:
