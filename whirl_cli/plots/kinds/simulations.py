@@ -66,29 +66,25 @@ def _time_history_panel(result, ax, choice, caption) -> list[Axes]:
                               [:, 0]), title=title))
 
 
-def _hub_path_panel(result, ax, choice, caption) -> list[Axes]:
-    from ..simulations import hub_path
+def _on_the_axes(draw: str):
+    """The panel of a kind that ``simulations.<draw>(simulation, ax=, title=)`` draws on the
+    panel's axes (imported when drawing)."""
+    def panel(result, ax, choice, caption) -> list[Axes]:
+        from .. import simulations
 
-    simulation = _chosen(result, choice)
-    hub_path(simulation, ax=ax, title=choice.title or caption.simulation_title(simulation))
-    return [ax]
+        simulation = _chosen(result, choice)
+        getattr(simulations, draw)(simulation, ax=ax, title=choice.title
+                                   or caption.simulation_title(simulation))
+        return [ax]
+    return panel
 
 
 TIME_HISTORY = PlotKind("time_history", 100, _time_history_panel, missing=_no_simulation,
                         figures=_time_history_files)
-HUB_PATH = PlotKind("hub_path", 110, _hub_path_panel, missing=_no_simulation,
+HUB_PATH = PlotKind("hub_path", 110, _on_the_axes("hub_path"), missing=_no_simulation,
                     figures=_hub_path_files)
 
 
-def _whirl_snapshots_panel(result, ax, choice, caption) -> list[Axes]:
-    """Snapshots of the nacelle axis through the last cycle of a simulation (a sheet panel)."""
-    from ..simulations import whirl_snapshots
-
-    simulation = _chosen(result, choice)
-    whirl_snapshots(simulation, ax=ax,
-                    title=choice.title or caption.simulation_title(simulation))
-    return [ax]
-
-
-#: Panel-only (no files of its own): the thesis's figure of the whirl motion.
-WHIRL_SNAPSHOTS = PlotKind("whirl_snapshots", 115, _whirl_snapshots_panel)
+#: Panel-only (no files of its own): the thesis's figure of the whirl motion, snapshots of the
+#: nacelle axis through the last cycle of a simulation.
+WHIRL_SNAPSHOTS = PlotKind("whirl_snapshots", 115, _on_the_axes("whirl_snapshots"))
