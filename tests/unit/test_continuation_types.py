@@ -4,17 +4,10 @@ type added as two files (its spec, its recipe) appears in all of them."""
 
 from __future__ import annotations
 
-import os
-import shutil
-import subprocess
-import sys
-from pathlib import Path
 from typing import get_args
 
-import whirl_cli
+from tests.package_copy import loaded_after, run_in_a_copy
 from whirl_cli.study import continuations
-
-PACKAGE = Path(whirl_cli.__file__).resolve().parent
 
 
 def test_the_schema_union_is_the_registry():
@@ -30,12 +23,8 @@ def test_the_schema_union_is_the_registry():
 def test_the_registry_is_light():
     """Listing the types imports no recipe, AUTO or numerical code (``whirl validate`` reads
     them)."""
-    script = ("import sys; from whirl_cli.study import continuations; continuations.registry(); "
-              "print(sorted({'numpy', 'whirl_cli.pipeline', 'whirl_cli.continuation.engine'} "
-              "& set(sys.modules)))")
-    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
-                          check=True)
-    assert done.stdout.strip() == "[]"
+    assert loaded_after("from whirl_cli.study import continuations; continuations.registry()",
+                        {"numpy", "whirl_cli.pipeline", "whirl_cli.continuation.engine"}) == []
 
 
 SPEC = '''
@@ -139,13 +128,8 @@ print("run", [c.name for c in result.continuations])
 def test_a_type_added_as_two_files_validates_and_runs(tmp_path):
     """A copy of the package with a toy type's spec and recipe dropped in: a study of it
     validates (defaults and checks its own), costs what it says and runs its recipe."""
-    package = tmp_path / "whirl_cli"
-    shutil.copytree(PACKAGE, package, ignore=shutil.ignore_patterns("__pycache__"))
-    (package / "study" / "continuations" / "toy.py").write_text(SPEC)
-    (package / "continuation" / "toy.py").write_text(RECIPE)
-    done = subprocess.run([sys.executable, "-c", CHECK, str(tmp_path)], capture_output=True,
-                          text=True, timeout=300, cwd=tmp_path,
-                          env={**os.environ, "PYTHONPATH": str(tmp_path)})
+    done = run_in_a_copy(tmp_path, {"study/continuations/toy.py": SPEC,
+                                    "continuation/toy.py": RECIPE}, CHECK, str(tmp_path))
     assert done.returncode == 0, done.stderr
     assert done.stdout.splitlines() == [
         "copy True", "spec ToyContinuation K_theta",

@@ -3,15 +3,9 @@ module in whirl_cli/models/laws/, and studies, the schema reference and the mode
 
 from __future__ import annotations
 
-import shutil
-import subprocess
-import sys
-from pathlib import Path
-
+from tests.package_copy import run_in_a_copy
 from whirl_cli.models.laws import LAWS
 from whirl_cli.study.schema import LAW_BLOCKS
-
-PACKAGE = Path(__file__).resolve().parents[2] / "whirl_cli"
 
 
 def test_each_law_block_has_the_keys_of_its_laws_coefficients():
@@ -60,12 +54,7 @@ except StudyError as error:
 
 
 def test_a_smooth_law_added_as_one_module_is_read_from_studies(tmp_path):
-    copy = tmp_path / "whirl_cli"
-    shutil.copytree(PACKAGE, copy, ignore=shutil.ignore_patterns("__pycache__"))
-    (copy / "models" / "laws" / "septic.py").write_text(TOY)
-    done = subprocess.run([sys.executable, "-c", CHECK], cwd=tmp_path, capture_output=True,
-                          text=True, timeout=300, env={"PYTHONPATH": str(tmp_path),
-                                                       "PATH": "/usr/bin:/bin"})
+    done = run_in_a_copy(tmp_path, {"models/laws/septic.py": TOY}, CHECK)
     assert done.returncode == 0, done.stderr
     assert done.stdout.splitlines() == [
         "[('K7_theta', 3.0), ('width_theta', 0.1)]",

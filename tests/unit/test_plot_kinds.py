@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 from typing import get_args
 
+from tests.package_copy import loaded_after
 from whirl_cli.plots.kinds import overlay_kinds, panel_kinds, plot_kinds, registry
 
 REFERENCE = Path(__file__).resolve().parents[1] / "regression" / "references" / \
@@ -38,11 +39,8 @@ def test_every_kind_draws_a_panel_and_a_file_kind_says_what_it_needs():
 
 def test_the_registry_is_light():
     """Listing the kinds imports no drawing code (the command line lists them at start-up)."""
-    script = ("import sys; from whirl_cli.plots.kinds import plot_kinds; plot_kinds(); "
-              "print(sorted({'numpy', 'matplotlib', 'whirl_cli.results'} & set(sys.modules)))")
-    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
-                          check=True)
-    assert done.stdout.strip() == "[]"
+    assert loaded_after("from whirl_cli.plots.kinds import plot_kinds; plot_kinds()",
+                        {"numpy", "matplotlib", "whirl_cli.results"}) == []
 
 
 TOY = '''
