@@ -19,7 +19,7 @@ from functools import partial
 from pathlib import Path
 
 from ..errors import OutputError
-from ..output.guard import Own, check, whirl_marked
+from ..output.guard import Own, check, starting, whirl_marked
 from ..results import StudyResult
 from . import csvfiles, matlab, netcdf
 
@@ -38,13 +38,6 @@ class Format:
     branch_files: bool = False
 
 
-def _starting(*signatures: bytes) -> Callable[[int], str]:
-    def recognise(fd: int) -> str:
-        head = os.pread(fd, max(len(s) for s in signatures), 0)
-        return "" if any(head.startswith(s) for s in signatures) else "another kind of file"
-    return recognise
-
-
 def _netcdf(fd: int) -> str:
     """"" for a NetCDF-4 file that is not a whirl result file (HDF5 without whirl's
     ``whirl_schema`` attribute)."""
@@ -54,17 +47,21 @@ def _netcdf(fd: int) -> str:
     return "a whirl result file" if marked else ""
 
 
+#: Why a file of another kind is not replaced.
+OTHER = "another kind of file"
+
 FORMATS: dict[str, Format] = {f.suffix: f for f in (
     Format(".mat", "MATLAB/Octave MAT-file (version 5)",
            lambda result, output, _: [(output, partial(matlab.render, result))],
-           Own("a MAT-file", _starting(b"MATLAB 5.0 MAT-file"))),
+           Own("a MAT-file", starting(OTHER, b"MATLAB 5.0 MAT-file", any_case=False))),
     Format(".nc", "NetCDF-4 (xarray, groups as in the HDF5 file)",
            lambda result, output, _: [(output, partial(netcdf.render, result))],
            Own("a NetCDF-4 file", _netcdf)),
     Format(".csv", "CSV: the special points; with branches, one file per branch",
            csvfiles.files,
-           Own("a CSV file whirl wrote", _starting(b"continuation,branch,type,",
-                                                   csvfiles.BRANCH_HEADER.encode())),
+           Own("a CSV file whirl wrote", starting(OTHER, b"continuation,branch,type,",
+                                                  csvfiles.BRANCH_HEADER.encode(),
+                                                  any_case=False)),
            branch_files=True),
 )}
 

@@ -67,17 +67,21 @@ def _result(fd: int) -> str:
     return "" if marked else "an HDF5 file without whirl's whirl_schema attribute"
 
 
-def starting(signature: bytes, what: str) -> Callable[[int], str]:
-    """A check for :class:`Own`: the file starts with ``signature`` (any case), else ``what``."""
+def starting(what: str, *signatures: bytes, any_case: bool = True) -> Callable[[int], str]:
+    """A check for :class:`Own`: the file starts with one of ``signatures`` (in any case
+    unless ``any_case`` is False), else ``what``."""
+    def fold(text: bytes) -> bytes:
+        return text.lower() if any_case else text
+
     def recognise(fd: int) -> str:
-        head = os.pread(fd, len(signature), 0)
-        return "" if head.lower() == signature.lower() else what
+        head = fold(os.pread(fd, max(len(s) for s in signatures), 0))
+        return "" if any(head.startswith(fold(s)) for s in signatures) else what
     return recognise
 
 
 RESULT = Own("a whirl result file", _result)
-IMAGE = Own("a PNG image", starting(b"\x89PNG\r\n\x1a\n", "a file that is not PNG"))
-PAGE = Own("an HTML page", starting(b"<!DOCTYPE html>", "a file that is not HTML"))
+IMAGE = Own("a PNG image", starting("a file that is not PNG", b"\x89PNG\r\n\x1a\n"))
+PAGE = Own("an HTML page", starting("a file that is not HTML", b"<!DOCTYPE html>"))
 #: Any regular file (no check of its content).
 FILE = Own("a regular file", lambda fd: "")
 

@@ -327,8 +327,8 @@ def replaceable_image(suffix: str):
     from ..output.guard import IMAGE, Own, starting
 
     return {"png": IMAGE,
-            "pdf": Own("a PDF document", starting(b"%PDF-", "a file that is not PDF")),
-            "svg": Own("an SVG image", starting(b"<?xml", "a file that is not SVG"))}[suffix]
+            "pdf": Own("a PDF document", starting("a file that is not PDF", b"%PDF-")),
+            "svg": Own("an SVG image", starting("a file that is not SVG", b"<?xml"))}[suffix]
 
 
 def rendered_formats(figure: Figure, formats: tuple[str, ...], dpi: int,
