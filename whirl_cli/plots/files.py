@@ -166,12 +166,13 @@ def _viewed(figure: Figure, view: View) -> Figure:
 
 def legends_off_data(figure: Figure) -> None:
     """Move every axes legend that lies over drawn data (a vertex of a line, a point of a
-    collection, found by drawing ``figure`` once) off it: beside the axes if the figure has
-    one axes, else below all of them as one legend of the figure (each entry once)."""
+    collection, found by laying ``figure`` out once, without rendering it) off it: beside the
+    axes if the figure has one axes, else below all of them as one legend of the figure (each
+    entry once)."""
     legends = [(ax, ax.get_legend()) for ax in figure.axes if ax.get_legend() is not None]
     if not legends:
         return
-    figure.canvas.draw()
+    figure.draw_without_rendering()
     covering = [(ax, legend) for ax, legend in legends if _over_data(ax, legend)]
     if len(figure.axes) == 1:
         for ax, legend in covering:
