@@ -171,7 +171,7 @@ def test_the_short_persistence_runs_agree_with_the_repeated_continuation():
     finds the two folds within the persistence tolerance (2e-3 of the range)."""
     from whirl_cli.continuation.engine import Engine, Numerics
     from whirl_cli.continuation.one_parameter import one_parameter
-    from whirl_cli.pipeline import repeated, seeded_orbits
+    from whirl_cli.continuation.recipes import repeated, seeded_orbits
 
     study, result = computed()
     continuation = result.continuations[0]

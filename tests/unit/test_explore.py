@@ -1,5 +1,5 @@
 """A continuation's ``explore:``: the settled motion classified by simulation at listed values
-(whirl_cli.pipeline.explorations), stored, compared and drawn.
+(whirl_cli.continuation.recipes.explorations), stored, compared and drawn.
 
 The classification is checked against AUTO's own answer for hardening case 2 (classical
 model): at K1 = 0.24 AUTO continues a stable limit cycle (its period from the regression
@@ -15,7 +15,7 @@ import h5py
 import numpy as np
 import pytest
 
-from whirl_cli import pipeline
+from whirl_cli.continuation import recipes
 from whirl_cli.analysis import motion
 from whirl_cli.errors import StudyError, WhirlError
 from whirl_cli.output import compare, store
@@ -53,7 +53,7 @@ def auto_stable_period(k1: float) -> float:
 def explored():
     study = validate_text(hardening_study(), "h.yaml")
     spec = study.continuations[0]
-    return pipeline.explorations(study.variant(), study.parameter_values(), spec)
+    return recipes.explorations(study.variant(), study.parameter_values(), spec)
 
 
 # ----------------------------------------------------------------------------- the class
@@ -78,7 +78,7 @@ def test_far_from_cycles_at_a_linearly_stable_value_the_motion_is_an_equilibrium
 def test_explorations_are_the_same_bits_for_any_jobs(explored):
     """Two values side by side in forked processes: every field as one after another."""
     study = validate_text(hardening_study(), "h.yaml")
-    forked = pipeline.explorations(study.variant(), study.parameter_values(),
+    forked = recipes.explorations(study.variant(), study.parameter_values(),
                                    study.continuations[0], jobs=2)
     for a, b in zip(explored, forked, strict=True):
         for name in Exploration.__dataclass_fields__:
@@ -91,11 +91,11 @@ def test_the_initial_state_is_the_first_dof_at_2_degrees_unless_given():
     study = validate_text(hardening_study("[0.45]"), "h.yaml")
     spec = study.continuations[0]
     assert spec.explore_initial is None
-    (found,) = pipeline.explorations(study.variant(), study.parameter_values(), spec)
+    (found,) = recipes.explorations(study.variant(), study.parameter_values(), spec)
     assert found.initial == pytest.approx([np.radians(2.0), 0.0, 0.0, 0.0])
     study = validate_text(hardening_study("[0.45]", "    explore_initial: {psi: 1, dtheta: 10}\n"),
                           "h.yaml")
-    (found,) = pipeline.explorations(study.variant(), study.parameter_values(),
+    (found,) = recipes.explorations(study.variant(), study.parameter_values(),
                                      study.continuations[0])
     assert found.initial == pytest.approx([0.0, np.radians(1.0), np.radians(10.0), 0.0])
 
@@ -106,7 +106,7 @@ def test_a_failed_classification_is_reported_never_raised(monkeypatch):
 
     monkeypatch.setattr(motion, "classify_model", broken)
     study = validate_text(hardening_study("[0.3]"), "h.yaml")
-    (found,) = pipeline.explorations(study.variant(), study.parameter_values(),
+    (found,) = recipes.explorations(study.variant(), study.parameter_values(),
                                      study.continuations[0])
     assert found.kind == "diverged"
     assert "overflow in the field" in found.evidence

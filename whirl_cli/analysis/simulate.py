@@ -16,6 +16,7 @@ AUTO; perturbations and deviations of equilibria in units of the dofs' typical a
 
 from __future__ import annotations
 
+import importlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,6 +38,13 @@ from .global_bifurcations import BLOWUP_FACTOR
 #: What simulating imports (scipy's integrators, with scipy.optimize: about 0.5 s): imported
 #: once before forking simulation workers, which then inherit it.
 MODULES = ("scipy.integrate",)
+
+
+def import_integrators() -> None:
+    """Import scipy's integrators (:data:`MODULES`) here, once, before workers fork: they
+    inherit them instead of each importing them."""
+    for module in MODULES:
+        importlib.import_module(module)
 
 #: Relative tolerance on the amplitude for "the simulation stays on the orbit".
 ORBIT_TOLERANCE = 0.01

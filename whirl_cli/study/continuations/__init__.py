@@ -45,7 +45,8 @@ class ContinuationType(NamedTuple):
     ``rank``: its place in the schema's union (and so in messages naming the types).
     ``spec``: the schema of its study block (a :class:`ContinuationSpec` whose ``type`` is
     ``Literal[name]``). ``recipe(stage, spec)``: runs it on the engine of ``stage`` (a
-    :class:`whirl_cli.pipeline.Stage`), returns its result and its boundary (None: none).
+    :class:`whirl_cli.continuation.recipes.Stage`), returns its result and its boundary
+    (None: none).
     ``cost(spec, study)``: its rough relative cost, in one-parameter runs without periodic
     families (``whirl sweep`` starts the costly studies first). ``resolved(item, names,
     values)``: its raw study mapping with canonical parameter names and the defaults the

@@ -1,6 +1,6 @@
 """The ``one-parameter`` continuation type: equilibria in one parameter, the periodic families
 from their Hopf points, seeds, explored values (its recipe:
-:func:`whirl_cli.pipeline.continue_one_parameter`).
+:func:`whirl_cli.continuation.recipes.continue_one_parameter`).
 """
 
 from __future__ import annotations
@@ -124,9 +124,16 @@ class OneParameterContinuation(ContinuationSpec):
         name = names.canonical(self.parameter)
         return study.parameter_values().get(name, names.defaults()[name])
 
+    def explore_start(self, first: str) -> dict[str, float]:
+        """The initial state of the ``explore`` simulations as the seeds give states:
+        ``explore_initial``, or the state ``first`` (the model's first dof) at
+        :data:`EXPLORE_OFFSET`."""
+        return self.explore_initial if self.explore_initial is not None else {
+            first: EXPLORE_OFFSET}
+
 
 def _recipe(stage, spec: OneParameterContinuation):
-    from ...pipeline import continue_one_parameter
+    from ...continuation.recipes import continue_one_parameter
 
     return continue_one_parameter(stage, spec)
 

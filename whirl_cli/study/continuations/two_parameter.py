@@ -1,6 +1,6 @@
 """The ``two-parameter`` continuation type: loci of special points in two parameters, the
 stability boundary and the unsafe region (its recipe:
-:func:`whirl_cli.pipeline.continue_two_parameter`).
+:func:`whirl_cli.continuation.recipes.continue_two_parameter`).
 """
 
 from __future__ import annotations
@@ -128,7 +128,7 @@ class TwoParameterContinuation(ContinuationSpec):
 
 
 def _recipe(stage, spec: TwoParameterContinuation):
-    from ...pipeline import continue_two_parameter
+    from ...continuation.recipes import continue_two_parameter
 
     return continue_two_parameter(stage, spec)
 
