@@ -12,7 +12,7 @@ import numpy as np
 
 from ..results import LinearSweep
 from ..units import HZ_PER_RAD_S
-from .key import axis_label, colour_cycle, new_figure
+from .key import axis_label, colour_cycle, log_scale_if_decades, new_figure
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -30,7 +30,8 @@ def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = 
     numbered if repeated); a mode whose damping ratio falls below zero somewhere (flutter) is
     drawn in :data:`UNSTABLE_COLOURS`, the others in :data:`STABLE_COLOURS`. Each crossing of
     zero by a damping ratio (:func:`zero_crossings`) is marked on both panels and named with
-    its value in the legend; the damping panel has a zero line.
+    its value in the legend; the damping panel has a zero line. The parameter axis is log if
+    the sweep spans decades or samples log (:func:`~.key.log_scale_if_decades`).
     Title: ``title`` (None: ``"linear analysis vs <parameter>"``). Draws on ``axes``
     (frequency, damping) if given, else on a new figure; returns the figure.
     """
@@ -63,6 +64,8 @@ def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = 
     ax_freq.set_ylabel(axis_label("frequency", "Hz" if hz else "rad/s"))
     ax_damp.set_ylabel(axis_label("damping ratio", ""))
     ax_damp.set_xlabel(axis_label(sweep.parameter, sweep.unit))
+    for ax in (ax_freq, ax_damp):
+        log_scale_if_decades(ax, "x", sweep.values, sweep.spacing)
     if ax_freq.get_lines():
         handles, labels = ax_freq.get_legend_handles_labels()
         more, named = ax_damp.get_legend_handles_labels()
