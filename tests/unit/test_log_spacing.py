@@ -15,6 +15,7 @@ from whirl_cli.kinds import Spacing
 from whirl_cli.output import store
 from whirl_cli.pipeline import run_study
 from whirl_cli.plots.files import study_figures
+from whirl_cli.plots.linear import damping_multiples_plot
 from whirl_cli.plots.maps import boundary_plot
 from whirl_cli.results import Boundary
 from whirl_cli.study import StudyError, validate_text
@@ -161,3 +162,17 @@ def test_a_log_grid_axis_is_log_over_its_parameter_on_a_boundary_in_the_other_or
         assert ax.get_ylim() == pytest.approx((0.0033, 0.0173))
     finally:
         plt.close(figure)
+
+
+def test_multiples_sampled_log_are_drawn_on_a_log_axis(stored):
+    """I_x from 0.5 to 4 times its datum (under the decades rule's factor): log when the sweep
+    samples log, linear when it does not."""
+    result, _ = stored
+    multiples = next(s for s in result.linear_sweeps if s.parameter == "I_x")
+    for sweep, scale in ((multiples, "log"), (replace(multiples, spacing=Spacing.LINEAR),
+                                              "linear")):
+        figure = damping_multiples_plot([sweep])
+        try:
+            assert [ax.get_xscale() for ax in figure.axes] == [scale, scale]
+        finally:
+            plt.close(figure)

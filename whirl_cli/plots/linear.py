@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..results import LinearSweep
+from ..results import LinearSweep, Spacing
 from ..units import HZ_PER_RAD_S
 from .key import axis_label, colour_cycle, log_scale_if_decades, new_figure
 
@@ -211,7 +211,8 @@ def damping_multiples_plot(sweeps: Sequence[LinearSweep],
     "R (BW, FW)"; the mode group first for models with several); a dot marks each point
     where the least-damped mode changes direction. The datum is the sweep's own
     (:func:`sweep_datum`, else ``datums``); sweeps without a non-zero datum are left out.
-    A zero line on the damping panel, the datum (x = 1) dotted on both.
+    A zero line on the damping panel, the datum (x = 1) dotted on both. The x axis is log if
+    the multiples span decades or every sweep drawn samples log.
 
     ``axes``: (damping axes, frequency axes) to draw into (None: a new figure). Title:
     ``title`` (None: ``"least-damped mode vs parameter multiples"``).
@@ -224,7 +225,7 @@ def damping_multiples_plot(sweeps: Sequence[LinearSweep],
         figure = ax_damp.figure
     scale = HZ_PER_RAD_S if hz else 1.0
     colours = colour_cycle()
-    drawn = 0
+    drawn: list[tuple[np.ndarray, Spacing]] = []
     for sweep in sweeps:
         datum = sweep_datum(sweep, datums)
         if datum is None:
@@ -240,7 +241,7 @@ def damping_multiples_plot(sweeps: Sequence[LinearSweep],
             style.update(marker="o", markersize=4, markevery=changes)
         ax_damp.plot(x, zeta, **style)
         ax_freq.plot(x, freq * scale, **style)
-        drawn += 1
+        drawn.append((x, sweep.spacing))
     ax_damp.axhline(0.0, color="black", linewidth=0.8, label="_zero")
     for ax in (ax_damp, ax_freq):
         ax.axvline(1.0, color="grey", linewidth=0.8, linestyle=":", label="_datum")
@@ -248,6 +249,9 @@ def damping_multiples_plot(sweeps: Sequence[LinearSweep],
     ax_freq.set_ylabel(axis_label("frequency", "Hz" if hz else "rad/s"))
     ax_freq.set_xlabel("parameter / datum")
     if drawn:
+        spacing = Spacing.LOG if all(s == Spacing.LOG for _, s in drawn) else Spacing.LINEAR
+        for ax in (ax_damp, ax_freq):
+            log_scale_if_decades(ax, "x", np.concatenate([x for x, _ in drawn]), spacing)
         ax_damp.legend(fontsize="small")
     ax_damp.set_title("least-damped mode vs parameter multiples" if title is None else title)
     return figure
