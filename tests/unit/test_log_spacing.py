@@ -13,6 +13,7 @@ import pytest
 
 from whirl_cli.kinds import Spacing
 from whirl_cli.output import store
+from whirl_cli.output.compare import compare_linear_sweep
 from whirl_cli.pipeline import run_study
 from whirl_cli.plots.files import study_figures
 from whirl_cli.plots.linear import damping_multiples_plot
@@ -176,3 +177,13 @@ def test_multiples_sampled_log_are_drawn_on_a_log_axis(stored):
             assert [ax.get_xscale() for ax in figure.axes] == [scale, scale]
         finally:
             plt.close(figure)
+
+
+def test_compare_reports_a_sweep_sampled_with_another_spacing(stored):
+    """The same values stored as log- and as linear-spaced: compare names the attribute."""
+    result, _ = stored
+    sweep = result.linear_sweeps[0]
+    found = compare_linear_sweep(sweep, replace(sweep, spacing=Spacing.LINEAR), 1e-9)
+    assert [(d.path, d.a, d.b) for d in found] == [
+        ("/linear/sweeps/K_beta/@spacing", "log", "linear")]
+    assert compare_linear_sweep(sweep, sweep, 1e-9) == []
