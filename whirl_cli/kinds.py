@@ -69,6 +69,14 @@ class BoundaryMethod(Word):
     SLICES = "slices"
 
 
+class Spacing(Word):
+    """How a linear sweep or grid axis samples its range: evenly (linear) or with a constant
+    ratio between neighbours (log, a positive range)."""
+
+    LINEAR = "linear"
+    LOG = "log"
+
+
 class ContinuationKind(Word):
     """A study's continuation ``type``, and a result's continuation kind."""
 

@@ -117,16 +117,18 @@ def _stages(study: Study, model, parameters: dict[str, float], workroot: Path, j
     if study.linear is not None:
         for sweep in study.linear.sweeps:
             datum = model.parameter(model.canonical(sweep.parameter)).default
-            values = np.linspace(sweep.range[0], sweep.range[1], sweep.points)
+            values = linear.samples(*sweep.range, sweep.points, sweep.spacing)
             if sweep.multiples:  # the range in multiples of the datum: absolute values
                 values = values * datum
             found = linear.sweep(model, parameters, sweep.parameter, values)
-            sweeps.append(replace(found, multiples=sweep.multiples))
+            sweeps.append(replace(found, multiples=sweep.multiples, spacing=sweep.spacing))
     grid = None
     if study.linear is not None and study.linear.grid is not None:
         x, y = study.linear.grid.x, study.linear.grid.y
-        grid = linear.grid(model, parameters, x.parameter, np.linspace(*x.range, x.points),
-                           y.parameter, np.linspace(*y.range, y.points))
+        grid = replace(linear.grid(model, parameters,
+                                   x.parameter, linear.samples(*x.range, x.points, x.spacing),
+                                   y.parameter, linear.samples(*y.range, y.points, y.spacing)),
+                       x_spacing=x.spacing, y_spacing=y.spacing)
     result = StudyResult(
         study_name=study.name, model=model.name, continuations=tuple(continuations),
         linear_sweeps=tuple(sweeps), runs=engine.records() if engine else (),

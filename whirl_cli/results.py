@@ -26,13 +26,14 @@ from .kinds import (
     RunStatus,
     SeedKind,
     SimulationLaw,
+    Spacing,
     UnsafeCause,
 )
 
 #: re-exported: the vocabulary results are written in
 __all__ = ["BoundaryMethod", "BranchKind", "CheckKind", "ContinuationKind", "Criticality",
            "LocateStatus", "LocusKind", "MotionKind", "RunStatus", "SeedKind", "SimulationLaw",
-           "UnsafeCause"]
+           "Spacing", "UnsafeCause"]
 
 
 def _brief(value) -> str:
@@ -412,7 +413,8 @@ class LinearSweep:
     each mode's energy (e.g. "nacelle", "gimbal"); None for a model with one group.
     ``datum``: the parameter's datum [``unit``] (None: not stored, files before it);
     ``multiples``: the study gave the sweep in multiples of it (``values`` are absolute all
-    the same: ``values / datum`` are the multiples).
+    the same: ``values / datum`` are the multiples); ``spacing``: how ``values`` sample the
+    range (log: a constant ratio).
     """
 
     parameter: str
@@ -425,6 +427,7 @@ class LinearSweep:
     mode_group: np.ndarray | None = None
     datum: float | None = None
     multiples: bool = False
+    spacing: Spacing = Spacing.LINEAR
 
     __repr__ = _brief_repr
 
@@ -437,6 +440,7 @@ class LinearGrid:
     ``oscillatory``: (Ny, Nx) True where that eigenvalue is complex (flutter), False where it
     is real (divergence). ``flutter`` and ``divergence``: the zero contour of ``max_real`` as
     polylines (K, 2) in (x, y), split by the kind of the critical eigenvalue along it.
+    ``x_spacing``, ``y_spacing``: how ``x`` and ``y`` sample their ranges.
     """
 
     x_parameter: str
@@ -449,6 +453,8 @@ class LinearGrid:
     oscillatory: np.ndarray
     flutter: tuple[np.ndarray, ...]
     divergence: tuple[np.ndarray, ...]
+    x_spacing: Spacing = Spacing.LINEAR
+    y_spacing: Spacing = Spacing.LINEAR
 
     __repr__ = _brief_repr
 

@@ -26,7 +26,7 @@ from whirl_cli.models import get_model
 from whirl_cli.models.numeric import numeric_source
 from whirl_cli.output import store
 from whirl_cli.pipeline import run_study
-from whirl_cli.results import BranchKind, PointType
+from whirl_cli.results import BranchKind, PointType, Spacing
 from whirl_cli.study import load_study, validate_text
 
 from ..conftest import ROOT
@@ -188,7 +188,7 @@ def test_onset_study_hopf_locus_against_eigenvalues(tmp_path):
     """studies/gimballed/linear_onset_kbeta.yaml through ``whirl sweep``: every 5th point of
     the Hopf locus in (V, K_beta) by AUTO is where the eigenvalues give the onset at that
     K_beta (1e-5 of V's range); the locus spans soft to stiff gimbals; the K_beta sweep
-    stores mode groups."""
+    stores mode groups; the sweep and the grid sample K_beta log."""
     done = CliRunner().invoke(cli, ["sweep", str(GIMBALLED_STUDIES / "linear_onset_kbeta.yaml"),
                                     "-o", str(tmp_path), "--jobs", "1"])
     assert done.exit_code == 0, done.output
@@ -204,6 +204,11 @@ def test_onset_study_hopf_locus_against_eigenvalues(tmp_path):
         assert min(abs(v - speed) for v in onset) < 1e-5 * 12.0
     (sweep,) = result.linear_sweeps
     assert set(np.unique(sweep.mode_group)) == {"nacelle", "gimbal"}
+    # soft to rigid gimbals: K_beta sampled with a constant ratio, sweep and grid alike
+    for values, spacing in ((sweep.values, sweep.spacing),
+                            (result.linear_grid.x, result.linear_grid.x_spacing)):
+        assert spacing == Spacing.LOG
+        np.testing.assert_allclose(values[1:] / values[:-1], values[1] / values[0], rtol=1e-12)
 
 
 # ------------------------------------------------------------------------------ size

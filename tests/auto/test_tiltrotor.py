@@ -18,7 +18,8 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 from whirl_cli.pipeline import run_study
-from whirl_cli.results import MotionKind, PointType
+from whirl_cli.plots.files import study_figures
+from whirl_cli.results import MotionKind, PointType, Spacing
 from whirl_cli.study import load_study
 
 from ..conftest import ROOT
@@ -214,23 +215,52 @@ def linear_computed():
 
 
 def test_the_hopf_locus_is_the_numpy_onset_across_tiltrotor_gimbals():
-    """Every point of the Hopf locus in (V, K_beta) over 1.02-1.10/rev is where the numpy
-    eigenvalues' largest real part crosses zero at its K_beta (1e-4), and the locus spans the
-    whole K_beta range (0.61 m/s at 1.02/rev to 1.36 m/s at 1.10/rev)."""
+    """Every point of the Hopf locus in (V, K_beta), from 1.02/rev to beyond the thesis'
+    K_beta = 10 (11/rev), is where the numpy eigenvalues' largest real part crosses zero at its
+    K_beta (1e-4), and the locus spans the whole K_beta range (0.61 m/s at 1.02/rev, 1.36 m/s
+    at 1.10/rev, 7.31 m/s at 11/rev); over 1.02-1.10/rev alone it has points enough to draw."""
     (continuation,) = linear_computed().continuations
     loci = [b for b in continuation.branches if b.name.startswith("hopf")]
     k_beta = np.concatenate([b.parameters[:, 1] for b in loci])
     assert k_beta.min() == pytest.approx(0.0033, abs=1e-6)
-    assert k_beta.max() == pytest.approx(0.0173, abs=1e-6)
+    assert k_beta.max() == pytest.approx(12.0, abs=1e-6)
+    assert np.count_nonzero(k_beta <= 0.0173) > 20
     checked = 0
     for branch in loci:
         for v, kb in branch.parameters[::3, :2]:
             values = {**VALUES, "K_psi": 0.3, "K_beta": float(kb)}
             onset = brentq(lambda x, values=values: np.linalg.eigvals(
-                _linear(x, values)).real.max(), 0.2, 2.5, xtol=1e-10)
+                _linear(x, values)).real.max(), 0.2, 8.9, xtol=1e-10)
             assert v == pytest.approx(onset, rel=1e-4)
             checked += 1
     assert checked > 10
+    thesis = [p for p in continuation.special_points if p.point_type == PointType.HB
+              and p.parameters[1] == pytest.approx(10.0)]
+    assert [p.parameters[0] for p in thesis] == pytest.approx([brentq(
+        lambda x: np.linalg.eigvals(_linear(x, {**VALUES, "K_beta": 10.0})).real.max(),
+        5.0, 8.9, xtol=1e-10)], rel=1e-4)
+
+
+def test_the_onset_map_draws_k_beta_on_a_log_axis_over_the_stored_log_grid():
+    """The study's grid samples K_beta log from 1.02/rev to beyond 11/rev: its map draws K_beta
+    (y) on a log axis over that range and V (x) linear, the Hopf locus drawn across it."""
+    import matplotlib.pyplot as plt
+
+    result = linear_computed()
+    grid = result.linear_grid
+    assert grid.x_parameter == "K_beta" and grid.x_spacing == Spacing.LOG
+    ratios = grid.x[1:] / grid.x[:-1]
+    np.testing.assert_allclose(ratios, ratios[0], rtol=1e-12)
+    ((_, figure), *_) = study_figures(result, ("boundary",), "s")
+    try:
+        ax = figure.axes[0]
+        assert (ax.get_xscale(), ax.get_yscale()) == ("linear", "log")
+        low, high = ax.get_ylim()
+        assert low == pytest.approx(0.0033) and high == pytest.approx(12.0)
+        locus = max((line.get_ydata() for line in ax.lines), key=np.ptp)
+        assert min(locus) < 0.0034 and max(locus) > 10.0
+    finally:
+        plt.close(figure)
 
 
 EXPLORE_STUDY = ROOT / "studies" / "gimballed" / "tiltrotor_combined_airspeed.yaml"

@@ -658,10 +658,10 @@ def test_schema_reference_lists_every_key_with_a_description():
                 "nonlinearity[].delta", "nonlinearity[].K_out", "nonlinearity[].K_in",
                 "nonlinearity[].epsilon", "linear.sweeps",
                 "linear.sweeps[].parameter", "linear.sweeps[].range", "linear.sweeps[].points",
-                "linear.sweeps[].multiples",
+                "linear.sweeps[].multiples", "linear.sweeps[].spacing",
                 "linear.grid", "linear.grid.x", "linear.grid.y"}
     expected |= {f"linear.grid.{axis}.{k}" for axis in "xy" for k in ("parameter", "range",
-                                                                      "points")}
+                                                                      "points", "spacing")}
     expected |= {f"continuations[].{k}" for k in OneParameterContinuation.model_fields}
     expected |= {f"continuations[].{k}" for k in TwoParameterContinuation.model_fields}
     expected |= {f"auto.{k}" for k in AutoSettings.model_fields}

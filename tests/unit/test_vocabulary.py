@@ -34,6 +34,7 @@ from whirl_cli.results import (
     RunStatus,
     SeedKind,
     SimulationLaw,
+    Spacing,
     SpecialPoint,
     StudyResult,
     UnsafeCause,
@@ -93,6 +94,7 @@ DOCUMENTED = [
     (RunStatus, r"status \((ok \| mx \| error \| timeout \| crashed)\)"),
     (BoundaryMethod, r"method \((loci \| slices)\)"),
     (UnsafeCause, r"cause \((flutter \|\s+divergence)\)"),
+    (Spacing, r"spacing \((linear \| log)"),
     (LocusKind, r"attrs kind \((hopf \|\s+branch_point \| fold \| fold_of_cycles \| torus)\)"),
 ]
 

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..kinds import LocusKind
+from ..kinds import LocusKind, Spacing
 from ..models import Model
 from ..results import LinearGrid, LinearSweep
 from ..runtime import thread_map
@@ -127,6 +127,15 @@ def analyse(model: Model, params: np.ndarray, equilibrium: np.ndarray | None = N
     eigenvectors = np.take_along_axis(eigenvectors, order[:, None, :], axis=-1)
     groups = mode_groups(model, params, eigenvectors)
     return eigenvalues, whirl_direction(model, eigenvalues, eigenvectors, groups), groups
+
+
+def samples(lower: float, upper: float, points: int, spacing: Spacing = Spacing.LINEAR
+            ) -> np.ndarray:
+    """``points`` values from ``lower`` to ``upper``: evenly spaced, or (log, both > 0)
+    ``lower * (upper / lower) ** (k / (points - 1))``, a constant ratio between neighbours."""
+    if spacing == Spacing.LOG:
+        return np.geomspace(lower, upper, points)
+    return np.linspace(lower, upper, points)
 
 
 def sweep(model: Model, overrides: dict[str, float], parameter: str, values: np.ndarray,

@@ -202,7 +202,7 @@ def sweep_table(sweep: LinearSweep) -> Table:
         columns.append(Column("mode_group", np.asarray(sweep.mode_group, dtype=object), modes,
                               long_name="mode group", flat="mode group {label}"))
     attributes = {"parameter": sweep.parameter, "unit": sweep.unit,
-                  "multiples": int(sweep.multiples)}
+                  "multiples": int(sweep.multiples), "spacing": str(sweep.spacing)}
     if sweep.datum is not None:
         attributes["datum"] = float(sweep.datum)
     return Table(sweep.parameter, tuple(columns),

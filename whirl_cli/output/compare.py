@@ -654,8 +654,8 @@ def _compare_cross_checks(path: str, a: ContinuationResult, b: ContinuationResul
 # ------------------------------------------------------------------------------ linear sweeps
 def compare_linear_sweep(a: LinearSweep, b: LinearSweep, rtol: float) -> list[Difference]:
     """Every column of a linear sweep, element by element (relative ``rtol``); the datum
-    where both files store it (files before it do not: that is no drift), and whether the
-    study gave it in multiples of the datum."""
+    where both files store it (files before it do not: that is no drift), whether the
+    study gave it in multiples of the datum, and its spacing."""
     path = f"/linear/sweeps/{a.parameter}"
     found = []
     for key in ("values", "eigenvalues", "damping_ratio", "frequency"):
@@ -670,8 +670,10 @@ def compare_linear_sweep(a: LinearSweep, b: LinearSweep, rtol: float) -> list[Di
     if a.datum is not None and b.datum is not None:  # older files store no datum: no drift
         found += _compare_arrays(f"{path}/datum", np.asarray(a.datum, float),
                                  np.asarray(b.datum, float), rtol)
-    if a.multiples != b.multiples:
-        found.append(Difference(f"{path}/@multiples", str(a.multiples), str(b.multiples)))
+    for key in ("multiples", "spacing"):
+        if getattr(a, key) != getattr(b, key):
+            found.append(Difference(f"{path}/@{key}", str(getattr(a, key)),
+                                    str(getattr(b, key))))
     return found
 
 

@@ -69,6 +69,7 @@ from ..results import (
     Simulation,
     SimulationLaw,
     SliceLabel,
+    Spacing,
     SpecialPoint,
     StudyResult,
     UnsafeCause,
@@ -214,12 +215,17 @@ LINEAR_SWEEP = (
     Field("datum", kind="float", unit_field="unit", default=None,  # older files: none
           shape=()),
     Field("multiples", "attribute", "bool", default=False),
+    Field("spacing", "attribute", "text", vocabulary=Spacing,  # older files: linear
+          default=Spacing.LINEAR),
 )
 #: A :class:`LinearGrid` in ``linear/grid`` (its contour lines: collections of their own).
 LINEAR_GRID = (
     Field("x_parameter", "attribute", "text"), Field("y_parameter", "attribute", "text"),
     Field("x", unit_field="x_unit", shape=("x",)), Field("y", unit_field="y_unit", shape=("y",)),
     Field("max_real", units="1/s", shape=("y", "x")), Field("oscillatory", shape=("y", "x")),
+    Field("x_spacing", "attribute", "text", vocabulary=Spacing,  # older files: linear
+          default=Spacing.LINEAR),
+    Field("y_spacing", "attribute", "text", vocabulary=Spacing, default=Spacing.LINEAR),
 )
 #: A :class:`Boundary` in ``boundaries/<name>`` (its loci and polygons: collections).
 BOUNDARY = (

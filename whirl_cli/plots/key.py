@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..results import BranchKind, PointType
+from ..results import BranchKind, PointType, Spacing
 from ..units import axis_label as _plain_axis_label
 from ..units import display_unit  # noqa: F401  (re-exported: plots use them)
 
@@ -272,17 +272,19 @@ DECADES = 20.0
 smallest is drawn on a log scale (:func:`log_scale_if_decades`)."""
 
 
-def spans_decades(values) -> bool:
-    """True if the finite ``values`` are all positive and max/min exceeds :data:`DECADES`."""
+def spans_decades(values, factor: float = DECADES) -> bool:
+    """True if the finite ``values`` are all positive and max/min exceeds ``factor``."""
     values = np.asarray(values, dtype=float).ravel()
     values = values[np.isfinite(values)]
-    return bool(values.size and values.min() > 0 and values.max() > DECADES * values.min())
+    return bool(values.size and values.min() > 0 and values.max() > factor * values.min())
 
 
-def log_scale_if_decades(ax: Axes, axis: str, values) -> bool:
+def log_scale_if_decades(ax: Axes, axis: str, values, spacing: Spacing = Spacing.LINEAR
+                         ) -> bool:
     """Put ``ax``'s ``axis`` ("x" or "y") on a log scale if ``values`` (what it shows)
-    :func:`span decades <spans_decades>`; True if it did."""
-    if not spans_decades(values):
+    :func:`span decades <spans_decades>`, or were sampled with a log ``spacing`` (all > 0);
+    True if it did."""
+    if not (spans_decades(values) or spacing == Spacing.LOG and spans_decades(values, 1.0)):
         return False
     getattr(ax, f"set_{axis}scale")("log")
     return True

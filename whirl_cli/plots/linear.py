@@ -10,9 +10,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..results import LinearSweep
+from ..results import LinearSweep, Spacing
 from ..units import HZ_PER_RAD_S
-from .key import axis_label, colour_cycle, new_figure
+from .key import axis_label, colour_cycle, log_scale_if_decades, new_figure
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -30,7 +30,8 @@ def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = 
     numbered if repeated); a mode whose damping ratio falls below zero somewhere (flutter) is
     drawn in :data:`UNSTABLE_COLOURS`, the others in :data:`STABLE_COLOURS`. Each crossing of
     zero by a damping ratio (:func:`zero_crossings`) is marked on both panels and named with
-    its value in the legend; the damping panel has a zero line.
+    its value in the legend; the damping panel has a zero line. The parameter axis is log if
+    the sweep spans decades or samples log (:func:`~.key.log_scale_if_decades`).
     Title: ``title`` (None: ``"linear analysis vs <parameter>"``). Draws on ``axes``
     (frequency, damping) if given, else on a new figure; returns the figure.
     """
@@ -63,6 +64,8 @@ def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = 
     ax_freq.set_ylabel(axis_label("frequency", "Hz" if hz else "rad/s"))
     ax_damp.set_ylabel(axis_label("damping ratio", ""))
     ax_damp.set_xlabel(axis_label(sweep.parameter, sweep.unit))
+    for ax in (ax_freq, ax_damp):
+        log_scale_if_decades(ax, "x", sweep.values, sweep.spacing)
     if ax_freq.get_lines():
         handles, labels = ax_freq.get_legend_handles_labels()
         more, named = ax_damp.get_legend_handles_labels()
@@ -208,7 +211,8 @@ def damping_multiples_plot(sweeps: Sequence[LinearSweep],
     "R (BW, FW)"; the mode group first for models with several); a dot marks each point
     where the least-damped mode changes direction. The datum is the sweep's own
     (:func:`sweep_datum`, else ``datums``); sweeps without a non-zero datum are left out.
-    A zero line on the damping panel, the datum (x = 1) dotted on both.
+    A zero line on the damping panel, the datum (x = 1) dotted on both. The x axis is log if
+    the multiples span decades or every sweep drawn samples log.
 
     ``axes``: (damping axes, frequency axes) to draw into (None: a new figure). Title:
     ``title`` (None: ``"least-damped mode vs parameter multiples"``).
@@ -221,7 +225,7 @@ def damping_multiples_plot(sweeps: Sequence[LinearSweep],
         figure = ax_damp.figure
     scale = HZ_PER_RAD_S if hz else 1.0
     colours = colour_cycle()
-    drawn = 0
+    drawn: list[tuple[np.ndarray, Spacing]] = []
     for sweep in sweeps:
         datum = sweep_datum(sweep, datums)
         if datum is None:
@@ -237,7 +241,7 @@ def damping_multiples_plot(sweeps: Sequence[LinearSweep],
             style.update(marker="o", markersize=4, markevery=changes)
         ax_damp.plot(x, zeta, **style)
         ax_freq.plot(x, freq * scale, **style)
-        drawn += 1
+        drawn.append((x, sweep.spacing))
     ax_damp.axhline(0.0, color="black", linewidth=0.8, label="_zero")
     for ax in (ax_damp, ax_freq):
         ax.axvline(1.0, color="grey", linewidth=0.8, linestyle=":", label="_datum")
@@ -245,6 +249,9 @@ def damping_multiples_plot(sweeps: Sequence[LinearSweep],
     ax_freq.set_ylabel(axis_label("frequency", "Hz" if hz else "rad/s"))
     ax_freq.set_xlabel("parameter / datum")
     if drawn:
+        spacing = Spacing.LOG if all(s == Spacing.LOG for _, s in drawn) else Spacing.LINEAR
+        for ax in (ax_damp, ax_freq):
+            log_scale_if_decades(ax, "x", np.concatenate([x for x, _ in drawn]), spacing)
         ax_damp.legend(fontsize="small")
     ax_damp.set_title("least-damped mode vs parameter multiples" if title is None else title)
     return figure

@@ -12,7 +12,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import WhirlError
-from ..results import Boundary, ContinuationKind, ContinuationResult, LinearGrid, on_slice
+from ..results import (
+    Boundary,
+    ContinuationKind,
+    ContinuationResult,
+    LinearGrid,
+    Spacing,
+    on_slice,
+)
 from .diagrams import checked_branches, draw_bifurcation
 from .key import (
     BLACK,
@@ -121,7 +128,8 @@ def oriented_grid(grid: LinearGrid, names: Sequence[str]) -> LinearGrid | None:
                           grid.y, grid.x, np.asarray(grid.max_real).T,
                           np.asarray(grid.oscillatory).T,
                           tuple(np.asarray(line)[:, ::-1] for line in grid.flutter),
-                          tuple(np.asarray(line)[:, ::-1] for line in grid.divergence))
+                          tuple(np.asarray(line)[:, ::-1] for line in grid.divergence),
+                          x_spacing=grid.y_spacing, y_spacing=grid.x_spacing)
     return None
 
 
@@ -196,14 +204,15 @@ def _draw_loci(ax: Axes, boundary: Boundary, first: dict) -> None:
 
 def _set_map_limits(ax: Axes, boundary: Boundary | None, grid: LinearGrid | None) -> None:
     """Grid extent; else loci extent (polygons if no loci) with a margin; else leave as is.
-    An axis whose extent spans decades is logarithmic (:func:`log_scale_if_decades`), its
-    margin then a factor."""
+    An axis whose extent spans decades, or the grid samples log, is logarithmic
+    (:func:`log_scale_if_decades`), its margin then a factor."""
     extent = _map_extent(boundary, grid)
     if extent is None:
         return
     for axis, (low, high) in zip("xy", extent[:2], strict=True):
         margin = extent[2]
-        if log_scale_if_decades(ax, axis, (low, high)):
+        spacing = Spacing.LINEAR if grid is None else getattr(grid, f"{axis}_spacing")
+        if log_scale_if_decades(ax, axis, (low, high), spacing):
             factor = (high / low) ** margin
             low, high = low / factor, high * factor
         else:

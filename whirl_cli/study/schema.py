@@ -40,6 +40,7 @@ from ..documents.values import (
     bound,
     fail,
 )
+from ..kinds import Spacing
 from ..models import FAMILIES, Model, is_known, is_model_file
 from ..models.laws import LAWS, POLYNOMIAL, Coefficient, Law
 from ..plots.kinds import plot_kinds
@@ -134,15 +135,26 @@ Continuation = Annotated[functools.reduce(operator.or_, continuations.specs()),
 
 
 class LinearAxisSpec(Strict):
-    """One parameter on an even grid of values: a grid axis."""
+    """One parameter sampled over a range, evenly or with a constant ratio: a grid axis."""
 
     parameter: Text = Field(
         description="Swept parameter, by name or alias (stored as the canonical name)."
     )
     range: Range = Field(description="[lower, upper] of the sweep, in the parameter's unit.")
     points: Annotated[Integer, bound(">=", 2), bound("<=", 100000)] = Field(
-        201, description="Number of equally spaced values, 2 to 100000."
+        201, description="Number of values, from `lower` to `upper`, 2 to 100000."
     )
+    spacing: Literal[tuple(Spacing)] = Field(
+        Spacing.LINEAR, description="`linear`: equally spaced values; `log`: a constant "
+        "ratio between neighbours, lower (upper/lower)^(k/(points - 1)), for a parameter "
+        "spanning decades (the range > 0; its plots draw the axis log).")
+
+    @model_validator(mode="after")
+    def _log_range_positive(self) -> LinearAxisSpec:
+        """A log spacing samples a positive range only."""
+        if self.spacing == Spacing.LOG and not self.range[0] > 0:
+            fail(f"with spacing: log the range must be > 0, got {self.range[0]!r}", ("range",))
+        return self
 
 
 class LinearSweepSpec(LinearAxisSpec):
@@ -160,9 +172,10 @@ class LinearSweepSpec(LinearAxisSpec):
 class LinearGridSpec(Strict):
     """Linear stability over a grid of two parameters."""
 
-    x: LinearAxisSpec = Field(description="First grid axis: parameter, range, points.")
+    x: LinearAxisSpec = Field(description="First grid axis: parameter, range, points, "
+                              "spacing.")
     y: LinearAxisSpec = Field(description="Second grid axis: another parameter, range, "
-                              "points.")
+                              "points, spacing.")
 
 
 class LinearSpec(Strict):
