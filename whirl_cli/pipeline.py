@@ -14,8 +14,6 @@ from functools import partial
 from pathlib import Path
 from typing import TypeVar
 
-import numpy as np
-
 from .analysis import freeplay, linear, seeds, simulate
 from .auto.runner import RunOutcome, interruptible
 from .continuation.engine import Engine, Numerics

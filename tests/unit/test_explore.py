@@ -15,8 +15,8 @@ import h5py
 import numpy as np
 import pytest
 
-from whirl_cli.continuation import recipes
 from whirl_cli.analysis import motion
+from whirl_cli.continuation import recipes
 from whirl_cli.errors import StudyError, WhirlError
 from whirl_cli.output import compare, store
 from whirl_cli.plots.files import PLOT_KINDS, missing_data, plot_names, study_figures
