@@ -6,6 +6,8 @@ from its rates): negative below nu = 0.5549, positive above."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -51,3 +53,20 @@ def test_a_gh_point_is_located_only_where_l1_changes_sign(nu, status):
     judged = with_bautin_verdict(_model(), locus, point, PAIR, {})
     assert judged.status == status
     assert ("does not change sign" in judged.note) == (status == LocateStatus.REJECTED)
+
+
+def test_at_a_locus_end_a_gh_point_is_rejected_where_l1_vanishes_beside_it(tmp_path):
+    """The last row of a locus of a model without a nonlinear term (the Bautin model's
+    rates with their nonlinear terms left out): l1 is zero on the one side there is."""
+    path = ROOT / "tests" / "data" / "bautin.model.yaml"
+    text = path.read_text().replace(" + x**2 + x*y + (nu - 0.3)*x**3", "").replace(
+        " + x**2\n", "\n").replace("name: bautin\n", "name: bautin_linear\n")
+    assert "x**" not in text.split("rates:")[1]
+    (tmp_path / "linear.yaml").write_text(text)
+    linear = get_model(load_model_file(tmp_path / "linear.yaml"))
+    locus, point = _locus(np.array([0.2, 0.25, 0.3]))
+    point = replace(point, index=2)
+    judged = with_bautin_verdict(linear, locus, point, PAIR, {})
+    assert judged.status == LocateStatus.REJECTED and "vanishes beside it" in judged.note
+    nonlinear = with_bautin_verdict(_model(), locus, point, PAIR, {})
+    assert nonlinear.status == LocateStatus.LOCATED  # one side only: cannot be refuted

@@ -115,29 +115,32 @@ def locus_lyapunov(model: Model, locus: Branch, row: int, pair: tuple[str, str],
     return criticality_of(l1, 2 * np.pi / float(locus.period[row]))
 
 
-def bautin_verdict(before: Criticality, after: Criticality) -> str:
-    """Why a GH (Bautin) point between rows whose first Lyapunov coefficient gives
-    ``before`` and ``after`` is not one ("" if it may be: the sign changes, or a side is
-    unknown while the other is not)."""
-    if before == after == Criticality.UNKNOWN:
-        return ("the first Lyapunov coefficient vanishes on both sides (identically zero "
+def bautin_verdict(*sides: Criticality) -> str:
+    """Why a GH (Bautin) point is not one, given the verdicts of the first Lyapunov
+    coefficient at the locus rows beside it (two, or one at an end of the locus); "" if it
+    may be (the sign changes, or one side is unknown while the other is not, or one side
+    only and l1 does not vanish there)."""
+    if all(side == Criticality.UNKNOWN for side in sides):
+        where = "on both sides" if len(sides) > 1 else "beside it"
+        return (f"the first Lyapunov coefficient vanishes {where} (identically zero "
                 "without a nonlinear term at the equilibrium): every Hopf point here is "
                 "degenerate, not a Bautin point")
-    if before == after:
-        return (f"the first Lyapunov coefficient does not change sign ({before} on both "
+    if len(sides) > 1 and len(set(sides)) == 1:
+        return (f"the first Lyapunov coefficient does not change sign ({sides[0]} on both "
                 "sides): not a Bautin point")
     return ""
 
 
 def with_bautin_verdict(model: Model, locus: Branch, point: SpecialPoint,
                         pair: tuple[str, str], parameters: dict[str, float]) -> SpecialPoint:
-    """A GH point of a Hopf ``locus`` rejected, with a note saying why, unless the first
-    Lyapunov coefficient changes sign between the locus's rows either side of it (a point
-    at either end of the locus is left as it is)."""
-    if point.point_type != PointType.GH or not 0 < point.index < len(locus) - 1:
+    """A GH point of a Hopf ``locus`` rejected, with a note saying why (:func:`bautin_verdict`
+    of the first Lyapunov coefficient at the locus's rows beside it), unless it changes
+    sign there."""
+    rows = [row for row in (point.index - 1, point.index + 1) if 0 <= row < len(locus)]
+    if point.point_type != PointType.GH or not rows:
         return point
     note = bautin_verdict(*(locus_lyapunov(model, locus, row, pair, parameters)
-                            for row in (point.index - 1, point.index + 1)))
+                            for row in rows))
     if not note:
         return point
     return replace(point, status=LocateStatus.REJECTED, note=joined_notes(point.note, note))
