@@ -10,7 +10,7 @@ import pytest
 from whirl_cli.analysis import boundaries, linear, simulate
 from whirl_cli.models import get_model
 from whirl_cli.pipeline import run_study
-from whirl_cli.results import BranchKind
+from whirl_cli.results import BranchKind, LocateStatus, PointType
 from whirl_cli.study import validate_text
 
 from ..conftest import STUDIES
@@ -95,6 +95,18 @@ def test_linear_map_anatomy(results):
     hopf = np.vstack([c for k, c in boundary.loci.values() if k == "hopf"])
     assert hopf[:, 0].min() < 0.05 and hopf[:, 0].max() > 0.3  # the loci span the bubble
     assert not boundary.intervals  # a linear model has no overhang
+
+
+def test_a_linear_models_hopf_locus_lists_no_located_bautin_point(results):
+    """A linear model's first Lyapunov coefficient is identically zero, so the GH points AUTO
+    flags along its Hopf loci (its test function changing sign on round-off) are listed as
+    rejected, their note saying so, never as located."""
+    _, result = results("boundary_linear", slices="[0.3, 0.4]")
+    (continuation,) = [c for c in result.continuations if c.name == "boundary"]
+    gh = [p for p in continuation.special_points if p.point_type == PointType.GH]
+    assert gh  # AUTO flags them: the check below is not vacuous
+    assert all(p.status == LocateStatus.REJECTED for p in gh)
+    assert all("vanishes" in p.note for p in gh)
 
 
 def _slice_intervals(boundary, value, cause=None):

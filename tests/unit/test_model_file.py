@@ -378,3 +378,50 @@ def test_api_loads_a_model_file_or_a_built_in(tmp_path):
         api.load_model(tmp_path / "bad.model.yaml")
     with pytest.raises(WhirlError, match="unknown model 'tiltrotor'"):
         api.load_model("tiltrotor")
+
+
+#: Names the generated numeric module once used itself: its arguments (y, c, p) and
+#: temporaries (t_0, r_0, m_0_0, s_0_0), as a model's states and parameters.
+CLASHING = """\
+name: clashing
+description: names of the generated module's own
+states:
+  - {name: y}
+  - {name: q}
+  - {name: c}
+parameters:
+  - {name: p, value: 2.0}
+  - {name: t_0, value: 0.5}
+  - {name: r_0, value: 3.0}
+  - {name: m_0_0, value: 0.25}
+rates:
+  y: q
+  q: -p*y - t_0*q + c*y**2 - m_0_0*y**3
+  c: -r_0*c + y*q*t_0
+"""
+
+
+def test_a_models_names_never_clash_with_the_generated_codes(tmp_path):
+    """States and parameters named as the generated module's arguments and temporaries give
+    the right-hand side, Jacobian, derivative tensors and simulation field written here."""
+    path = tmp_path / "clashing.yaml"
+    path.write_text(CLASHING)
+    model = get_model(load_model_file(path))
+    p, t0, r0, m00 = 2.0, 0.5, 3.0, 0.25
+    params = model.parameter_vector({})
+    state = np.array([0.3, -0.7, 1.1])
+    y, q, c = state
+    rates = [q, -p * y - t0 * q + c * y**2 - m00 * y**3, -r0 * c + y * q * t0]
+    jacobian = [[0, 1, 0], [-p + 2 * c * y - 3 * m00 * y**2, -t0, y**2],
+                [q * t0, y * t0, -r0]]
+    np.testing.assert_allclose(model.rhs_numpy(state, params), rates, rtol=1e-12)
+    np.testing.assert_allclose(model.jacobian_numpy(state, params), jacobian, rtol=1e-12)
+    field, field_jacobian = model.field_at(params)
+    np.testing.assert_allclose(field(state), rates, rtol=1e-12)
+    np.testing.assert_allclose(field_jacobian(state), jacobian, rtol=1e-12)
+    second, third = model.derivative_tensors(state, params)
+    assert second[1, 0, 0] == pytest.approx(2 * c - 6 * m00 * y)
+    assert second[1, 0, 2] == second[1, 2, 0] == pytest.approx(2 * y)
+    assert second[2, 0, 1] == pytest.approx(t0)
+    assert third[1, 0, 0, 0] == pytest.approx(-6 * m00)
+    assert third[1, 0, 0, 2] == pytest.approx(2.0)

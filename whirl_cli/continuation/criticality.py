@@ -11,7 +11,7 @@ import numpy as np
 
 from ..analysis.normal_form import criticality_of, hopf_lyapunov_coefficient
 from ..models import Model
-from ..results import Branch, Criticality, Origin, PointType, SpecialPoint
+from ..results import Branch, Criticality, LocateStatus, Origin, PointType, SpecialPoint
 from .branches import joined_notes
 from .periodic import hopf_at
 
@@ -99,3 +99,48 @@ def _hopf_growth_direction(branch: Branch, hopf: SpecialPoint) -> float:
                                                    - branch.parameters[k - 1, 0])
     return float(np.sign(slope)) if np.isfinite(slope) else 0.0
 
+
+
+def locus_lyapunov(model: Model, locus: Branch, row: int, pair: tuple[str, str],
+                   parameters: dict[str, float]) -> Criticality:
+    """The criticality the first Lyapunov coefficient gives at ``row`` of a Hopf ``locus``
+    in the parameter ``pair`` (unknown where it vanishes to round-off or cannot be
+    computed)."""
+    values = model.parameter_vector({**parameters, pair[0]: float(locus.parameters[row, 0]),
+                                     pair[1]: float(locus.parameters[row, 1])})
+    try:
+        l1 = hopf_lyapunov_coefficient(model, locus.state_max[row], values)
+    except (ValueError, np.linalg.LinAlgError):
+        l1 = float("nan")
+    return criticality_of(l1, 2 * np.pi / float(locus.period[row]))
+
+
+def bautin_verdict(*sides: Criticality) -> str:
+    """Why a GH (Bautin) point is not one, given the verdicts of the first Lyapunov
+    coefficient at the locus rows beside it (two, or one at an end of the locus); "" if it
+    may be (the sign changes, or one side is unknown while the other is not, or one side
+    only and l1 does not vanish there)."""
+    if all(side == Criticality.UNKNOWN for side in sides):
+        where = "on both sides" if len(sides) > 1 else "beside it"
+        return (f"the first Lyapunov coefficient vanishes {where} (identically zero "
+                "without a nonlinear term at the equilibrium): every Hopf point here is "
+                "degenerate, not a Bautin point")
+    if len(sides) > 1 and len(set(sides)) == 1:
+        return (f"the first Lyapunov coefficient does not change sign ({sides[0]} on both "
+                "sides): not a Bautin point")
+    return ""
+
+
+def with_bautin_verdict(model: Model, locus: Branch, point: SpecialPoint,
+                        pair: tuple[str, str], parameters: dict[str, float]) -> SpecialPoint:
+    """A GH point of a Hopf ``locus`` rejected, with a note saying why (:func:`bautin_verdict`
+    of the first Lyapunov coefficient at the locus's rows beside it), unless it changes
+    sign there."""
+    rows = [row for row in (point.index - 1, point.index + 1) if 0 <= row < len(locus)]
+    if point.point_type != PointType.GH or not rows:
+        return point
+    note = bautin_verdict(*(locus_lyapunov(model, locus, row, pair, parameters)
+                            for row in rows))
+    if not note:
+        return point
+    return replace(point, status=LocateStatus.REJECTED, note=joined_notes(point.note, note))

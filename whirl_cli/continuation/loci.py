@@ -4,6 +4,7 @@ points (Hopf, branch point, fold, fold of cycles), each traced once, chunk by ch
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 from functools import partial
 
@@ -28,6 +29,7 @@ from ..results import (
 )
 from ..runtime import thread_map
 from .branches import head, join, same_point, special_points, typical_amplitudes
+from .criticality import with_bautin_verdict
 from .engine import Engine, Numerics, RunSpec, read_run
 from .equilibria import equilibrium_constants
 from .geometry import (
@@ -122,12 +124,23 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
                     and same_point(named, other, width, amplitudes)
                     for other, _ in starts):
                 starts.append((named, runs[point.branch]))
-    curves = _loci(engine, name, pair, bounds, numerics, starts,
+    checked = partial(locus_points, engine.model, pair=pair, parameters=parameters)
+    curves = _loci(engine, name, pair, bounds, numerics, starts, checked,
                    outermost=snaking_folds == "outermost")
     for curve in curves:
-        points += special_points(curve, skip_first=True)
+        points += checked(curve)
     return (ContinuationResult(name, ContinuationKind.TWO_PARAMETER, tuple(branches + curves),
                                tuple(points)), curves)
+
+
+def locus_points(model: Model, curve: Branch, pair: tuple[str, str],
+                 parameters: dict[str, float]) -> list[SpecialPoint]:
+    """The special points of a locus after its start, the GH points of a Hopf locus with
+    their verdict (:func:`.criticality.with_bautin_verdict`)."""
+    points = special_points(curve, skip_first=True)
+    if curve.kind != BranchKind.HOPF_LOCUS:
+        return points
+    return [with_bautin_verdict(model, curve, p, pair, parameters) for p in points]
 
 
 def _starts_locus(point: SpecialPoint) -> bool:
@@ -142,9 +155,13 @@ def _starts_locus(point: SpecialPoint) -> bool:
 
 def _loci(engine: Engine, name: str, pair: tuple[str, str],
           bounds: dict[str, tuple[float, float]], numerics: Numerics,
-          starts: list[tuple[SpecialPoint, str]], outermost: bool = False) -> list[Branch]:
+          starts: list[tuple[SpecialPoint, str]],
+          checked: Callable[[Branch], list[SpecialPoint]] | None = None,
+          outermost: bool = False) -> list[Branch]:
     """Locus branches from the start points, both directions, each locus once (``outermost``:
-    of the folds of cycles of a snaking family only the outermost, :func:`_outermost_folds`).
+    of the folds of cycles of a snaking family only the outermost, :func:`_outermost_folds`;
+    ``checked``: a locus's special points with their verdicts, :func:`locus_points`, whose
+    located codimension-2 points may end a locus).
 
     Starts are taken slice by slice (a wave per slice): a start lying on a locus of its type
     already traced from an earlier slice is the same locus and is not run again, nor is a
@@ -206,7 +223,9 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
     kept = [curve for _, _, curve in _distinct(
         {k: (kind, None, curve) for k, (kind, curve) in enumerate(
             sorted(curves, key=lambda c: c[1].name))}, [], width)[0].values()]
-    codim2 = _codim2(kept)
+    checked = checked or partial(special_points, skip_first=True)
+    codim2 = [p for c in kept for p in checked(c)
+              if p.point_type in CODIM2 and p.status == LocateStatus.LOCATED]
     points = tuple(point for point, _ in starts)
     return [_locus_end(c, codim2, bounds, width, points, numerics.max_steps) for c in kept]
 

@@ -1,6 +1,7 @@
 """Mirror images of a symmetric model (equations invariant under y -> -y): Hopf points in +/-
 pairs, and a periodic family of one mapped onto the other's instead of computed again, so the
-two carry the same special points by construction.
+two carry the same special points by construction; so too the families doubled at their
+period-doubling points (:mod:`.doubling`).
 """
 
 from __future__ import annotations
@@ -51,6 +52,51 @@ def mirror_sources(model: Model, hopfs: list[SpecialPoint], width: float,
                 sources[k] = j
             break
     return sources
+
+
+def mirror_points(model: Model, points: list[SpecialPoint], branches: dict[str, Branch],
+                  width: float, parameters: dict[str, float]) -> dict[int, int]:
+    """{k: j} for every point k on a periodic family that is the mirror image of an earlier
+    one j on another family (same type, parameter and period; the orbit at k the negated
+    orbit at j: its maxima the negated minima), where the model is symmetric and its
+    right-hand side odd there."""
+    if not model.symmetric:
+        return {}
+    amplitudes = typical_amplitudes(model)
+
+    def orbit(point: SpecialPoint) -> tuple[np.ndarray, np.ndarray]:
+        branch = branches[point.branch]
+        return (branch.state_max[point.index] / amplitudes,
+                branch.state_min[point.index] / amplitudes)
+
+    images: dict[int, int] = {}
+    for k, point in enumerate(points):
+        for j, other in enumerate(points[:k]):
+            if j in images or not _mirror_pair(point, other, orbit(point), orbit(other), width):
+                continue
+            name = point.parameter_names[0]
+            params = model.parameter_vector({**parameters, name: float(point.parameters[0])})
+            if is_odd(model, params, [point.state]):
+                images[k] = j
+            break
+    return images
+
+
+def _mirror_pair(a: SpecialPoint, b: SpecialPoint, orbit_a: tuple[np.ndarray, np.ndarray],
+                 orbit_b: tuple[np.ndarray, np.ndarray], width: float) -> bool:
+    """True if ``a`` and ``b``, on different families, are of one type at one parameter and
+    period, and their orbits (maxima, minima) each other's negatives."""
+    return (a.branch != b.branch and a.point_type == b.point_type
+            and abs(a.parameters[0] - b.parameters[0]) <= MIRROR_TOLERANCE * width
+            and abs(a.period - b.period) <= MIRROR_TOLERANCE * abs(b.period)
+            and _negated(orbit_a, orbit_b))
+
+
+def _negated(a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray]) -> bool:
+    """True if the orbit with (maxima, minima) ``a`` is the negated ``b``: its maxima ``b``'s
+    negated minima and the other way round, to MIRROR_TOLERANCE."""
+    return all(np.allclose(x, y, rtol=MIRROR_TOLERANCE, atol=MIRROR_TOLERANCE)
+               for x, y in zip(a, (-b[1], -b[0]), strict=True))
 
 
 def _mirrors(a: SpecialPoint, b: SpecialPoint, width: float, amplitudes: np.ndarray) -> bool:

@@ -13,6 +13,10 @@ M(p) v' = R):
   ``residual_tensors(y, p)``: the non-zero second and third derivatives;
 * ``mass(p)``: the entries of M, and ``DIAGONAL_MASS``.
 
+The states and parameters are local names there, so every name the module makes up
+(arguments, written ``p``, ``y`` ... above, and temporaries) starts with ``w_``, which no
+model's name may.
+
 :class:`Numeric` adds the generic part: q' = v, and the solve with M (a division where M is
 diagonal), vectorised over points.
 """
@@ -93,22 +97,22 @@ def numeric_source(model, exact: bool = False) -> str:
     forces, slopes = reduced[:n_rows], reduced[n_rows:]
 
     # M^-1 as prepared numbers (field_at: fixed parameters): 1/M_ii, or a numeric inverse
-    inverse = [[sp.Symbol(f"m_{i}_{j}") for j in range(n_dof)] for i in range(n_dof)]
+    inverse = [[sp.Symbol(f"w_m{i}_{j}") for j in range(n_dof)] for i in range(n_dof)]
     structure = [[i == j or not symbolic.diagonal_mass for j in range(n_dof)]
                  for i in range(n_dof)]
     if symbolic.diagonal_mass:
-        inverse_lines = [f"    m_{i}_{i} = 1.0 / ({printer.doprint(symbolic.mass[i, i])})"
+        inverse_lines = [f"    w_m{i}_{i} = 1.0 / ({printer.doprint(symbolic.mass[i, i])})"
                          for i in range(n_dof)]
     else:
         inverse_lines = [f"    ({', '.join(str(s) for row in inverse for s in row)},) = "
-                         f"numpy.linalg.inv(numpy.array(mass(p), dtype=float).reshape("
+                         f"numpy.linalg.inv(numpy.array(mass(w_p), dtype=float).reshape("
                          f"{n_dof}, {n_dof})).ravel()"]
     field_constants = prepared + [str(inverse[i][j]) for i in range(n_dof)
                                   for j in range(n_dof) if structure[i][j]]
     # each force and slope once, as a temporary: with a full M^-1 every row of the
     # accelerations sums all of them (printed inline, each would be evaluated n_dof times)
-    force_symbols = [sp.Symbol(f"r_{j}") for j in range(n_dof)]
-    slope_symbols = [sp.S.Zero if slopes[j * n + k] == 0 else sp.Symbol(f"s_{j}_{k}")
+    force_symbols = [sp.Symbol(f"w_r{j}") for j in range(n_dof)]
+    slope_symbols = [sp.S.Zero if slopes[j * n + k] == 0 else sp.Symbol(f"w_s{j}_{k}")
                      for j in range(n_dof) for k in range(n)]
     force_lines = list(zip(force_symbols, forces[:n_dof], strict=True))
     slope_lines = [(symbol, slope) for symbol, slope in zip(slope_symbols, slopes[:n_dof * n],
@@ -132,7 +136,7 @@ def numeric_source(model, exact: bool = False) -> str:
         return [a for a in state_dependent if a[0] in _needed(results, state_dependent)]
 
     nonzero, tensors = symbolic.residual_tensors
-    tensor_temps, tensor_reduced = sp.cse(tensors, symbols=sp.numbered_symbols("t_"),
+    tensor_temps, tensor_reduced = sp.cse(tensors, symbols=sp.numbered_symbols("w_t"),
                                           order="canonical") if tensors else ([], [])
     laws = ", ".join(f"{law} on {dof}" for law, dof in zip(model.laws, model.family.dof_names,
                                                           strict=True))
@@ -153,40 +157,40 @@ def numeric_source(model, exact: bool = False) -> str:
         f"TENSOR_INDEX = {list(nonzero)}",
         "",
         "",
-        "def prepare(p):",
-        *body(parameter_only, [sp.Symbol(name) for name in prepared], [unpack(params, "p")]),
+        "def prepare(w_p):",
+        *body(parameter_only, [sp.Symbol(name) for name in prepared], [unpack(params, "w_p")]),
         "",
         "",
-        "def residual(y, c):",
-        *body(used(forces), forces, [unpack(states, "y"), unpack(prepared, "c")]),
+        "def residual(w_y, w_c):",
+        *body(used(forces), forces, [unpack(states, "w_y"), unpack(prepared, "w_c")]),
         "",
         "",
-        "def residual_jacobian(y, c):",
-        *body(used(slopes), slopes, [unpack(states, "y"), unpack(prepared, "c")]),
+        "def residual_jacobian(w_y, w_c):",
+        *body(used(slopes), slopes, [unpack(states, "w_y"), unpack(prepared, "w_c")]),
         "",
         "",
-        "def residual_tensors(y, p):",
-        *body(tensor_temps, tensor_reduced, [unpack(states, "y"), unpack(params, "p")]),
+        "def residual_tensors(w_y, w_p):",
+        *body(tensor_temps, tensor_reduced, [unpack(states, "w_y"), unpack(params, "w_p")]),
         "",
         "",
-        "def mass(p):",
-        *body([], list(symbolic.mass), [unpack(params, "p")]),
+        "def mass(w_p):",
+        *body([], list(symbolic.mass), [unpack(params, "w_p")]),
         "",
         "",
-        "def prepare_field(p):",
-        f"    ({', '.join(params)},) = p",
+        "def prepare_field(w_p):",
+        f"    ({', '.join(params)},) = w_p",
         *inverse_lines,
-        "    return prepare(p) + [" + ", ".join(field_constants[len(prepared):]) + "]",
+        "    return prepare(w_p) + [" + ", ".join(field_constants[len(prepared):]) + "]",
         "",
         "",
-        "def field(y, f):",
+        "def field(w_y, w_f):",
         *body(used(forces) + force_lines, list(symbolic.v) + accelerations + forces[n_dof:],
-              [unpack(states, "y"), unpack(field_constants, "f")]),
+              [unpack(states, "w_y"), unpack(field_constants, "w_f")]),
         "",
         "",
-        "def field_jacobian(y, f):",
+        "def field_jacobian(w_y, w_f):",
         *body(used(slopes) + slope_lines, upper + lower + slopes[n_dof * n:],
-              [unpack(states, "y"), unpack(field_constants, "f")]),
+              [unpack(states, "w_y"), unpack(field_constants, "w_f")]),
         "",
     ]
     return "\n".join(lines)
