@@ -19,7 +19,14 @@ from click.testing import CliRunner
 from whirl_cli.cli import cli
 from whirl_cli.output import store
 from whirl_cli.output.summary import Table
-from whirl_cli.results import Branch, BranchKind, ContinuationResult, SpecialPoint, StudyResult
+from whirl_cli.results import (
+    Branch,
+    BranchKind,
+    ContinuationResult,
+    LocateStatus,
+    SpecialPoint,
+    StudyResult,
+)
 
 from ..conftest import ROOT
 
@@ -297,3 +304,25 @@ def test_the_table_needs_no_rich():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           timeout=60, check=True)
     assert done.stdout.split() == ["True", "False"]
+
+
+def test_rejected_points_are_counted_apart_and_never_shortened_with_located_ones(tmp_path):
+    """A run of GH points whirl's check rejected (a linear model's Hopf locus) is shortened
+    apart from the located ones beside it, its "..." row says they are rejected, and the
+    title says how many of the points are."""
+    base = oscillator_result()
+    (continuation,) = base.continuations
+    hopf = continuation.special_points[0]
+    gh = replace(hopf, point_type=-32)
+    located = tuple(replace(gh, parameters=np.array([-0.01 * k, 2.0])) for k in range(1, 6))
+    rejected = tuple(replace(gh, parameters=np.array([-0.1 - 0.01 * k, 2.0]),
+                             status=LocateStatus.REJECTED) for k in range(1, 8))
+    points = (hopf, *located, *rejected)
+    result = replace(base, continuations=(replace(continuation, special_points=points),))
+    path = tmp_path / "rejected.h5"
+    store.write(result, path)
+    lines = summary(path).splitlines()
+    assert lines[0] == "alpha (one-parameter): 13 special points, 7 of them rejected by " \
+        "whirl's checks"
+    skipped = [line.split(maxsplit=1)[1] for line in lines if line.startswith("...")]
+    assert skipped == ["3 more GH", "5 more GH, rejected"]

@@ -28,6 +28,7 @@ import numpy as np
 from ..results import (
     Branch,
     ContinuationResult,
+    LocateStatus,
     PointType,
     SpecialPoint,
     StudyResult,
@@ -260,28 +261,38 @@ full; a longer run as its first and last row with one "... N more" row between t
 
 @dataclass(frozen=True)
 class Skipped:
-    """Where :func:`compact` left out ``count`` records of points of ``type``."""
+    """Where :func:`compact` left out ``count`` records of points of ``type`` with one
+    ``status``."""
 
     count: int
     type: str
+    status: str = LocateStatus.LOCATED
+
+    def text(self) -> str:
+        """What the "..." row says: "6 more GH", "203 more GH, rejected" (a status other
+        than located is named)."""
+        named = "" if self.status == LocateStatus.LOCATED else f", {self.status}"
+        return f"{self.count} more {self.type}{named}"
 
 
 def compact(records_: Sequence[dict[str, object]], longest: int = RUN_SHOWN
             ) -> list[dict[str, object] | Skipped]:
     """``records_`` with every run of more than ``longest`` consecutive records of the same
-    branch and type replaced by its first record, a :class:`Skipped` and its last record
-    (e.g. the many GH points AUTO flags along a Hopf locus of a linear model)."""
+    branch, type and status replaced by its first record, a :class:`Skipped` and its last
+    record (e.g. the many GH points AUTO flags along a Hopf locus of a linear model, which
+    whirl's check rejects)."""
+    def key(record: dict[str, object]) -> tuple:
+        return record["branch"], record["type"], record["status"]
+
     shown: list[dict[str, object] | Skipped] = []
     start = 0
     while start < len(records_):
-        key = (records_[start]["branch"], records_[start]["type"])
         end = start
-        while end + 1 < len(records_) and \
-                (records_[end + 1]["branch"], records_[end + 1]["type"]) == key:
+        while end + 1 < len(records_) and key(records_[end + 1]) == key(records_[start]):
             end += 1
         run = list(records_[start:end + 1])
-        shown += run if len(run) <= longest else [run[0], Skipped(len(run) - 2, str(key[1])),
-                                                  run[-1]]
+        skipped = Skipped(len(run) - 2, str(run[0]["type"]), str(run[0]["status"]))
+        shown += run if len(run) <= longest else [run[0], skipped, run[-1]]
         start = end + 1
     return shown
 
@@ -313,6 +324,14 @@ class Table:
         return [self.title, header, *body, *self.notes]
 
 
+def counted(rows: Sequence[SummaryRow]) -> str:
+    """"3 special points", or "221 special points, 203 of them rejected by whirl's checks"
+    (AUTO labelled them; whirl's own check says they are not that point)."""
+    rejected = sum(row.status == LocateStatus.REJECTED for row in rows)
+    text = f"{len(rows)} special point{'s' if len(rows) != 1 else ''}"
+    return text + (f", {rejected} of them rejected by whirl's checks" if rejected else "")
+
+
 def tables(result: StudyResult, dofs: Sequence[str] | None = None) -> list[Table]:
     """One :class:`Table` per continuation of ``result`` (its special points, as in
     :func:`summary_rows`, long runs of one type on one branch shortened by :func:`compact`;
@@ -324,13 +343,12 @@ def tables(result: StudyResult, dofs: Sequence[str] | None = None) -> list[Table
         cells = []
         for record in compact(records(rows)):
             if isinstance(record, Skipped):
-                cells.append(("...", f"{record.count} more {record.type}",
+                cells.append(("...", record.text(),
                               *[""] * (len(names) - 2)))
             else:
                 cells.append(tuple(_cell(record[name]) for name in names))
         drawn.append(Table(
-            f"{continuation.name} ({continuation.kind}): "
-            f"{len(rows)} special point{'s' if len(rows) != 1 else ''}", names,
+            f"{continuation.name} ({continuation.kind}): {counted(rows)}", names,
             tuple(name not in ("branch", "type", *LAST_COLUMNS[1:]) for name in names),
             tuple(cells), tuple(f"note: {truncation(b)}" for b in continuation.branches
                                 if b.truncated)
