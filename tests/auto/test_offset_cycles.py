@@ -19,6 +19,7 @@ from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 from scipy.optimize import brentq
 
+from whirl_cli.continuation import persistence
 from whirl_cli.pipeline import run_study
 from whirl_cli.results import PointType
 from whirl_cli.study import load_study
@@ -154,4 +155,10 @@ def test_homoclinic_end_against_the_exact_law(continuation):
         low, high = point.bracket
         assert low <= exact <= high
         assert point.parameters[0] == pytest.approx(exact, abs=HOMOCLINIC_TOLERANCE)
-    print(f"homoclinic: {exact:.6f} m/s (exact law), {point.parameters[0]:.6f} (whirl)")
+        # it persists as the smoothing shrinks, judged from the folds that bracket it (not
+        # from whether a repeated continuation happens to reach it again)
+        assert not point.artefact, point.note
+        assert point.refined_by == persistence.FOLDS
+        np.testing.assert_allclose(point.refined, exact, atol=HOMOCLINIC_TOLERANCE)
+    print(f"homoclinic: {exact:.6f} m/s (exact law), {point.parameters[0]:.6f} (whirl; "
+          f"{point.refined[0]:.6f}, {point.refined[1]:.6f} at epsilon / 2, / 4)")
