@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 from scipy.linalg import expm
-from scipy.optimize import brentq
+from scipy.optimize import brentq, fsolve, minimize_scalar
 
 from whirl_cli.continuation import persistence
 from whirl_cli.pipeline import run_study
@@ -162,3 +162,74 @@ def test_homoclinic_end_against_the_exact_law(continuation):
         np.testing.assert_allclose(point.refined, exact, atol=HOMOCLINIC_TOLERANCE)
     print(f"homoclinic: {exact:.6f} m/s (exact law), {point.parameters[0]:.6f} (whirl; "
           f"{point.refined[0]:.6f}, {point.refined[1]:.6f} at epsilon / 2, / 4)")
+
+
+def exact_flow(v: float, y0: np.ndarray, duration: float) -> np.ndarray:
+    """The exact law's state after ``duration`` s from ``y0`` at airspeed ``v``, restarted at
+    each gap edge."""
+    f = field({"K_psi": K_PSI, "V": v}, freeplay(DELTA, K_OUT))
+    edges = [lambda _t, y, e=e: y[0] - e for e in (DELTA, -DELTA)]
+    for edge in edges:
+        edge.terminal = True
+    t, y = 0.0, np.asarray(y0, dtype=float)
+    while True:
+        done = solve_ivp(f, (t, duration), y, method="DOP853", rtol=1e-11, atol=1e-14,
+                         events=edges)
+        if done.status != 1:
+            return done.y[:, -1]
+        t = min(e[0] for e in done.t_events if len(e)) + 1e-12
+        y = done.y[:, -1] + 1e-12 * f(t, done.y[:, -1])
+
+
+def exact_cycle(top: float, guess) -> np.ndarray:
+    """(psi, psi', V, period) of the exact law's cycle whose pitch peaks at ``top`` (rad),
+    started there with theta' = 0: shooting (scipy fsolve) from ``guess``."""
+    def closes(x):
+        y0 = np.array([top, x[0], 0.0, x[1]])
+        return (exact_flow(x[2], y0, x[3]) - y0) / np.array([1, 1, 30, 30]) / DELTA
+
+    found, _, solved, message = fsolve(closes, guess, full_output=True, xtol=1e-12)
+    assert solved == 1, message
+    return found
+
+
+def test_no_fold_between_the_onset_and_the_lower_fold_under_the_exact_law(continuation):
+    """The exact law's family of the offset Hopf point: vertical at the onset (the law is
+    linear outside the gap), then, once its cycles reach into the gap (pitch peak above 1.25
+    delta), its airspeed falls without a turn to the lower fold, where whirl's lowest fold
+    converges as epsilon shrinks."""
+    def growth(v):
+        return np.linalg.eigvals(linear_matrix({"K_psi": K_PSI, "V": v,
+                                                "K_theta": K_OUT})).real.max()
+
+    onset = brentq(growth, 7.0, 8.0, xtol=1e-12)
+    rest = fsolve(lambda y: field({"K_psi": K_PSI, "V": onset}, freeplay(DELTA, K_OUT))(
+        0.0, np.r_[y, 0.0, 0.0])[2:], [1.1 * DELTA, 0.3 * DELTA])
+    eigenvalues, vectors = np.linalg.eig(linear_matrix({"K_psi": K_PSI, "V": onset,
+                                                        "K_theta": K_OUT}))
+    k = int(np.argmax(eigenvalues.real))
+    mode = (vectors[:, k] / vectors[0, k]).real
+    guess = [rest[1] + (1.15 * DELTA - rest[0]) * mode[1],
+             (1.15 * DELTA - rest[0]) * mode[3], onset, 2 * math.pi / eigenvalues[k].imag]
+    airspeeds = []
+    for top in (1.15, 1.22, 1.255, 1.26, 1.27, 1.28):
+        guess = exact_cycle(top * DELTA, guess)
+        airspeeds.append(guess[2])
+    np.testing.assert_allclose(airspeeds[:2], onset, atol=1e-7)  # out of the gap: vertical
+    assert onset - 1e-3 > airspeeds[2] > airspeeds[3] > airspeeds[4] > airspeeds[5]
+    last = [guess]  # each cycle from the one before
+
+    def airspeed(top):
+        last.append(exact_cycle(top * DELTA, last[-1]))
+        return last[-1][2]
+
+    fold = minimize_scalar(airspeed, bounds=(1.28, 1.31), method="bounded",
+                           options={"xatol": 1e-4})
+    assert 1.28 < fold.x < 1.31
+    lowest = min((p for p in continuation.special_points
+                  if p.branch == "periodic_1" and p.point_type == PointType.LPC),
+                 key=lambda p: p.parameters[0])
+    errors = np.abs(np.r_[lowest.parameters[:1], lowest.refined] - fold.fun)
+    assert errors[0] < 5e-3 and np.all(np.diff(errors) < 0)  # converges as epsilon shrinks
+    print(f"lower fold: {fold.fun:.6f} m/s (exact law), whirl {lowest.parameters[0]:.6f}, "
+          f"{lowest.refined[0]:.6f}, {lowest.refined[1]:.6f} at epsilon, /2, /4")
