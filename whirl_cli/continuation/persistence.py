@@ -61,10 +61,9 @@ def annotate(base: ContinuationResult, refined: list[ContinuationResult],
              width: float, tolerance: float = TOLERANCE,
              recomputed: dict | None = None) -> ContinuationResult:
     """``base`` with each special point's values at :data:`FACTORS` and its artefact flag:
-    those of ``recomputed`` (index of the point -> its
-    :class:`Recomputed`) as they are, the others' looked for
-    in ``refined`` (the continuation repeated at :data:`FACTORS`; empty if every point was
-    recomputed)."""
+    those of ``recomputed`` (index of the point -> its :class:`Recomputed`) as they are, the
+    others' looked for in ``refined`` (the continuation repeated at :data:`FACTORS`; empty if
+    every point was recomputed)."""
     recomputed = recomputed or {}
     points = tuple(_annotated(point, refined, width, tolerance, recomputed.get(k))
                    for k, point in enumerate(base.special_points))
