@@ -391,8 +391,9 @@ class SpecialPoint:
     refined: np.ndarray = field(default_factory=lambda: np.full(2, np.nan))
     artefact: bool = False  # does not persist as the smoothing shrinks (see ``note``)
     #: how ``refined`` was computed: "restart", "epsilon locus" (short runs near the point,
-    #: :mod:`whirl_cli.continuation.shrinking`), "repetition" (the continuation repeated) or
-    #: "" (not recomputed)
+    #: :mod:`whirl_cli.continuation.shrinking`), "bracketing folds" (a snaking global point,
+    #: from its family's recomputed folds), "repetition" (the continuation repeated) or ""
+    #: (not recomputed)
     refined_by: str = ""
     #: torus (TR, Neimark-Sacker) points: the angle in (0, pi) rad of the complex pair of
     #: Floquet multipliers on the unit circle, exp(+-i angle) (NaN: not TR, no multipliers)

@@ -130,6 +130,17 @@ def _extrapolated(extremes: np.ndarray) -> float:
     return float(extremes[-1] - second**2 / (second - first))
 
 
+def snaking_estimate(extremes: np.ndarray) -> tuple[float, tuple[float, float]]:
+    """(p*, (low, high)) of a snaking approach from the parameter at its last turns (at least
+    two): bracketed by the last two, estimated by Aitken's delta-squared of the last three
+    (:func:`_extrapolated`), or the bracket's middle where that falls outside it."""
+    low, high = sorted(float(x) for x in extremes[-2:])
+    estimate = _extrapolated(np.asarray(extremes[-3:], dtype=float))
+    if not low <= estimate <= high:
+        estimate = 0.5 * (low + high)
+    return estimate, (low, high)
+
+
 def _tail(period: np.ndarray, reference_period: float) -> slice:
     """The last at most 15 points of :func:`_stretch`."""
     stretch = _stretch(period, reference_period)
@@ -167,10 +178,7 @@ def fit_blowup(parameter: np.ndarray, period: np.ndarray, unstable_rate: float |
         extremes = parameter[turns]
         if len(extremes) == 1:  # one turn (AUTO stopped early): the last point stands in
             extremes = np.append(extremes, parameter[_stretch(period, reference_period).stop - 1])
-        low, high = sorted(float(x) for x in extremes[-2:])
-        estimate = _extrapolated(extremes[-3:])
-        if not low <= estimate <= high:
-            estimate = 0.5 * (low + high)
+        estimate, (low, high) = snaking_estimate(extremes)
         stretch = _stretch(period, reference_period)
         return BlowupFit(estimate, estimate, float("nan"), stretch.stop - stretch.start,
                          (low, high))

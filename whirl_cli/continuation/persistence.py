@@ -8,14 +8,21 @@ and looking for it there (the same type, the nearest in the principal parameter)
 :func:`annotate` stores the two values (``SpecialPoint.refined``, and how they were found in
 ``refined_by``) and flags a point that is not found again, or moves by more than ``tolerance``
 of the range, as a smoothing artefact (``artefact``, and why in its ``note``).
+
+A global bifurcation bracketed by a snaking approach (its family's folds of cycles alternate
+around it) is recomputed from those folds (:func:`snaking_recomputed`): its estimate is a
+function of its family's last three folds, which the short runs recompute, so it is not left
+to the repetition, whose family may take another path at a reduced width and never reach it.
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..analysis.global_bifurcations import snaking_estimate
+from ..kinds import LocateStatus
 from ..results import ContinuationResult, PointType, SpecialPoint
 from .branches import joined_notes
 
@@ -26,6 +33,22 @@ TOLERANCE = 2e-3
 #: Types checked (global bifurcations are bracketed estimates, checked as they are).
 CHECKED = frozenset({PointType.BP, PointType.LP, PointType.HB, PointType.LPC, PointType.BPC,
                      PointType.PD, PointType.TR, PointType.HOMOCLINIC, PointType.HETEROCLINIC})
+
+#: How a snaking global point is recomputed (``SpecialPoint.refined_by``).
+FOLDS = "bracketing folds"
+#: A snaking global point's bracket ends are its family's last two folds if within this
+#: fraction of the bracket's width of them (the bracket holds the turns of the stored rows,
+#: the folds are located by AUTO).
+FOLD_MATCH = 1e-2
+
+
+@dataclass(frozen=True)
+class Recomputed:
+    """A special point's principal parameter at each reduced smoothing (in the order of the
+    factors) and how it was found (``SpecialPoint.refined_by``)."""
+
+    values: np.ndarray
+    method: str
 
 
 def refined_parameters(parameters: dict[str, float], smoothing: tuple[str, ...],
@@ -38,10 +61,9 @@ def annotate(base: ContinuationResult, refined: list[ContinuationResult],
              width: float, tolerance: float = TOLERANCE,
              recomputed: dict | None = None) -> ContinuationResult:
     """``base`` with each special point's values at :data:`FACTORS` and its artefact flag:
-    those of ``recomputed`` (index of the point -> its
-    :class:`~whirl_cli.continuation.shrinking.Recomputed`) as they are, the others' looked for
-    in ``refined`` (the continuation repeated at :data:`FACTORS`; empty if every point was
-    recomputed)."""
+    those of ``recomputed`` (index of the point -> its :class:`Recomputed`) as they are, the
+    others' looked for in ``refined`` (the continuation repeated at :data:`FACTORS`; empty if
+    every point was recomputed)."""
     recomputed = recomputed or {}
     points = tuple(_annotated(point, refined, width, tolerance, recomputed.get(k))
                    for k, point in enumerate(base.special_points))
@@ -52,6 +74,40 @@ def needs_repetition(base: ContinuationResult, recomputed: dict) -> bool:
     """True if a checked special point of ``base`` is not among ``recomputed`` (by index)."""
     return any(p.point_type in CHECKED and k not in recomputed
                for k, p in enumerate(base.special_points))
+
+
+def snaking_recomputed(base: ContinuationResult, recomputed: dict) -> dict[int, Recomputed]:
+    """The bracketed global points of ``base`` (by index) of a snaking approach recomputed
+    from the folds that bracket them: where the last two folds of cycles before the point on
+    its branch are its bracket's ends and the last three were recomputed (``recomputed``: by
+    index, as :func:`annotate` takes it), the same estimate from their values at each
+    factor."""
+    points = base.special_points
+    found = {}
+    for k, point in enumerate(points):
+        if not _snaking(point):
+            continue
+        folds = sorted((p.index, j) for j, p in enumerate(points)
+                       if p.branch == point.branch and p.point_type == PointType.LPC
+                       and p.index < point.index)[-3:]
+        rows = [j for _, j in folds]
+        if len(rows) < 3 or any(j not in recomputed for j in rows):
+            continue
+        ends = sorted(points[j].parameters[0] for j in rows[-2:])
+        if not np.allclose(ends, point.bracket, rtol=0,
+                           atol=FOLD_MATCH * np.ptp(point.bracket)):
+            continue
+        values = np.array([recomputed[j].values for j in rows])  # fold x factor
+        found[k] = Recomputed(np.array([snaking_estimate(column)[0] for column in values.T]),
+                              FOLDS)
+    return found
+
+
+def _snaking(point: SpecialPoint) -> bool:
+    """True for a bracketed global point of a snaking approach (no fit residual)."""
+    return point.point_type in (PointType.HOMOCLINIC, PointType.HETEROCLINIC) and \
+        point.status == LocateStatus.BRACKETED and np.isnan(point.residual) and \
+        bool(np.all(np.isfinite(point.bracket)))
 
 
 def _annotated(point: SpecialPoint, refined: list[ContinuationResult], width: float,

@@ -54,10 +54,11 @@ def persisted(engine: Engine, base: ContinuationResult, continued: Callable, spe
     """``base`` (a continuation of a model that smooths a law) with its special points
     recomputed as the smoothing shrinks (:mod:`whirl_cli.continuation.persistence`): by short
     runs near each point of a type they recompute (folds, Hopf and branch points:
-    :func:`whirl_cli.continuation.shrinking.recompute`), and, only if one is left that they
-    did not recompute (another type, such as a period blow-up, or one they did not confirm),
-    by the continuation ``continued`` repeated at every factor (runs ``<name>_eps<k>``),
-    which then gives those points' values. Points the short runs confirm keep their values:
+    :func:`whirl_cli.continuation.shrinking.recompute`; a snaking global point from the
+    folds that bracket it), and, only if one is left that they did not recompute (another
+    type, such as a period blow-up, or one they did not confirm), by the continuation
+    ``continued`` repeated at every factor (runs ``<name>_eps<k>``), which then gives those
+    points' values. Points the short runs confirm keep their values:
     a repetition may miss a fold its branch does not reach at a smaller width (it would call
     it an artefact) or pick another point of the type nearby."""
     smoothing = engine.model.smoothing_parameters
@@ -66,6 +67,7 @@ def persisted(engine: Engine, base: ContinuationResult, continued: Callable, spe
         engine, spec.name, base, parameters, smoothing, persistence.FACTORS,
         persistence.CHECKED, bounds, numerics,
         reach=persistence.TOLERANCE * (bounds[1] - bounds[0]))
+    recomputed |= persistence.snaking_recomputed(base, recomputed)
     refined = repeated(continued, spec.name, parameters, smoothing) \
         if persistence.needs_repetition(base, recomputed) else []
     return persistence.annotate(base, refined, bounds[1] - bounds[0], recomputed=recomputed)

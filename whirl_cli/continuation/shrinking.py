@@ -28,13 +28,14 @@ makes the repetition too).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
 from ..results import BranchKind, ContinuationResult, Origin, PointType, SpecialPoint
 from .engine import Engine, Numerics, RunSpec, read_run
 from .loci import locus_constants
+from .persistence import Recomputed
 
 #: AUTO's STOP code for the first point of each type a restart looks for.
 STOP_CODES = {PointType.LP: "LP", PointType.LPC: "LP", PointType.HB: "HB", PointType.BP: "BP",
@@ -53,15 +54,6 @@ LOCUS_MESH_CAP = 4
 WIDTH_MATCH = 1e-2
 #: How each point was recomputed (``SpecialPoint.refined_by``).
 RESTART, LOCUS, REPETITION = "restart", "epsilon locus", "repetition"
-
-
-@dataclass(frozen=True)
-class Recomputed:
-    """A special point's principal parameter at each reduced smoothing (in the order of the
-    factors) and how it was found (:data:`RESTART` or :data:`LOCUS`)."""
-
-    values: np.ndarray
-    method: str
 
 
 def recompute(engine: Engine, name: str, continuation: ContinuationResult,
