@@ -349,3 +349,38 @@ def test_the_letters_of_close_cuts_do_not_overlap_on_a_short_diagram():
     for a in range(3):
         for b in range(a + 1, 3):
             assert not boxes[a].overlaps(boxes[b])
+
+
+def _figure_eight_cut():
+    """At K1 = 0.1: a main cycle (a figure eight through the origin) stored first, and the two
+    secondary cycles that are its upper and lower loops, as at a homoclinic."""
+    from whirl_cli.results import ContinuationResult
+
+    s = np.linspace(0.0, 2 * np.pi, 60, endpoint=False)
+    upper = np.column_stack([0.1 * (1 - np.cos(s)), 0.05 * np.sin(s)])  # theta, psi [rad]
+    loops = {"periodic_1": np.vstack([upper, -upper]), "periodic_2": upper,
+             "periodic_3": -upper}
+    branches = []
+    for name, loop in loops.items():
+        family = make_branch(name, BranchKind.PERIODIC, [0.05, 0.1, 0.15], [0.2] * 3,
+                             [0, 0, 0])
+        orbit = Orbit(label=1, point_type=0, index=1, parameters=np.array([0.1, 6.7]),
+                      period=1.0, time=np.linspace(0.0, 1.0, len(loop)),
+                      states=np.column_stack([loop, 0 * loop]))
+        branches.append(replace(family, orbits=(orbit,)))
+    return ContinuationResult("k1", "one-parameter", tuple(branches), ())
+
+
+def test_the_main_cycle_at_a_cut_lies_above_the_secondary_cycles_it_runs_along():
+    from whirl_cli.plots.cuts import phase_cut
+    from whirl_cli.plots.key import new_figure
+
+    ax = new_figure().add_subplot()
+    assert phase_cut(_figure_eight_cut(), 0.1, ax) == 3
+    lines = {line.get_label().split()[2]: line for line in ax.lines
+             if "limit cycle" in line.get_label()}
+    main = lines.pop("periodic_1")
+    for secondary in lines.values():
+        assert main.get_zorder() > secondary.get_zorder()
+        # drawn wider: the secondary shows on both sides of the main cycle above it
+        assert secondary.get_linewidth() > 2 * main.get_linewidth()
