@@ -160,9 +160,12 @@ def test_torus_and_global_markers_lie_above_a_fold_at_the_same_place():
     (homoclinic,) = [line for line in ax.lines if line.get_marker() == "^"]
     (torus,) = [line for line in ax.lines if line.get_marker() == "o"
                 and line.get_markerfacecolor() == "none"]
-    (fold,) = [line for line in ax.lines if line.get_marker() == "o" and line is not torus]
-    assert torus.get_zorder() > fold.get_zorder() and homoclinic.get_zorder() > fold.get_zorder()
-    assert torus.get_markersize() > fold.get_markersize()  # a ring around the fold, not under it
+    folds = [line for line in ax.lines if line.get_marker() == "o" and line is not torus]
+    assert folds  # the fold under the homoclinic marker is set beside it, in a line of its own
+    for fold in folds:
+        assert torus.get_zorder() > fold.get_zorder()
+        assert homoclinic.get_zorder() > fold.get_zorder()
+        assert torus.get_markersize() > fold.get_markersize()  # a ring around the fold
 
 
 def _unseen_entries(ax) -> list[str]:
@@ -384,3 +387,115 @@ def test_the_main_cycle_at_a_cut_lies_above_the_secondary_cycles_it_runs_along()
         assert main.get_zorder() > secondary.get_zorder()
         # drawn wider: the secondary shows on both sides of the main cycle above it
         assert secondary.get_linewidth() > 2 * main.get_linewidth()
+
+
+def _snaking_family(folds: int):
+    """A periodic family whose period grows towards K1 = 0.08 while it snakes there: ``folds``
+    folds of cycles within 1e-5 of each other, then a homoclinic end."""
+    from whirl_cli.results import ContinuationResult, SpecialPoint
+
+    rows = 20 + 4 * folds
+    k1 = np.concatenate([np.linspace(0.4, 0.08, 20),
+                         0.08 + 1e-5 * np.tile([0.0, 0.5, 1.0, 0.5], folds)])
+    period = np.concatenate([np.linspace(0.25, 0.5, 20), np.linspace(0.5, 2.0, 4 * folds)])
+    family = replace(make_branch("periodic_1", BranchKind.PERIODIC, k1, 0.1 + 0 * k1,
+                                 np.ones(rows)), period=period)
+
+    def point(kind, row):
+        return SpecialPoint(branch="periodic_1", index=row, point_type=int(kind),
+                            parameter_names=("K1", "V"), parameters=family.parameters[row],
+                            state=np.zeros(4), period=period[row], stable=True)
+
+    turns = [point(PointType.LPC, 20 + 4 * k + 2) for k in range(folds)]
+    return ContinuationResult("k1", "one-parameter", (family,),
+                              (*turns, point(PointType.HOMOCLINIC, rows - 1)))
+
+
+def _fold_marks(ax) -> np.ndarray:
+    """The centres of the filled circles drawn on ``ax`` (fold markers), in data units."""
+    lines = [line for line in ax.lines if line.get_marker() == "o"
+             and line.get_markerfacecolor() not in ("none", "None")]
+    return np.concatenate([line.get_xydata() for line in lines] or [np.zeros((0, 2))])
+
+
+def test_the_folds_of_a_snaking_family_are_drawn_as_one_cluster():
+    from whirl_cli.plots.blowup import blowup_plot
+    from whirl_cli.plots.diagrams import period_plot
+
+    continuation = _snaking_family(6)
+    for ax in (period_plot(continuation).axes[0], blowup_plot(continuation).axes[0]):
+        assert len(_fold_marks(ax)) == 1
+        assert [t.get_text() for t in ax.texts if "folds" in t.get_text()] == ["6 folds"]
+        labels = [t.get_text() for t in ax.get_legend().get_texts()]
+        assert any("snaking" in label for label in labels)
+        assert not any(label.startswith("fold (") for label in labels)
+
+
+def test_two_folds_of_a_family_stay_two_markers():
+    from whirl_cli.plots.diagrams import period_plot
+
+    assert len(_fold_marks(period_plot(_snaking_family(2)).axes[0])) == 2
+
+
+def _hidden_markers(ax) -> list[tuple[str, str]]:
+    """Pairs (marker below, marker above) of ``ax``'s special-point markers, after a draw,
+    where the centre of the lower lies inside the upper's marker (half its size around its
+    centre) and the upper is no larger hollow ring around it."""
+    ax.figure.canvas.draw()
+    lines = [line for line in ax.lines if line.get_linestyle() in ("None", "none", "")
+             and line.get_marker() not in ("None", "", None, "_")]
+    per_point = ax.figure.dpi / 72.0
+    hidden = []
+    for k, low in enumerate(lines):
+        for m, high in enumerate(lines):
+            above = (high.get_zorder(), m) > (low.get_zorder(), k)
+            alike = (low.get_marker(), low.get_markerfacecolor()) == (
+                high.get_marker(), high.get_markerfacecolor())
+            ring = high.get_markerfacecolor() == "none" and \
+                high.get_markersize() > low.get_markersize()
+            if not above or alike or ring:
+                continue
+            a = low.get_transform().transform(low.get_xydata())
+            b = high.get_transform().transform(high.get_xydata())
+            gaps = np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2)
+            if (gaps < 0.5 * high.get_markersize() * per_point).any():
+                hidden.append((str(low.get_marker()), str(high.get_marker())))
+    return hidden
+
+
+def _branch_point_under_homoclinic():
+    """A family ending at a homoclinic point, with a branch point of cycles one row before,
+    at the same K1 and a period 2 % shorter, and a fold at the homoclinic's own row."""
+    from whirl_cli.results import ContinuationResult, SpecialPoint
+
+    k1 = np.array([0.3, 0.2, 0.12, 0.1021, 0.1021, 0.1021])
+    period = np.array([0.3, 0.5, 1.4, 1.8, 5.52, 5.63])
+    family = replace(make_branch("periodic_1", BranchKind.PERIODIC, k1, 0.1 + 0 * k1,
+                                 np.zeros(6)), period=period)
+
+    def point(kind, row):
+        return SpecialPoint(branch="periodic_1", index=row, point_type=int(kind),
+                            parameter_names=("K1", "V"), parameters=family.parameters[row],
+                            state=np.zeros(4), period=period[row], stable=False)
+
+    return ContinuationResult("k1", "one-parameter", (family,), (
+        point(PointType.BPC, 4), point(PointType.HOMOCLINIC, 5), point(PointType.LPC, 5)))
+
+
+def test_markers_at_one_place_are_set_apart_so_both_show():
+    from whirl_cli.plots.diagrams import bifurcation_diagram, period_plot
+
+    period = period_plot(_branch_point_under_homoclinic()).axes[0]
+    assert _hidden_markers(period) == []
+    assert {"*", "^", "o"} <= {str(line.get_marker()) for line in period.lines}
+    diagram = bifurcation_diagram(_homoclinic_ending(saddle_theta=0.12)).axes[0]
+    assert _hidden_markers(diagram) == []
+
+
+def test_markers_set_apart_keep_every_point_and_its_place_in_data():
+    from whirl_cli.plots.diagrams import period_plot
+
+    ax = period_plot(_branch_point_under_homoclinic()).axes[0]
+    stars = np.concatenate([line.get_xydata() for line in ax.lines
+                            if line.get_marker() == "*"])
+    np.testing.assert_allclose(stars, [[0.1021, 5.52]])

@@ -24,6 +24,7 @@ from .key import (
     stability_curves,
     symbol,
 )
+from .markers import Mark, draw_marks, unstack
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -159,7 +160,7 @@ def blowup_plot(continuation: ContinuationResult, branch: str | None = None,
         ax = new_figure().add_subplot()
     x, period = family.parameters[:, 0], family.period
     first: dict[str, object] = {}
-    _draw_family(ax, continuation, family, global_point, first)
+    markers = _draw_family(ax, continuation, family, global_point, first)
     name, unit = family.parameter_names[0], family.parameter_units[0]
     handles = [first[key] for key in PLOT_KEY if key in first]
     labels = [str(PLOT_KEY[key]["label"]) for key in PLOT_KEY if key in first]
@@ -188,6 +189,7 @@ def blowup_plot(continuation: ContinuationResult, branch: str | None = None,
         ax.set_ylim(0.95 * float(np.nanmin(period[shown])), top)
         _zoom_approach(ax, continuation, family, global_point, fit, top)
     log_scale_if_decades(ax, "y", ax.get_ylim() if fit is not None else period)
+    unstack(ax, markers)
     ax.set_xlabel(axis_label(name, unit))
     ax.set_ylabel(axis_label("period", "s"))
     ax.legend(handles, labels, fontsize="small")
@@ -196,12 +198,13 @@ def blowup_plot(continuation: ContinuationResult, branch: str | None = None,
 
 
 def _draw_family(ax: Axes, continuation: ContinuationResult, family: Branch, global_point,
-                 first: dict) -> None:
-    """The family's period by stability and its points (:func:`_family_points`)."""
+                 first: dict) -> list:
+    """The family's period by stability and its points (:func:`_family_points`); the marker
+    lines."""
     for xs, ys, stable in stability_curves(family.parameters[:, 0], family.period,
                                            family.stable, family.stability_known):
         plot_styled(ax, xs, ys, branch_style(family.kind, stable), first)
-    _family_points(ax, continuation, family, global_point, first)
+    return _family_points(ax, continuation, family, global_point, first)
 
 
 def _draw_fit(ax: Axes, fit: BlowupFit, start: float, top: float) -> tuple:
@@ -248,10 +251,11 @@ def _zoom_approach(ax: Axes, continuation: ContinuationResult, family: Branch, g
     points = ax.transLimits.transform(np.column_stack([x[finite], period[finite]]))
     x0, y0 = emptiest_corner(points)
     inset = ax.inset_axes([x0, y0, ZOOM_SIZE, ZOOM_SIZE])
-    _draw_family(inset, continuation, family, global_point, {})
+    markers = _draw_family(inset, continuation, family, global_point, {})
     _draw_fit(inset, fit, x[fit.start], top)
     inset.set_xlim(*xlim)
     inset.set_ylim(*ylim)
+    unstack(inset, markers)
     inset.tick_params(labelsize="x-small")
     inset.xaxis.set_major_locator(MaxNLocator(3))
     ax.indicate_inset_zoom(inset, edgecolor="black", alpha=0.6)
@@ -259,10 +263,10 @@ def _zoom_approach(ax: Axes, continuation: ContinuationResult, family: Branch, g
 
 
 def _family_points(ax: Axes, continuation: ContinuationResult, family: Branch, global_point,
-                   first: dict) -> None:
-    """The family's own special points at their periods, and its global point at the
-    family's last finite period."""
-    points: dict[str, list[tuple[float, float]]] = {}
+                   first: dict) -> list:
+    """The family's own special points at their periods (a snaking run of folds as one
+    cluster), and its global point at the family's last finite period; the marker lines."""
+    points: dict[str, list[Mark]] = {}
     for point in continuation.special_points:
         if point.branch != family.name or int(point.point_type) not in {
                 int(t) for t in _FAMILY_POINTS}:
@@ -271,18 +275,19 @@ def _family_points(ax: Axes, continuation: ContinuationResult, family: Branch, g
         if not np.isfinite(period) and 0 <= point.index < len(family):
             period = float(family.period[point.index])
         style = MARKER_STYLE[PointType(int(point.point_type))]
-        points.setdefault(style, []).append((float(point.parameters[0]), period))
+        points.setdefault(style, []).append(Mark(float(point.parameters[0]), period,
+                                                 family.name, point.index))
     if global_point is not None:
         finite = family.period[np.isfinite(family.period)]
         if finite.size:
             style = MARKER_STYLE[PointType(int(global_point.point_type))]
-            points.setdefault(style, []).append((float(global_point.parameters[0]),
-                                                 float(finite[-1])))
-    for style in PLOT_KEY:
-        if style in points:
-            xs, ys = np.array(points[style]).T
-            plot_styled(ax, xs, ys, style, first)
-            if style in ("homoclinic", "heteroclinic"):  # on top of the fold beside it
-                hollow = PLOT_KEY[style].get("markerfacecolor") == "none"
-                first[style].set(zorder=5, markersize=11, markeredgewidth=1.4 if hollow
-                                 else 0.8, markeredgecolor="black" if hollow else "white")
+            points.setdefault(style, []).append(Mark(float(global_point.parameters[0]),
+                                                     float(finite[-1]), family.name,
+                                                     len(family) - 1))
+    drawn = draw_marks(ax, points, first, float(np.ptp(family.parameters[:, 0])))
+    for style, line in drawn.items():
+        if style in ("homoclinic", "heteroclinic"):  # on top of the fold beside it
+            hollow = PLOT_KEY[style].get("markerfacecolor") == "none"
+            line.set(zorder=5, markersize=11, markeredgewidth=1.4 if hollow else 0.8,
+                     markeredgecolor="black" if hollow else "white")
+    return list(drawn.values())
