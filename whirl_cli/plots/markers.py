@@ -20,6 +20,8 @@ SNAKE_FOLDS = 3
 SNAKE_WIDTH = 0.01
 #: The key of :data:`~whirl_cli.plots.key.PLOT_KEY` a cluster's legend entry is filed under.
 CLUSTER = "fold_cluster"
+#: A cluster with another this fraction of the span to its right has its count on its left.
+_LABEL_NEAR = 0.05
 
 
 @dataclass(frozen=True)
@@ -70,12 +72,12 @@ def draw_marks(ax: Axes, marks: dict[str, list[Mark]], first: dict, span: float
         chosen = marks.get(style, [])
         if style == "fold" and chosen:
             chosen, clusters = fold_clusters(chosen, span)
-            shown: set[tuple] = set()
-            for cluster in clusters:  # a mirror family's identical cluster drawn once
-                key = _cluster_key(cluster)
-                if key not in shown:
-                    shown.add(key)
-                    drawn[CLUSTER] = draw_cluster(ax, cluster, first)
+            unique = {_cluster_key(c): c for c in reversed(clusters)}  # a mirror family's
+            clusters = [c for c in clusters if unique.get(_cluster_key(c)) is c]  # once
+            for cluster in clusters:
+                left = any(0 < other[0].x - cluster[0].x <= _LABEL_NEAR * span
+                           for other in clusters)
+                drawn[CLUSTER] = draw_cluster(ax, cluster, first, left)
         if chosen:
             lines_before = len(ax.lines)
             plot_styled(ax, np.array([m.x for m in chosen]), np.array([m.y for m in chosen]),
@@ -89,9 +91,9 @@ def _cluster_key(cluster: list[Mark]) -> tuple:
     return len(cluster), f"{cluster[0].x:.9g}", f"{min(ys):.9g}", f"{max(ys):.9g}"
 
 
-def draw_cluster(ax: Axes, cluster: list[Mark], first: dict) -> Line2D:
+def draw_cluster(ax: Axes, cluster: list[Mark], first: dict, left: bool = False) -> Line2D:
     """One fold marker at the cluster's first fold, a capped bar over the values of all its
-    folds, and their count beside the bar; the marker's line."""
+    folds, and their count beside the bar (on its ``left`` or right); the marker's line."""
     anchor = cluster[0]
     ys = np.array([m.y for m in cluster])
     low, high = float(ys.min()), float(ys.max())
@@ -100,8 +102,11 @@ def draw_cluster(ax: Axes, cluster: list[Mark], first: dict) -> Line2D:
                       fmt="o", markersize=8.0, markerfacecolor=style["markerfacecolor"],
                       markeredgecolor=style["markeredgecolor"], ecolor=BLACK,
                       elinewidth=1.2, capsize=4, zorder=3, label="_fold cluster")
-    ax.annotate(f"{len(cluster)} folds", xy=(anchor.x, (low + high) / 2), xytext=(6, 0),
-                textcoords="offset points", ha="left", va="center", fontsize="x-small")
+    ax.annotate(f"{len(cluster)} folds", xy=(anchor.x, (low + high) / 2),
+                xytext=(-6 if left else 6, 0), textcoords="offset points",
+                ha="right" if left else "left", va="center", fontsize="x-small", zorder=6,
+                bbox={"boxstyle": "round,pad=0.1", "facecolor": "white", "edgecolor": "none",
+                      "alpha": 0.8})  # legible over a marker beside it
     first.setdefault(CLUSTER, _cluster_handle())
     return bar.lines[0]
 
