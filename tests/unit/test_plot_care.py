@@ -499,3 +499,22 @@ def test_markers_set_apart_keep_every_point_and_its_place_in_data():
     stars = np.concatenate([line.get_xydata() for line in ax.lines
                             if line.get_marker() == "*"])
     np.testing.assert_allclose(stars, [[0.1021, 5.52]])
+
+
+def test_a_blowup_panel_clusters_folds_by_the_axis_it_shows():
+    """Three folds 0.0017 apart on the approach: under 1 % of the family's span, but apart on
+    the zoomed axis of the blowup panel (3 % of it), so drawn one by one there."""
+    from whirl_cli.plots.blowup import blowup_plot
+
+    from .plot_data import blowup_continuation
+
+    continuation = blowup_continuation()
+    family = continuation.branches[0]
+    folds = tuple(replace(continuation.special_points[1], index=row,
+                          parameters=family.parameters[row].copy(), period=family.period[row])
+                  for row in (58, 59, 60))
+    assert np.ptp([f.parameters[0] for f in folds]) < 0.01 * np.ptp(family.parameters[:, 0])
+    ax = blowup_plot(replace(continuation, special_points=(continuation.special_points[0],
+                                                           *folds))).axes[0]
+    assert len(_fold_marks(ax)) == 3
+    assert not [t for t in ax.texts if "folds" in t.get_text()]
