@@ -425,7 +425,7 @@ def test_the_folds_of_a_snaking_family_are_drawn_as_one_cluster():
     continuation = _snaking_family(6)
     for ax in (period_plot(continuation).axes[0], blowup_plot(continuation).axes[0]):
         assert len(_fold_marks(ax)) == 1
-        assert [t.get_text() for t in ax.texts if "folds" in t.get_text()] == ["6 folds"]
+        assert [t.get_text() for t in ax.texts if "\u00d7" in t.get_text()] == ["\u00d76"]
         labels = [t.get_text() for t in ax.get_legend().get_texts()]
         assert any("snaking" in label for label in labels)
         assert not any(label.startswith("fold (") for label in labels)
@@ -517,4 +517,4 @@ def test_a_blowup_panel_clusters_folds_by_the_axis_it_shows():
     ax = blowup_plot(replace(continuation, special_points=(continuation.special_points[0],
                                                            *folds))).axes[0]
     assert len(_fold_marks(ax)) == 3
-    assert not [t for t in ax.texts if "folds" in t.get_text()]
+    assert not [t for t in ax.texts if "\u00d7" in t.get_text()]

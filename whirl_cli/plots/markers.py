@@ -102,7 +102,7 @@ def draw_cluster(ax: Axes, cluster: list[Mark], first: dict, left: bool = False)
                       fmt="o", markersize=8.0, markerfacecolor=style["markerfacecolor"],
                       markeredgecolor=style["markeredgecolor"], ecolor=BLACK,
                       elinewidth=1.2, capsize=4, zorder=3, label="_fold cluster")
-    ax.annotate(f"{len(cluster)} folds", xy=(anchor.x, (low + high) / 2),
+    ax.annotate(f"\u00d7{len(cluster)}", xy=(anchor.x, (low + high) / 2),
                 xytext=(-6 if left else 6, 0), textcoords="offset points",
                 ha="right" if left else "left", va="center", fontsize="x-small", zorder=6,
                 bbox={"boxstyle": "round,pad=0.1", "facecolor": "white", "edgecolor": "none",
@@ -128,8 +128,10 @@ def unstack(ax: Axes, lines: list[Line2D]) -> None:
     """Set apart markers at one place: from the top down (by zorder, then drawing order),
     each marker whose centre lies within the half size of a marker drawn above it (a larger
     hollow ring around it excepted, and a marker of the same look) is drawn beside it
-    instead, shifted sideways by whole steps of the two markers' mean size, in a copy of its
-    line. Positions are those of the axes as they are now (their limits autoscaled)."""
+    instead, shifted sideways (right, else left) until its centre is a quarter of its size
+    clear of the other's half size, in a copy of its line; one step at most, so that a crowd
+    of markers does not spread far from its place. Positions are those of the axes as they
+    are now (their limits autoscaled)."""
     ax.autoscale_view()
     order = sorted(lines, key=lambda line: line.get_zorder())
     per_point = ax.figure.dpi / 72.0
@@ -143,12 +145,12 @@ def unstack(ax: Axes, lines: list[Line2D]) -> None:
 
 def _shift(centre: np.ndarray, line: Line2D, placed: list, per_point: float) -> float:
     """The sideways shift [points] that puts a marker of ``line`` at ``centre`` clear of
-    every marker ``placed`` above it (0 if none covers it, or none is clear)."""
+    every marker ``placed`` above it (0 if none covers it, or neither side is clear)."""
     above = [(other, xy) for other, xy in placed if not _both_seen(line, other)]
     if not above:
         return 0.0
-    step = 0.5 * (line.get_markersize() + max(o.get_markersize() for o, _ in above))
-    for k in (0, 1, -1, 2, -2, 3, -3):
+    step = 0.25 * line.get_markersize() + 0.5 * max(o.get_markersize() for o, _ in above)
+    for k in (0, 1, -1):
         at = centre + np.array([k * step * per_point, 0.0])
         if not any(_covers(other, xy, at, per_point) for other, xy in above):
             return k * step
