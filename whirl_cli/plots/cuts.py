@@ -189,10 +189,11 @@ def phase_cut(continuation: ContinuationResult, value: float, ax: Axes, title: s
         status = {True: "stable", False: "unstable", None: "stability unknown"}[solution.stable]
         colour = next_colour(ax.figure)
         under = any(_runs_along(xy, above) for _, above in loops[rank + 1:])
+        over = any(_runs_along(below, xy) for _, below in loops[:rank])
         ax.plot(xy[:, 0], xy[:, 1], color=colour, zorder=2 + 0.01 * rank,
                 linestyle={True: "-", False: ":", None: "--"}[solution.stable],
                 label=f"{letter}limit cycle {solution.family}{solution.parent} ({status})",
-                **(_UNDER_CYCLE if under else {"linewidth": 1.4}))
+                **(_UNDER_CYCLE if under else {"linewidth": 2.0 if over else 1.4}))
         _arrow(ax, xy[:, 0], xy[:, 1], colour)
     for stable, style in ((True, _STABLE_POINT), (False, _UNSTABLE_POINT),
                           (None, _UNSTABLE_POINT), ("saddle", _SADDLE_POINT)):
@@ -209,8 +210,9 @@ def phase_cut(continuation: ContinuationResult, value: float, ax: Axes, title: s
 
 
 #: A limit cycle that runs along one drawn above it (the secondary cycles beside the main
-#: one at a homoclinic): a wide pale band, the thin cycle above it drawn inside.
-_UNDER_CYCLE = {"linewidth": 4.0, "alpha": 0.55, "solid_capstyle": "butt"}
+#: one at a homoclinic): a wide pale band, the cycle above it drawn inside, a little wider
+#: than the others (it reads in greyscale over the band).
+_UNDER_CYCLE = {"linewidth": 4.5, "alpha": 0.4, "solid_capstyle": "butt"}
 _ALONG = 0.02  # a vertex within this fraction of the loops' extent lies on the other loop
 _ALONG_SHARE = 0.25  # a loop with this share of its vertices on another runs along it
 
