@@ -518,3 +518,28 @@ def test_a_blowup_panel_clusters_folds_by_the_axis_it_shows():
                                                            *folds))).axes[0]
     assert len(_fold_marks(ax)) == 3
     assert not [t for t in ax.texts if "\u00d7" in t.get_text()]
+
+
+def test_every_cluster_of_a_plot_is_set_apart_from_a_marker_over_it():
+    """Two snaking families, each with a period-doubling point at its first fold: both
+    clusters' fold markers are set beside the diamonds, not only the last cluster drawn."""
+    from whirl_cli.plots.diagrams import period_plot
+
+    one = _snaking_family(4)
+    two = _snaking_family(4)
+    moved = replace(two.branches[0], name="periodic_2",
+                    parameters=two.branches[0].parameters + np.array([0.2, 0.0]))
+    points = []
+    for family, source in (("periodic_1", one), ("periodic_2", two)):
+        branch = one.branches[0] if family == "periodic_1" else moved
+        for point in source.special_points:
+            points.append(replace(point, branch=family,
+                                  parameters=branch.parameters[point.index].copy()))
+        first_fold = points[-len(source.special_points)]
+        points.append(replace(first_fold, point_type=int(PointType.PD)))
+    from whirl_cli.results import ContinuationResult
+
+    ax = period_plot(ContinuationResult("k1", "one-parameter", (one.branches[0], moved),
+                                        tuple(points))).axes[0]
+    assert len(_fold_marks(ax)) == 2
+    assert _hidden_markers(ax) == []

@@ -289,9 +289,9 @@ def _family_points(ax: Axes, continuation: ContinuationResult, family: Branch, g
                                                      float(finite[-1]), family.name,
                                                      len(family) - 1))
     drawn = draw_marks(ax, points, first, span)
-    for style, line in drawn.items():
-        if style in ("homoclinic", "heteroclinic"):  # on top of the fold beside it
-            hollow = PLOT_KEY[style].get("markerfacecolor") == "none"
+    for style in [MARKER_STYLE[kind] for kind in _GLOBAL if MARKER_STYLE[kind] in drawn]:
+        hollow = PLOT_KEY[style].get("markerfacecolor") == "none"
+        for line in drawn[style]:  # on top of the fold beside it
             line.set(zorder=5, markersize=11, markeredgewidth=1.4 if hollow else 0.8,
                      markeredgecolor="black" if hollow else "white")
-    return list(drawn.values())
+    return [line for lines in drawn.values() for line in lines]

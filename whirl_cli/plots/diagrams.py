@@ -266,7 +266,7 @@ def period_plot(continuation: ContinuationResult, title: str | None = None,
         handles.append(bar)
         labels.append("bracket (global bifurcation)")
     log_scale_if_decades(ax, "y", periods)
-    unstack(ax, list(markers.values()))
+    unstack(ax, [line for lines in markers.values() for line in lines])
     if periodic:
         ax.set_xlabel(axis_label(periodic[0].parameter_names[0], periodic[0].parameter_units[0]))
     ax.set_ylabel(axis_label("period", "s"))
@@ -434,7 +434,8 @@ def draw_special_points(ax: Axes, continuation: ContinuationResult, branches: li
             points.setdefault(style, []).append(mark)
     values = [b.parameters[:, 0] for b in branches if len(b)]
     span = float(np.ptp(np.concatenate(values))) if values else 0.0
-    unstack(ax, list(draw_marks(ax, points, first, span).values()))
+    drawn = draw_marks(ax, points, first, span)
+    unstack(ax, [line for lines in drawn.values() for line in lines])
 
 
 def _at_row(point, branch: Branch) -> bool:

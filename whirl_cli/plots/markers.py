@@ -8,7 +8,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .key import BLACK, PLOT_KEY, plot_styled
+from ..results import PointType
+from .key import BLACK, MARKER_STYLE, PLOT_KEY, plot_styled
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -63,26 +64,26 @@ def _close(run: list[Mark], singles: list[Mark], clusters: list[list[Mark]]) -> 
 
 
 def draw_marks(ax: Axes, marks: dict[str, list[Mark]], first: dict, span: float
-               ) -> dict[str, Line2D]:
+               ) -> dict[str, list[Line2D]]:
     """Each style's marks as one artist (:func:`~whirl_cli.plots.key.plot_styled`), the folds
-    of a snaking family as one cluster (:func:`draw_cluster`); the marker lines drawn, by
-    style (a cluster's under :data:`CLUSTER`)."""
-    drawn: dict[str, Line2D] = {}
+    of a snaking family as one cluster each (:func:`draw_cluster`); the marker lines drawn,
+    by style (the clusters' under :data:`CLUSTER`)."""
+    drawn: dict[str, list[Line2D]] = {}
     for style in PLOT_KEY:
         chosen = marks.get(style, [])
-        if style == "fold" and chosen:
+        if style == MARKER_STYLE[PointType.LPC] and chosen:
             chosen, clusters = fold_clusters(chosen, span)
             unique = {_cluster_key(c): c for c in reversed(clusters)}  # a mirror family's
             clusters = [c for c in clusters if unique.get(_cluster_key(c)) is c]  # once
             for cluster in clusters:
                 left = any(0 < other[0].x - cluster[0].x <= _LABEL_NEAR * span
                            for other in clusters)
-                drawn[CLUSTER] = draw_cluster(ax, cluster, first, left)
+                drawn.setdefault(CLUSTER, []).append(draw_cluster(ax, cluster, first, left))
         if chosen:
             lines_before = len(ax.lines)
             plot_styled(ax, np.array([m.x for m in chosen]), np.array([m.y for m in chosen]),
                         style, first)
-            drawn[style] = ax.lines[lines_before]
+            drawn[style] = [ax.lines[lines_before]]
     return drawn
 
 
