@@ -160,9 +160,12 @@ def test_torus_and_global_markers_lie_above_a_fold_at_the_same_place():
     (homoclinic,) = [line for line in ax.lines if line.get_marker() == "^"]
     (torus,) = [line for line in ax.lines if line.get_marker() == "o"
                 and line.get_markerfacecolor() == "none"]
-    (fold,) = [line for line in ax.lines if line.get_marker() == "o" and line is not torus]
-    assert torus.get_zorder() > fold.get_zorder() and homoclinic.get_zorder() > fold.get_zorder()
-    assert torus.get_markersize() > fold.get_markersize()  # a ring around the fold, not under it
+    folds = [line for line in ax.lines if line.get_marker() == "o" and line is not torus]
+    assert folds  # the fold under the homoclinic marker is set beside it, in a line of its own
+    for fold in folds:
+        assert torus.get_zorder() > fold.get_zorder()
+        assert homoclinic.get_zorder() > fold.get_zorder()
+        assert torus.get_markersize() > fold.get_markersize()  # a ring around the fold
 
 
 def _unseen_entries(ax) -> list[str]:
@@ -349,3 +352,194 @@ def test_the_letters_of_close_cuts_do_not_overlap_on_a_short_diagram():
     for a in range(3):
         for b in range(a + 1, 3):
             assert not boxes[a].overlaps(boxes[b])
+
+
+def _figure_eight_cut():
+    """At K1 = 0.1: a main cycle (a figure eight through the origin) stored first, and the two
+    secondary cycles that are its upper and lower loops, as at a homoclinic."""
+    from whirl_cli.results import ContinuationResult
+
+    s = np.linspace(0.0, 2 * np.pi, 60, endpoint=False)
+    upper = np.column_stack([0.1 * (1 - np.cos(s)), 0.05 * np.sin(s)])  # theta, psi [rad]
+    loops = {"periodic_1": np.vstack([upper, -upper]), "periodic_2": upper,
+             "periodic_3": -upper}
+    branches = []
+    for name, loop in loops.items():
+        family = make_branch(name, BranchKind.PERIODIC, [0.05, 0.1, 0.15], [0.2] * 3,
+                             [0, 0, 0])
+        orbit = Orbit(label=1, point_type=0, index=1, parameters=np.array([0.1, 6.7]),
+                      period=1.0, time=np.linspace(0.0, 1.0, len(loop)),
+                      states=np.column_stack([loop, 0 * loop]))
+        branches.append(replace(family, orbits=(orbit,)))
+    return ContinuationResult("k1", "one-parameter", tuple(branches), ())
+
+
+def test_the_main_cycle_at_a_cut_lies_above_the_secondary_cycles_it_runs_along():
+    from whirl_cli.plots.cuts import phase_cut
+    from whirl_cli.plots.key import new_figure
+
+    ax = new_figure().add_subplot()
+    assert phase_cut(_figure_eight_cut(), 0.1, ax) == 3
+    lines = {line.get_label().split()[2]: line for line in ax.lines
+             if "limit cycle" in line.get_label()}
+    main = lines.pop("periodic_1")
+    for secondary in lines.values():
+        assert main.get_zorder() > secondary.get_zorder()
+        # drawn wider: the secondary shows on both sides of the main cycle above it
+        assert secondary.get_linewidth() > 2 * main.get_linewidth()
+
+
+def _snaking_family(folds: int):
+    """A periodic family whose period grows towards K1 = 0.08 while it snakes there: ``folds``
+    folds of cycles within 1e-5 of each other, then a homoclinic end."""
+    from whirl_cli.results import ContinuationResult, SpecialPoint
+
+    rows = 20 + 4 * folds
+    k1 = np.concatenate([np.linspace(0.4, 0.08, 20),
+                         0.08 + 1e-5 * np.tile([0.0, 0.5, 1.0, 0.5], folds)])
+    period = np.concatenate([np.linspace(0.25, 0.5, 20), np.linspace(0.5, 2.0, 4 * folds)])
+    family = replace(make_branch("periodic_1", BranchKind.PERIODIC, k1, 0.1 + 0 * k1,
+                                 np.ones(rows)), period=period)
+
+    def point(kind, row):
+        return SpecialPoint(branch="periodic_1", index=row, point_type=int(kind),
+                            parameter_names=("K1", "V"), parameters=family.parameters[row],
+                            state=np.zeros(4), period=period[row], stable=True)
+
+    turns = [point(PointType.LPC, 20 + 4 * k + 2) for k in range(folds)]
+    return ContinuationResult("k1", "one-parameter", (family,),
+                              (*turns, point(PointType.HOMOCLINIC, rows - 1)))
+
+
+def _fold_marks(ax) -> np.ndarray:
+    """The centres of the filled circles drawn on ``ax`` (fold markers), in data units."""
+    lines = [line for line in ax.lines if line.get_marker() == "o"
+             and line.get_markerfacecolor() not in ("none", "None")]
+    return np.concatenate([line.get_xydata() for line in lines] or [np.zeros((0, 2))])
+
+
+def test_the_folds_of_a_snaking_family_are_drawn_as_one_cluster():
+    from whirl_cli.plots.blowup import blowup_plot
+    from whirl_cli.plots.diagrams import period_plot
+
+    continuation = _snaking_family(6)
+    for ax in (period_plot(continuation).axes[0], blowup_plot(continuation).axes[0]):
+        assert len(_fold_marks(ax)) == 1
+        assert [t.get_text() for t in ax.texts if "\u00d7" in t.get_text()] == ["\u00d76"]
+        labels = [t.get_text() for t in ax.get_legend().get_texts()]
+        assert any("snaking" in label for label in labels)
+        assert not any(label.startswith("fold (") for label in labels)
+
+
+def test_two_folds_of_a_family_stay_two_markers():
+    from whirl_cli.plots.diagrams import period_plot
+
+    assert len(_fold_marks(period_plot(_snaking_family(2)).axes[0])) == 2
+
+
+def _hidden_markers(ax) -> list[tuple[str, str]]:
+    """Pairs (marker below, marker above) of ``ax``'s special-point markers, after a draw,
+    where the centre of the lower lies inside the upper's marker (half its size around its
+    centre) and the upper is no larger hollow ring around it."""
+    ax.figure.canvas.draw()
+    lines = [line for line in ax.lines if line.get_linestyle() in ("None", "none", "")
+             and line.get_marker() not in ("None", "", None, "_")]
+    per_point = ax.figure.dpi / 72.0
+    hidden = []
+    for k, low in enumerate(lines):
+        for m, high in enumerate(lines):
+            above = (high.get_zorder(), m) > (low.get_zorder(), k)
+            alike = (low.get_marker(), low.get_markerfacecolor()) == (
+                high.get_marker(), high.get_markerfacecolor())
+            ring = high.get_markerfacecolor() == "none" and \
+                high.get_markersize() > low.get_markersize()
+            if not above or alike or ring:
+                continue
+            a = low.get_transform().transform(low.get_xydata())
+            b = high.get_transform().transform(high.get_xydata())
+            gaps = np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2)
+            if (gaps < 0.5 * high.get_markersize() * per_point).any():
+                hidden.append((str(low.get_marker()), str(high.get_marker())))
+    return hidden
+
+
+def _branch_point_under_homoclinic():
+    """A family ending at a homoclinic point, with a branch point of cycles one row before,
+    at the same K1 and a period 2 % shorter, and a fold at the homoclinic's own row."""
+    from whirl_cli.results import ContinuationResult, SpecialPoint
+
+    k1 = np.array([0.3, 0.2, 0.12, 0.1021, 0.1021, 0.1021])
+    period = np.array([0.3, 0.5, 1.4, 1.8, 5.52, 5.63])
+    family = replace(make_branch("periodic_1", BranchKind.PERIODIC, k1, 0.1 + 0 * k1,
+                                 np.zeros(6)), period=period)
+
+    def point(kind, row):
+        return SpecialPoint(branch="periodic_1", index=row, point_type=int(kind),
+                            parameter_names=("K1", "V"), parameters=family.parameters[row],
+                            state=np.zeros(4), period=period[row], stable=False)
+
+    return ContinuationResult("k1", "one-parameter", (family,), (
+        point(PointType.BPC, 4), point(PointType.HOMOCLINIC, 5), point(PointType.LPC, 5)))
+
+
+def test_markers_at_one_place_are_set_apart_so_both_show():
+    from whirl_cli.plots.diagrams import bifurcation_diagram, period_plot
+
+    period = period_plot(_branch_point_under_homoclinic()).axes[0]
+    assert _hidden_markers(period) == []
+    assert {"*", "^", "o"} <= {str(line.get_marker()) for line in period.lines}
+    diagram = bifurcation_diagram(_homoclinic_ending(saddle_theta=0.12)).axes[0]
+    assert _hidden_markers(diagram) == []
+
+
+def test_markers_set_apart_keep_every_point_and_its_place_in_data():
+    from whirl_cli.plots.diagrams import period_plot
+
+    ax = period_plot(_branch_point_under_homoclinic()).axes[0]
+    stars = np.concatenate([line.get_xydata() for line in ax.lines
+                            if line.get_marker() == "*"])
+    np.testing.assert_allclose(stars, [[0.1021, 5.52]])
+
+
+def test_a_blowup_panel_clusters_folds_by_the_axis_it_shows():
+    """Three folds 0.0017 apart on the approach: under 1 % of the family's span, but apart on
+    the zoomed axis of the blowup panel (3 % of it), so drawn one by one there."""
+    from whirl_cli.plots.blowup import blowup_plot
+
+    from .plot_data import blowup_continuation
+
+    continuation = blowup_continuation()
+    family = continuation.branches[0]
+    folds = tuple(replace(continuation.special_points[1], index=row,
+                          parameters=family.parameters[row].copy(), period=family.period[row])
+                  for row in (58, 59, 60))
+    assert np.ptp([f.parameters[0] for f in folds]) < 0.01 * np.ptp(family.parameters[:, 0])
+    ax = blowup_plot(replace(continuation, special_points=(continuation.special_points[0],
+                                                           *folds))).axes[0]
+    assert len(_fold_marks(ax)) == 3
+    assert not [t for t in ax.texts if "\u00d7" in t.get_text()]
+
+
+def test_every_cluster_of_a_plot_is_set_apart_from_a_marker_over_it():
+    """Two snaking families, each with a period-doubling point at its first fold: both
+    clusters' fold markers are set beside the diamonds, not only the last cluster drawn."""
+    from whirl_cli.plots.diagrams import period_plot
+
+    one = _snaking_family(4)
+    two = _snaking_family(4)
+    moved = replace(two.branches[0], name="periodic_2",
+                    parameters=two.branches[0].parameters + np.array([0.2, 0.0]))
+    points = []
+    for family, source in (("periodic_1", one), ("periodic_2", two)):
+        branch = one.branches[0] if family == "periodic_1" else moved
+        for point in source.special_points:
+            points.append(replace(point, branch=family,
+                                  parameters=branch.parameters[point.index].copy()))
+        first_fold = points[-len(source.special_points)]
+        points.append(replace(first_fold, point_type=int(PointType.PD)))
+    from whirl_cli.results import ContinuationResult
+
+    ax = period_plot(ContinuationResult("k1", "one-parameter", (one.branches[0], moved),
+                                        tuple(points))).axes[0]
+    assert len(_fold_marks(ax)) == 2
+    assert _hidden_markers(ax) == []

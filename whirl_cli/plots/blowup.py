@@ -24,6 +24,7 @@ from .key import (
     stability_curves,
     symbol,
 )
+from .markers import Mark, draw_marks, unstack
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -158,8 +159,19 @@ def blowup_plot(continuation: ContinuationResult, branch: str | None = None,
     if ax is None:
         ax = new_figure().add_subplot()
     x, period = family.parameters[:, 0], family.period
+    try:
+        fit = fit_blowup(x, period)
+    except ValueError:
+        fit = None
+    xlim = None
+    if fit is not None:
+        run = x[growth_run(x, period)[0]]
+        margin = 0.06 * abs(run - fit.asymptote)
+        xlim = sorted((run + np.sign(run - fit.asymptote) * margin,
+                       fit.asymptote - np.sign(run - fit.asymptote) * margin))
     first: dict[str, object] = {}
-    _draw_family(ax, continuation, family, global_point, first)
+    shown_span = float(np.ptp(x)) if xlim is None else xlim[1] - xlim[0]
+    markers = _draw_family(ax, continuation, family, global_point, first, shown_span)
     name, unit = family.parameter_names[0], family.parameter_units[0]
     handles = [first[key] for key in PLOT_KEY if key in first]
     labels = [str(PLOT_KEY[key]["label"]) for key in PLOT_KEY if key in first]
@@ -169,10 +181,6 @@ def blowup_plot(continuation: ContinuationResult, branch: str | None = None,
             labels[[k for k in PLOT_KEY if k in first].index(style)] = (
                 f"{PLOT_KEY[style]['label']} (whirl: {symbol(name)} = "
                 f"{float(global_point.parameters[0]):.5g})")
-    try:
-        fit = fit_blowup(x, period)
-    except ValueError:
-        fit = None
     if fit is not None:
         top = 1.15 * float(np.nanmax(period))
         line, asymptote = _draw_fit(ax, fit, x[fit.start], top)
@@ -180,14 +188,12 @@ def blowup_plot(continuation: ContinuationResult, branch: str | None = None,
         labels += ["fitted 1/x curve",
                    f"fitted asymptote {symbol(name)} = {fit.asymptote:.5g}"
                    + (f" {unit}" if unit else "")]
-        run = x[growth_run(x, period)[0]]
-        margin = 0.06 * abs(run - fit.asymptote)
-        ax.set_xlim(*sorted((run + np.sign(run - fit.asymptote) * margin,
-                             fit.asymptote - np.sign(run - fit.asymptote) * margin)))
+        ax.set_xlim(*xlim)
         shown = (x >= min(ax.get_xlim())) & (x <= max(ax.get_xlim()))
         ax.set_ylim(0.95 * float(np.nanmin(period[shown])), top)
         _zoom_approach(ax, continuation, family, global_point, fit, top)
     log_scale_if_decades(ax, "y", ax.get_ylim() if fit is not None else period)
+    unstack(ax, markers)
     ax.set_xlabel(axis_label(name, unit))
     ax.set_ylabel(axis_label("period", "s"))
     ax.legend(handles, labels, fontsize="small")
@@ -196,12 +202,13 @@ def blowup_plot(continuation: ContinuationResult, branch: str | None = None,
 
 
 def _draw_family(ax: Axes, continuation: ContinuationResult, family: Branch, global_point,
-                 first: dict) -> None:
-    """The family's period by stability and its points (:func:`_family_points`)."""
+                 first: dict, span: float) -> list:
+    """The family's period by stability and its points (:func:`_family_points`, on an axis
+    spanning ``span`` of the parameter); the marker lines."""
     for xs, ys, stable in stability_curves(family.parameters[:, 0], family.period,
                                            family.stable, family.stability_known):
         plot_styled(ax, xs, ys, branch_style(family.kind, stable), first)
-    _family_points(ax, continuation, family, global_point, first)
+    return _family_points(ax, continuation, family, global_point, first, span)
 
 
 def _draw_fit(ax: Axes, fit: BlowupFit, start: float, top: float) -> tuple:
@@ -248,10 +255,11 @@ def _zoom_approach(ax: Axes, continuation: ContinuationResult, family: Branch, g
     points = ax.transLimits.transform(np.column_stack([x[finite], period[finite]]))
     x0, y0 = emptiest_corner(points)
     inset = ax.inset_axes([x0, y0, ZOOM_SIZE, ZOOM_SIZE])
-    _draw_family(inset, continuation, family, global_point, {})
+    markers = _draw_family(inset, continuation, family, global_point, {}, xlim[1] - xlim[0])
     _draw_fit(inset, fit, x[fit.start], top)
     inset.set_xlim(*xlim)
     inset.set_ylim(*ylim)
+    unstack(inset, markers)
     inset.tick_params(labelsize="x-small")
     inset.xaxis.set_major_locator(MaxNLocator(3))
     ax.indicate_inset_zoom(inset, edgecolor="black", alpha=0.6)
@@ -259,10 +267,10 @@ def _zoom_approach(ax: Axes, continuation: ContinuationResult, family: Branch, g
 
 
 def _family_points(ax: Axes, continuation: ContinuationResult, family: Branch, global_point,
-                   first: dict) -> None:
-    """The family's own special points at their periods, and its global point at the
-    family's last finite period."""
-    points: dict[str, list[tuple[float, float]]] = {}
+                   first: dict, span: float) -> list:
+    """The family's own special points at their periods (a snaking run of folds as one
+    cluster), and its global point at the family's last finite period; the marker lines."""
+    points: dict[str, list[Mark]] = {}
     for point in continuation.special_points:
         if point.branch != family.name or int(point.point_type) not in {
                 int(t) for t in _FAMILY_POINTS}:
@@ -271,18 +279,19 @@ def _family_points(ax: Axes, continuation: ContinuationResult, family: Branch, g
         if not np.isfinite(period) and 0 <= point.index < len(family):
             period = float(family.period[point.index])
         style = MARKER_STYLE[PointType(int(point.point_type))]
-        points.setdefault(style, []).append((float(point.parameters[0]), period))
+        points.setdefault(style, []).append(Mark(float(point.parameters[0]), period,
+                                                 family.name, point.index))
     if global_point is not None:
         finite = family.period[np.isfinite(family.period)]
         if finite.size:
             style = MARKER_STYLE[PointType(int(global_point.point_type))]
-            points.setdefault(style, []).append((float(global_point.parameters[0]),
-                                                 float(finite[-1])))
-    for style in PLOT_KEY:
-        if style in points:
-            xs, ys = np.array(points[style]).T
-            plot_styled(ax, xs, ys, style, first)
-            if style in ("homoclinic", "heteroclinic"):  # on top of the fold beside it
-                hollow = PLOT_KEY[style].get("markerfacecolor") == "none"
-                first[style].set(zorder=5, markersize=11, markeredgewidth=1.4 if hollow
-                                 else 0.8, markeredgecolor="black" if hollow else "white")
+            points.setdefault(style, []).append(Mark(float(global_point.parameters[0]),
+                                                     float(finite[-1]), family.name,
+                                                     len(family) - 1))
+    drawn = draw_marks(ax, points, first, span)
+    for style in [MARKER_STYLE[kind] for kind in _GLOBAL if MARKER_STYLE[kind] in drawn]:
+        hollow = PLOT_KEY[style].get("markerfacecolor") == "none"
+        for line in drawn[style]:  # on top of the fold beside it
+            line.set(zorder=5, markersize=11, markeredgewidth=1.4 if hollow else 0.8,
+                     markeredgecolor="black" if hollow else "white")
+    return [line for lines in drawn.values() for line in lines]

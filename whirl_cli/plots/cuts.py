@@ -161,7 +161,9 @@ def phase_cut(continuation: ContinuationResult, value: float, ax: Axes, title: s
     unstable, a filled cross for a saddle: :func:`is_saddle`), each limit cycle closed in a
     colour of its own in the figure (:func:`~whirl_cli.plots.key.next_colour`), solid if
     stable and dotted if not, with an arrow for its direction of motion, labelled by family
-    and stability. Returns the number
+    and stability; the larger cycles above the smaller, and a cycle that runs along one
+    above it (a secondary cycle beside the main one at a homoclinic) a wide pale band
+    around it. Returns the number
     of limit cycles drawn."""
     ref = next((b for b in continuation.branches if len(b)), None)
     if ref is None or len(ref.state_names) < 2:
@@ -172,20 +174,27 @@ def phase_cut(continuation: ContinuationResult, value: float, ax: Axes, title: s
     cycles = 0
     points: dict[bool | str | None, list[np.ndarray]] = {}
     letter = title.split(")")[0] + ") " if title.startswith("(") else ""
+    loops = []
     for solution in solutions_at(continuation, value):
         xs, ys = solution.states[:, ix] * fx, solution.states[:, iy] * fy
         if solution.kind == BranchKind.EQUILIBRIUM:
             kind = "saddle" if solution.saddle else solution.stable
             points.setdefault(kind, []).append(np.array([xs[0], ys[0]]))
             continue
+        loops.append((solution, np.column_stack([np.append(xs, xs[:1]),
+                                                 np.append(ys, ys[:1])])))
+    loops.sort(key=lambda loop: _box_area(loop[1]))  # the largest (the main cycle) on top
+    for rank, (solution, xy) in enumerate(loops):
         cycles += 1
         status = {True: "stable", False: "unstable", None: "stability unknown"}[solution.stable]
-        xs, ys = np.append(xs, xs[:1]), np.append(ys, ys[:1])
         colour = next_colour(ax.figure)
-        ax.plot(xs, ys, color=colour, linewidth=1.4,
+        under = any(_runs_along(xy, above) for _, above in loops[rank + 1:])
+        over = any(_runs_along(below, xy) for _, below in loops[:rank])
+        ax.plot(xy[:, 0], xy[:, 1], color=colour, zorder=2 + 0.01 * rank,
                 linestyle={True: "-", False: ":", None: "--"}[solution.stable],
-                label=f"{letter}limit cycle {solution.family}{solution.parent} ({status})")
-        _arrow(ax, xs, ys, colour)
+                label=f"{letter}limit cycle {solution.family}{solution.parent} ({status})",
+                **(_UNDER_CYCLE if under else {"linewidth": 2.0 if over else 1.4}))
+        _arrow(ax, xy[:, 0], xy[:, 1], colour)
     for stable, style in ((True, _STABLE_POINT), (False, _UNSTABLE_POINT),
                           (None, _UNSTABLE_POINT), ("saddle", _SADDLE_POINT)):
         if stable in points:
@@ -198,6 +207,28 @@ def phase_cut(continuation: ContinuationResult, value: float, ax: Axes, title: s
     ax.set_aspect("equal", adjustable="box")
     ax.set_title(title, fontsize="medium")
     return cycles
+
+
+#: A limit cycle that runs along one drawn above it (the secondary cycles beside the main
+#: one at a homoclinic): a wide pale band, the cycle above it drawn inside, a little wider
+#: than the others (it reads in greyscale over the band).
+_UNDER_CYCLE = {"linewidth": 4.5, "alpha": 0.4, "solid_capstyle": "butt"}
+_ALONG = 0.02  # a vertex within this fraction of the loops' extent lies on the other loop
+_ALONG_SHARE = 0.25  # a loop with this share of its vertices on another runs along it
+
+
+def _box_area(xy: np.ndarray) -> float:
+    """The area of the box around a loop's vertices."""
+    return float(np.ptp(xy[:, 0]) * np.ptp(xy[:, 1]))
+
+
+def _runs_along(xy: np.ndarray, other: np.ndarray) -> bool:
+    """Whether at least :data:`_ALONG_SHARE` of the loop ``xy``'s vertices lie within
+    :data:`_ALONG` of both loops' extent of a vertex of ``other``."""
+    both = np.vstack([xy, other])
+    reach = _ALONG * float(np.max(np.ptp(both, axis=0)))
+    gaps = np.linalg.norm(xy[:, None, :] - other[None, :, :], axis=2).min(axis=1)
+    return bool(np.mean(gaps <= reach) >= _ALONG_SHARE)
 
 
 def _arrow(ax: Axes, xs: np.ndarray, ys: np.ndarray, colour: str) -> None:

@@ -27,6 +27,7 @@ from .key import (
     plot_styled,
     stability_curves,
 )
+from .markers import Mark, draw_marks, unstack
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -234,7 +235,8 @@ def period_plot(continuation: ContinuationResult, title: str | None = None,
     period (where periodic branches are born), and HOMOCLINIC/HETEROCLINIC at (their parameter
     estimate, the period at the last point of their branch). A "bracketed" global point also
     gets its bracket drawn as a horizontal error bar at the top of the data, if wide enough to
-    be seen beside its marker (:data:`BRACKET_VISIBLE`). The y-axis is
+    be seen beside its marker (:data:`BRACKET_VISIBLE`). A snaking family's folds are one
+    cluster, markers at one place are set apart (:mod:`~whirl_cli.plots.markers`). The y-axis is
     logarithmic if the largest period exceeds 20 times the smallest. Without periodic branches
     the axes stay empty. Title: ``title`` (None: ``"<continuation>: period"``). Draws on ``ax``
     if given, else on a new figure; returns the figure.
@@ -252,10 +254,7 @@ def period_plot(continuation: ContinuationResult, title: str | None = None,
     periods = periods[np.isfinite(periods) & (periods > 0)]
     points, brackets = _period_points(continuation, periodic)
     brackets = _visible_brackets(brackets, continuation)
-    for style in PLOT_KEY:
-        if style in points:
-            xs, ys = np.array(points[style]).T
-            plot_styled(ax, xs, ys, style, first)
+    markers = draw_marks(ax, points, first, _periodic_span(continuation))
     handles = [first[key] for key in PLOT_KEY if key in first]
     labels = [str(PLOT_KEY[key]["label"]) for key in PLOT_KEY if key in first]
     if brackets and periods.size:
@@ -267,6 +266,7 @@ def period_plot(continuation: ContinuationResult, title: str | None = None,
         handles.append(bar)
         labels.append("bracket (global bifurcation)")
     log_scale_if_decades(ax, "y", periods)
+    unstack(ax, [line for lines in markers.values() for line in lines])
     if periodic:
         ax.set_xlabel(axis_label(periodic[0].parameter_names[0], periodic[0].parameter_units[0]))
     ax.set_ylabel(axis_label("period", "s"))
@@ -284,18 +284,23 @@ BRACKET_VISIBLE = 0.005
 def _visible_brackets(brackets: list[tuple[float, float]], continuation: ContinuationResult
                       ) -> list[tuple[float, float]]:
     """The ``brackets`` wide enough to be seen beside their marker (:data:`BRACKET_VISIBLE`)."""
-    values = [b.parameters[:, 0] for b in continuation.branches if b.is_periodic and len(b)]
-    span = float(np.ptp(np.concatenate(values))) if values else 0.0
+    span = _periodic_span(continuation)
     return [(low, high) for low, high in brackets if high - low > BRACKET_VISIBLE * span]
 
 
+def _periodic_span(continuation: ContinuationResult) -> float:
+    """The span of the principal parameter over the periodic branches (0 without any)."""
+    values = [b.parameters[:, 0] for b in continuation.branches if b.is_periodic and len(b)]
+    return float(np.ptp(np.concatenate(values))) if values else 0.0
+
+
 def _period_points(continuation: ContinuationResult, periodic: list[Branch]
-                   ) -> tuple[dict[str, list[tuple[float, float]]], list[tuple[float, float]]]:
+                   ) -> tuple[dict[str, list[Mark]], list[tuple[float, float]]]:
     """Marker positions by style, and the finite brackets of "bracketed" global points."""
     by_name = {b.name: b for b in continuation.branches}
     periodic_names = {b.name for b in periodic}
     x_name = periodic[0].parameter_names[0] if periodic else None
-    points: dict[str, list[tuple[float, float]]] = {}
+    points: dict[str, list[Mark]] = {}
     brackets: list[tuple[float, float]] = []
     for point in continuation.special_points:
         kind = _point_type(point.point_type)
@@ -315,9 +320,9 @@ def _period_points(continuation: ContinuationResult, periodic: list[Branch]
             period = float(point.period)
             if not np.isfinite(period) and 0 <= point.index < len(branch):
                 period = float(branch.period[point.index])
-        xy = (float(point.parameters[0]), period)
-        if np.all(np.isfinite(xy)):
-            points.setdefault(MARKER_STYLE[kind], []).append(xy)
+        mark = Mark(float(point.parameters[0]), period, point.branch, point.index)
+        if np.isfinite(mark.x) and np.isfinite(mark.y):
+            points.setdefault(MARKER_STYLE[kind], []).append(mark)
     return points, brackets
 
 
@@ -405,7 +410,8 @@ def _draw_branch(ax: Axes, branch: Branch, state: str, which: tuple[str, ...], d
 
 def draw_special_points(ax: Axes, continuation: ContinuationResult, branches: list[Branch],
                          state: str, degrees: bool, first: dict) -> None:
-    """Markers for special points, one artist per marker style.
+    """Markers for special points, one artist per marker style (a snaking family's folds
+    as one cluster, markers at one place set apart: :mod:`~whirl_cli.plots.markers`).
 
     A point at a row of a drawn branch (:func:`_at_row`) sits on that branch's curve there (a
     global point stores the saddle's state, not the orbit's max); any other at its own state,
@@ -414,7 +420,7 @@ def draw_special_points(ax: Axes, continuation: ContinuationResult, branches: li
     """
     by_name = {b.name: b for b in branches}
     x_name = branches[0].parameter_names[0] if branches else None
-    points: dict[str, list[tuple[float, float]]] = {}
+    points: dict[str, list[Mark]] = {}
     for point in continuation.special_points:
         style = MARKER_STYLE.get(_point_type(point.point_type))
         branch = by_name.get(point.branch, branches[0] if branches else None)
@@ -423,13 +429,13 @@ def draw_special_points(ax: Axes, continuation: ContinuationResult, branches: li
         index = branch.state_names.index(state)
         factor, _ = display_unit(branch.state_units[index], degrees)
         y = branch.state(state)[point.index] if _at_row(point, branch) else point.state[index]
-        xy = (float(point.parameters[0]), float(y) * factor)
-        if np.all(np.isfinite(xy)):
-            points.setdefault(style, []).append(xy)
-    for style in PLOT_KEY:
-        if style in points:
-            xs, ys = np.array(points[style]).T
-            plot_styled(ax, xs, ys, style, first)
+        mark = Mark(float(point.parameters[0]), float(y) * factor, point.branch, point.index)
+        if np.isfinite(mark.x) and np.isfinite(mark.y):
+            points.setdefault(style, []).append(mark)
+    values = [b.parameters[:, 0] for b in branches if len(b)]
+    span = float(np.ptp(np.concatenate(values))) if values else 0.0
+    drawn = draw_marks(ax, points, first, span)
+    unstack(ax, [line for lines in drawn.values() for line in lines])
 
 
 def _at_row(point, branch: Branch) -> bool:

@@ -45,6 +45,9 @@ PLOT_KEY: dict[str, dict[str, object]] = {
                      "label": "branch point (BP, BPC)"},
     "fold": {"marker": "o", "markerfacecolor": BLACK, "markeredgecolor": BLACK,
              "label": "fold (LP, LPC)"},
+    # the folds of a family snaking towards a global bifurcation (plots.markers.draw_cluster)
+    "fold_cluster": {"marker": "o", "markerfacecolor": BLACK, "markeredgecolor": BLACK,
+                     "label": "folds of a snaking family (LPC): span, \u00d7count"},
     "homoclinic": {"marker": "^", "markerfacecolor": BLACK, "markeredgecolor": BLACK,
                    "label": "homoclinic"},
     "heteroclinic": {"marker": "^", "markerfacecolor": "none", "markeredgecolor": BLACK,

@@ -1,0 +1,201 @@
+"""Special-point markers of the one-parameter plots: the folds of a snaking family drawn as
+one cluster, and markers at one place set apart so that none hides another."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..results import PointType
+from .key import BLACK, MARKER_STYLE, PLOT_KEY, plot_styled
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.lines import Line2D
+
+#: Fewest folds of one family, one after another along it, that make a snaking cluster.
+SNAKE_FOLDS = 3
+#: The folds of a cluster lie within this fraction of the plot's parameter span of its first.
+SNAKE_WIDTH = 0.01
+#: The key of :data:`~whirl_cli.plots.key.PLOT_KEY` a cluster's legend entry is filed under.
+CLUSTER = "fold_cluster"
+#: A cluster with another this fraction of the span to its right has its count on its left.
+_LABEL_NEAR = 0.05
+
+
+@dataclass(frozen=True)
+class Mark:
+    """A special point's marker: where it goes, and the family and row it belongs to."""
+
+    x: float
+    y: float
+    family: str
+    row: int
+
+
+def fold_clusters(folds: list[Mark], span: float) -> tuple[list[Mark], list[list[Mark]]]:
+    """(folds drawn one by one, clusters): runs of at least :data:`SNAKE_FOLDS` folds of one
+    family, in row order, each within :data:`SNAKE_WIDTH` of ``span`` of the run's first
+    (a family snaking towards a global bifurcation)."""
+    singles: list[Mark] = []
+    clusters: list[list[Mark]] = []
+    families: dict[str, list[Mark]] = {}
+    for mark in folds:
+        families.setdefault(mark.family, []).append(mark)
+    for marks in families.values():
+        run: list[Mark] = []
+        for mark in sorted(marks, key=lambda m: m.row):
+            if run and abs(mark.x - run[0].x) > SNAKE_WIDTH * span:
+                _close(run, singles, clusters)
+                run = []
+            run.append(mark)
+        _close(run, singles, clusters)
+    return singles, clusters
+
+
+def _close(run: list[Mark], singles: list[Mark], clusters: list[list[Mark]]) -> None:
+    """File a finished run as a cluster, or its folds as single ones."""
+    if len(run) >= SNAKE_FOLDS:
+        clusters.append(run)
+    else:
+        singles.extend(run)
+
+
+def draw_marks(ax: Axes, marks: dict[str, list[Mark]], first: dict, span: float
+               ) -> dict[str, list[Line2D]]:
+    """Each style's marks as one artist (:func:`~whirl_cli.plots.key.plot_styled`), the folds
+    of a snaking family as one cluster each (:func:`draw_cluster`); the marker lines drawn,
+    by style (the clusters' under :data:`CLUSTER`)."""
+    drawn: dict[str, list[Line2D]] = {}
+    for style in PLOT_KEY:
+        chosen = marks.get(style, [])
+        if style == MARKER_STYLE[PointType.LPC] and chosen:
+            chosen, clusters = fold_clusters(chosen, span)
+            unique = {_cluster_key(c): c for c in reversed(clusters)}  # a mirror family's
+            clusters = [c for c in clusters if unique.get(_cluster_key(c)) is c]  # once
+            for cluster in clusters:
+                left = any(0 < other[0].x - cluster[0].x <= _LABEL_NEAR * span
+                           for other in clusters)
+                drawn.setdefault(CLUSTER, []).append(draw_cluster(ax, cluster, first, left))
+        if chosen:
+            lines_before = len(ax.lines)
+            plot_styled(ax, np.array([m.x for m in chosen]), np.array([m.y for m in chosen]),
+                        style, first)
+            drawn[style] = [ax.lines[lines_before]]
+    return drawn
+
+
+def _cluster_key(cluster: list[Mark]) -> tuple:
+    ys = [m.y for m in cluster]
+    return len(cluster), f"{cluster[0].x:.9g}", f"{min(ys):.9g}", f"{max(ys):.9g}"
+
+
+def draw_cluster(ax: Axes, cluster: list[Mark], first: dict, left: bool = False) -> Line2D:
+    """One fold marker at the cluster's first fold, a capped bar over the values of all its
+    folds, and their count beside the bar (on its ``left`` or right); the marker's line."""
+    anchor = cluster[0]
+    ys = np.array([m.y for m in cluster])
+    low, high = float(ys.min()), float(ys.max())
+    style = PLOT_KEY["fold"]
+    bar = ax.errorbar([anchor.x], [anchor.y], yerr=[[anchor.y - low], [high - anchor.y]],
+                      fmt="o", markersize=8.0, markerfacecolor=style["markerfacecolor"],
+                      markeredgecolor=style["markeredgecolor"], ecolor=BLACK,
+                      elinewidth=1.2, capsize=4, zorder=3, label="_fold cluster")
+    ax.annotate(f"\u00d7{len(cluster)}", xy=(anchor.x, (low + high) / 2),
+                xytext=(-6 if left else 6, 0), textcoords="offset points",
+                ha="right" if left else "left", va="center", fontsize="x-small", zorder=6,
+                bbox={"boxstyle": "round,pad=0.1", "facecolor": "white", "edgecolor": "none",
+                      "alpha": 0.8})  # legible over a marker beside it
+    first.setdefault(CLUSTER, _cluster_handle())
+    return bar.lines[0]
+
+
+def _cluster_handle():
+    """The legend's picture of a cluster: a fold's dot on a capped bar."""
+    from matplotlib.lines import Line2D
+    from matplotlib.path import Path
+
+    circle = Path.circle((0.0, 0.0), 0.42)
+    bar = Path([(0.0, -1.0), (0.0, 1.0), (-0.35, 1.0), (0.35, 1.0), (-0.35, -1.0),
+                (0.35, -1.0)], [Path.MOVETO, Path.LINETO] * 3)
+    return Line2D([], [], marker=Path.make_compound_path(circle, bar), markersize=13,
+                  markerfacecolor=BLACK, markeredgecolor=BLACK, markeredgewidth=1.2,
+                  linestyle="none")
+
+
+def unstack(ax: Axes, lines: list[Line2D]) -> None:
+    """Set apart markers at one place: from the top down (by zorder, then drawing order),
+    each marker whose centre lies within the half size of a marker drawn above it (a larger
+    hollow ring around it excepted, and a marker of the same look) is drawn beside it
+    instead, shifted sideways (right, else left) until its centre is a quarter of its size
+    clear of the other's half size, in a copy of its line; one step at most, so that a crowd
+    of markers does not spread far from its place. Positions are those of the axes as they
+    are now (their limits autoscaled)."""
+    ax.autoscale_view()
+    order = sorted(lines, key=lambda line: line.get_zorder())
+    per_point = ax.figure.dpi / 72.0
+    placed: list[tuple[Line2D, np.ndarray]] = []  # lines above, with their final centres
+    for line in reversed(order):
+        centres = line.get_transform().transform(line.get_xydata())
+        shifts = np.array([_shift(centre, line, placed, per_point) for centre in centres])
+        placed.append((line, centres + np.column_stack([shifts, 0 * shifts]) * per_point))
+        _split_by_shift(ax, line, shifts)
+
+
+def _shift(centre: np.ndarray, line: Line2D, placed: list, per_point: float) -> float:
+    """The sideways shift [points] that puts a marker of ``line`` at ``centre`` clear of
+    every marker ``placed`` above it (0 if none covers it, or neither side is clear)."""
+    above = [(other, xy) for other, xy in placed if not _both_seen(line, other)]
+    if not above:
+        return 0.0
+    step = 0.25 * line.get_markersize() + 0.5 * max(o.get_markersize() for o, _ in above)
+    for k in (0, 1, -1):
+        at = centre + np.array([k * step * per_point, 0.0])
+        if not any(_covers(other, xy, at, per_point) for other, xy in above):
+            return k * step
+    return 0.0
+
+
+def _both_seen(below: Line2D, above: Line2D) -> bool:
+    """Whether a marker of ``above`` leaves one of ``below`` at its place in view: the same
+    mark, or a larger hollow ring around it."""
+    same = (below.get_marker() == above.get_marker()
+            and below.get_markerfacecolor() == above.get_markerfacecolor()
+            and below.get_markersize() == above.get_markersize())
+    ring = (above.get_markerfacecolor() == "none"
+            and above.get_markersize() > below.get_markersize())
+    return same or ring
+
+
+def _covers(other: Line2D, centres: np.ndarray, at: np.ndarray, per_point: float) -> bool:
+    """Whether a marker of ``other`` at one of ``centres`` [pixels] covers the point ``at``."""
+    if not len(centres):
+        return False
+    reach = 0.5 * other.get_markersize() * per_point
+    return bool((np.linalg.norm(centres - at, axis=1) < reach).any())
+
+
+def _split_by_shift(ax: Axes, line: Line2D, shifts: np.ndarray) -> None:
+    """Keep ``line``'s unshifted points in it and draw each group of shifted ones in a copy
+    shifted by that many points (the line itself takes a group if none is unshifted)."""
+    from matplotlib.lines import Line2D as Line
+    from matplotlib.transforms import ScaledTranslation
+
+    if not shifts.any():
+        return
+    xy = line.get_xydata()
+    groups = sorted(set(shifts.tolist()), key=lambda s: (s != 0.0, abs(s), s))
+    for n, shift in enumerate(groups):
+        chosen = xy[shifts == shift]
+        target = line
+        if n:
+            target = Line(chosen[:, 0], chosen[:, 1])
+            target.update_from(line)
+            target.set(label="_shifted", zorder=line.get_zorder(), transform=ax.transData)
+            ax.add_line(target)
+        target.set_data(chosen[:, 0], chosen[:, 1])
+        if shift:
+            target.set_transform(ax.transData + ScaledTranslation(
+                shift / 72.0, 0.0, ax.figure.dpi_scale_trans))
