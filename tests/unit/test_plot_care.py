@@ -543,3 +543,36 @@ def test_every_cluster_of_a_plot_is_set_apart_from_a_marker_over_it():
                                         tuple(points))).axes[0]
     assert len(_fold_marks(ax)) == 2
     assert _hidden_markers(ax) == []
+
+
+def _torus_markers(ax) -> int:
+    """Torus (TR) markers drawn on ``ax``: hollow rings."""
+    return sum(len(line.get_xdata()) for line in ax.lines
+               if line.get_marker() == "o" and line.get_markerfacecolor() == "none")
+
+
+def test_a_point_whirl_rejected_gets_no_marker_in_a_study_plot_or_a_sheet_panel():
+    """A TR that whirl's own check says is no torus bifurcation is listed (summary, HDF5) but
+    never drawn as one: a study's bifurcation plot and a sheet's panel draw only the located
+    TR beside it."""
+    import matplotlib.pyplot as plt
+
+    from whirl_cli.plots.files import study_figures
+    from whirl_cli.plots.panels import draw
+    from whirl_cli.results import LocateStatus
+
+    from .plot_data import hopf_continuation, make_point, result_with
+
+    base = hopf_continuation()
+    located = make_point("periodic_1", PointType.TR, 0.35, 0.1)
+    rejected = replace(make_point("periodic_1", PointType.TR, 0.38, 0.3),
+                       status=LocateStatus.REJECTED)
+    result = result_with(replace(base, special_points=(*base.special_points, located,
+                                                       rejected)), 0.0)
+    ((_, figure),) = list(study_figures(result, ("bifurcation",)))
+    assert [_torus_markers(ax) for ax in figure.axes if ax.lines] == [1]
+    plt.close(figure)
+    figure, ax = plt.subplots()
+    draw(result, "bifurcation", ax)
+    assert _torus_markers(ax) == 1
+    plt.close(figure)

@@ -7,7 +7,7 @@ from __future__ import annotations
 import io
 import re
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from functools import cache, partial
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -18,7 +18,7 @@ from ..errors import OutputError, WhirlError
 from ..output.guard import PLOT_CHARACTERS, plot_stem
 from ..results import Branch, ContinuationResult, PointType, StudyResult
 from .captions import Captions, Fixed, captions
-from .key import PLOTTED_KINDS
+from .key import PLOTTED_KINDS, drawn_points
 from .kinds import Figures, plot_kinds, registry
 
 if TYPE_CHECKING:
@@ -221,13 +221,6 @@ def _titles(figure: Figure) -> list:
     return texts + [t for ax in figure.axes for t in (ax.title, ax._left_title, ax._right_title)]
 
 
-def _without_artefacts(result: StudyResult) -> StudyResult:
-    """``result`` without the special points flagged as smoothing artefacts."""
-    return replace(result, continuations=tuple(
-        replace(c, special_points=tuple(p for p in c.special_points if not p.artefact))
-        for c in result.continuations))
-
-
 def _named_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str, state: str | None,
                 view: View = View()):
     """(unique filesystem-safe file name, figure factory) pairs of the requested kinds."""
@@ -247,8 +240,7 @@ def _figure_jobs(result: StudyResult, kinds: tuple[str, ...], stem: str,
                  state: str | None, view: View = View()):
     """(file name, figure factory) pairs for the requested kinds, in a stable order."""
     caption = cache(lambda: captions(result))  # read the stored study once, when drawing
-    if not view.artefacts:
-        result = _without_artefacts(result)
+    result = drawn_points(result, artefacts=view.artefacts)
     figures = Figures(result, stem, state, view, caption)
     return [job for name, kind in registry().items() if name in kinds
             for job in kind.figures(figures)]

@@ -11,12 +11,13 @@ from __future__ import annotations
 import itertools
 import re
 from collections.abc import Iterator
+from dataclasses import replace
 from functools import cache
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..results import BranchKind, PointType, Spacing
+from ..results import BranchKind, LocateStatus, PointType, Spacing, StudyResult
 from ..units import axis_label as _plain_axis_label
 from ..units import display_unit  # noqa: F401  (re-exported: plots use them)
 
@@ -343,3 +344,14 @@ def patch_proxy(style: dict[str, object]):
 
     return Patch(facecolor=style["color"], alpha=style.get("alpha"), label=style["label"])
 
+
+def drawn_points(result: StudyResult, artefacts: bool = False) -> StudyResult:
+    """``result`` with only the special points a figure marks: never one whirl's own check
+    rejected (AUTO labelled it, but it is not that point), nor, unless ``artefacts``, one
+    flagged as an artefact of a smoothed law."""
+    def marked(point) -> bool:
+        return point.status != LocateStatus.REJECTED and (artefacts or not point.artefact)
+
+    return replace(result, continuations=tuple(
+        replace(c, special_points=tuple(p for p in c.special_points if marked(p)))
+        for c in result.continuations))

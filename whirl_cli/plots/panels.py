@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 from ..errors import WhirlError
 from ..results import Branch, ContinuationKind, ContinuationResult, LinearSweep, StudyResult
 from .captions import Fixed, captions
+from .key import drawn_points
 from .kinds import overlay_kinds, panel_kinds, registry
 
 if TYPE_CHECKING:
@@ -59,7 +60,8 @@ def draw(result: StudyResult, kind: str, ax: Axes, choice: PanelChoice = PanelCh
     found = registry().get(kind)
     if found is None:
         raise WhirlError(f"unknown panel kind {kind!r}; choose from {', '.join(panel_kinds())}")
-    return found.panel(result, ax, choice, replace(captions(result), named=False))
+    return found.panel(drawn_points(result), ax, choice,
+                       replace(captions(result), named=False))
 
 
 def continuation_title(continuation: ContinuationResult, choice: PanelChoice, caption
@@ -159,7 +161,7 @@ def draw_overlay(results: Sequence[StudyResult], kind: str, ax: Axes,
     auto = differing_labels(results)
     names = [labels[k] if k < len(labels) and labels[k] else auto[k]
              for k in range(len(results))]
-    return found.overlay(results, names, ax, choice, title)
+    return found.overlay([drawn_points(r) for r in results], names, ax, choice, title)
 
 
 PANEL_KINDS = panel_kinds()
