@@ -6,6 +6,7 @@ period-doubling points (:mod:`.doubling`).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -41,17 +42,8 @@ def mirror_sources(model: Model, hopfs: list[SpecialPoint], width: float,
     if not model.symmetric:
         return {}
     amplitudes = typical_amplitudes(model)
-    sources: dict[int, int] = {}
-    for k, hopf in enumerate(hopfs):
-        for j, other in enumerate(hopfs[:k]):
-            if j in sources or not _mirrors(hopf, other, width, amplitudes):
-                continue
-            name = hopf.parameter_names[0]
-            params = model.parameter_vector({**parameters, name: float(hopf.parameters[0])})
-            if is_odd(model, params, [hopf.state]):
-                sources[k] = j
-            break
-    return sources
+    return _images(model, hopfs, parameters,
+                   lambda a, b: _mirrors(a, b, width, amplitudes))
 
 
 def mirror_points(model: Model, points: list[SpecialPoint], branches: dict[str, Branch],
@@ -69,10 +61,18 @@ def mirror_points(model: Model, points: list[SpecialPoint], branches: dict[str, 
         return (branch.state_max[point.index] / amplitudes,
                 branch.state_min[point.index] / amplitudes)
 
+    return _images(model, points, parameters,
+                   lambda a, b: _mirror_pair(a, b, orbit(a), orbit(b), width))
+
+
+def _images(model: Model, points: list[SpecialPoint], parameters: dict[str, float],
+            pair: Callable[[SpecialPoint, SpecialPoint], bool]) -> dict[int, int]:
+    """{k: j} for every point k whose first earlier ``pair``-ed point j (not itself an
+    image) it mirrors, where the model's right-hand side is odd at k's parameter value."""
     images: dict[int, int] = {}
     for k, point in enumerate(points):
         for j, other in enumerate(points[:k]):
-            if j in images or not _mirror_pair(point, other, orbit(point), orbit(other), width):
+            if j in images or not pair(point, other):
                 continue
             name = point.parameter_names[0]
             params = model.parameter_vector({**parameters, name: float(point.parameters[0])})
