@@ -5,7 +5,8 @@ sections 2.3 and 7, thesis convention): y = [theta, psi, theta', psi'],
     I_z psi''   = k_c theta - (K_psi - k_d) psi - I_x Omega theta' - (C_psi + c_a) psi'
 
 with k_d, k_c, c_a from :mod:`tests.strip_theory` and the pitch law M given as a function;
-simulated with scipy's solve_ivp (freeplay: an event at each breakpoint |theta| = delta).
+simulated with scipy's solve_ivp (an event at each breakpoint of a piecewise law), or, for the
+exact freeplay law, each piece of it in closed form (:func:`freeplay_motion`).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from tests.piecewise_linear import affine_pieces, motion
 from tests.strip_theory import coefficients
 
 #: Reed's tabletop model (models.md section 3).
@@ -34,15 +36,15 @@ def field(values: dict, law):
     v = {**DATUM, **values}
     k_d, k_c, c_a = aero(v)
     gyro = v["I_x"] * v["Omega"]
+    c_theta, c_psi, k_psi = v["C_theta"] + c_a, v["C_psi"] + c_a, v["K_psi"] - k_d
+    i_y, i_z = v["I_y"], v["I_z"]
 
     def f(_t, y):
-        theta, psi, dtheta, dpsi = y
+        theta, psi, dtheta, dpsi = y.tolist()  # Python floats: the same doubles, less overhead
         return np.array([
             dtheta, dpsi,
-            (-law(theta) + k_d * theta - k_c * psi - (v["C_theta"] + c_a) * dtheta
-             + gyro * dpsi) / v["I_y"],
-            (k_c * theta - (v["K_psi"] - k_d) * psi - gyro * dtheta
-             - (v["C_psi"] + c_a) * dpsi) / v["I_z"]])
+            (-law(theta) + k_d * theta - k_c * psi - c_theta * dtheta + gyro * dpsi) / i_y,
+            (k_c * theta - k_psi * psi - gyro * dtheta - c_psi * dpsi) / i_z])
     return f
 
 
@@ -101,3 +103,20 @@ def simulate(values: dict, law, y0, duration: float, breakpoints: tuple[float, .
         t0 = t_hit + 1e-12
         y = y + 1e-12 * f(t_hit, y)
     return np.concatenate(times), np.concatenate(states)
+
+
+def freeplay_motion(values: dict, delta: float, k_out: float, y0, duration: float,
+                    k_in: float = 0.0, samples_per_second: int = 2000, limit: float = 1.5):
+    """:func:`simulate` with the law ``freeplay(delta, k_out, k_in)``, each piece of it (where
+    the model is linear) in closed form (:mod:`tests.piecewise_linear`): (t, y) sampled from 0
+    to ``duration`` s; the samples end where |theta| or |psi| exceeds ``limit`` rad."""
+    v = {**DATUM, **values}
+
+    def a_of(piece: int) -> np.ndarray:
+        return linear_matrix({**v, "K_theta": k_in if piece == 0 else k_out})
+
+    def b_of(piece: int) -> np.ndarray:  # beyond the gap: k_out x - piece delta (k_out - k_in)
+        return np.array([0.0, 0.0, piece * delta * (k_out - k_in) / v["I_y"], 0.0])
+
+    grid = np.arange(1, math.floor(duration * samples_per_second) + 1) / samples_per_second
+    return motion(affine_pieces(a_of, b_of), 0, 2, delta, y0, grid, limit=((0, 1), limit))

@@ -1,8 +1,8 @@
 """The gimballed model with whirl's exact freeplay law, written out for tests apart from whirl's
 model file (../shared/models.md sections 2.2, 7 and 8, in the derivation frame: psi and beta_z
 of the thesis frame negated, which leaves |theta|, |beta_y|, periods and stability as they
-are), and simulated with scipy's solve_ivp, an event at each breakpoint |x| = delta where the
-law changes piece.
+are), and its exact freeplay law's motion, each piece of the law (where the model is linear) in
+closed form, a root-finder at each breakpoint |x| = delta where the law changes piece.
 
 q = [theta, psi, beta_y, beta_z]; M q'' + (C + G - C_a) q' + (K - K_a) q + freeplay = 0, the
 freeplay dof's spring replaced by K_in x + (K_out - K_in) (x - delta sat(x / delta)).
@@ -11,7 +11,8 @@ freeplay dof's spring replaced by K_in x + (K_out - K_in) (x - delta sat(x / del
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import solve_ivp
+
+from .piecewise_linear import affine_pieces, motion
 
 #: Reed's tabletop model (models.md section 3) and the gimbal's data (section 8).
 DATUM = {"R": 0.152, "Omega": 40.0, "N": 4, "c": 0.026, "C_l_alpha": 2 * np.pi, "a": 0.25,
@@ -50,49 +51,26 @@ def matrices(values: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def freeplay_simulation(values: dict, dof: str, delta: float, k_out: float, y0: np.ndarray,
                         duration: float, k_in: float = 0.0, samples_per_second: int = 2000):
-    """(t, y): the exact-law simulation from ``y0`` (8 states, derivation frame) for
-    ``duration`` s, sampled ``samples_per_second``; freeplay on ``dof`` with ``k_out``
-    outside the gap (the dof's linear spring in ``values`` is replaced)."""
+    """(t, y): the exact-law motion from ``y0`` (8 states, derivation frame) for ``duration``
+    s, sampled ``samples_per_second``; freeplay on ``dof`` with ``k_out`` outside the gap (the
+    dof's linear spring in ``values`` is replaced), each piece of the law in closed form
+    (:mod:`tests.piecewise_linear`)."""
     j = DOFS.index(dof)
     mass, damping, stiffness = matrices({**values, ("K_beta" if j > 1 else f"K_{dof}"): k_out})
-    stiffness = stiffness.copy()
-    stiffness[j, j] -= k_out  # the dof's spring is the freeplay law's
     minv = np.linalg.inv(mass)
 
-    def field(piece: int):
-        def f(_t, y):
-            x = y[j]
-            spring = k_in * x if piece == 0 else k_in * piece * delta + k_out * (
-                x - piece * delta)
-            force = stiffness @ y[:4] + damping @ y[4:]
-            force[j] += spring
-            return np.concatenate([y[4:], -minv @ force])
-        return f
+    def a_of(piece: int) -> np.ndarray:
+        spring = stiffness.copy()
+        spring[j, j] += (k_in if piece == 0 else k_out) - k_out  # the law's slope there
+        return np.block([[np.zeros((4, 4)), np.eye(4)], [-minv @ spring, -minv @ damping]])
 
-    def crossing(level: float, direction: int):
-        def event(_t, y):
-            return y[j] - level
-        event.terminal, event.direction = True, direction
-        return event
+    def b_of(piece: int) -> np.ndarray:
+        force = np.zeros(4)
+        force[j] = piece * delta * (k_in - k_out)  # K_in x + (K_out - K_in)(x - delta sat)
+        return np.concatenate([np.zeros(4), -minv @ force])
 
-    # the breakpoints a piece can leave by, each only in the direction that leaves it
-    leaving = {0: [crossing(delta, 1), crossing(-delta, -1)], 1: [crossing(delta, -1)],
-               -1: [crossing(-delta, 1)]}
-    grid = np.arange(0.0, duration, 1.0 / samples_per_second)
-    t0, y, out_t, out_y = 0.0, np.asarray(y0, dtype=float), [], []
-    piece = 0 if abs(y[j]) < delta else int(np.sign(y[j]))
-    while True:
-        sol = solve_ivp(field(piece), (t0, duration), y, method="DOP853", rtol=1e-10,
-                        atol=1e-13, t_eval=grid[grid >= t0], events=leaving[piece])
-        out_t.append(sol.t)
-        out_y.append(np.reshape(sol.y, (len(y), -1)).T)  # no samples left: sol.y is []
-        if sol.status != 1:
-            return np.concatenate(out_t), np.vstack(out_y)
-        hit = next(k for k, times in enumerate(sol.t_events) if len(times))
-        t0, y = float(sol.t_events[hit][0]), sol.y_events[hit][0].copy()
-        y[j] = delta * np.sign(y[j])  # exactly on the breakpoint
-        piece = int(np.sign(y[j])) if piece == 0 else 0
-        grid = grid[grid > t0]
+    return motion(affine_pieces(a_of, b_of), j, j + 4, delta, y0,
+                  np.arange(0.0, duration, 1.0 / samples_per_second))
 
 
 def maxima(t: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

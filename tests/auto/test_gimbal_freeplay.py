@@ -1,7 +1,7 @@
 """Freeplay on a gimbal dof (studies/gimballed/freeplay_gimbal_airspeed.yaml: beta_y, K_in =
 0, K_out = 10 N m/rad, delta = 1 deg): whirl's classifier calls the motion from 2 deg of pitch
-at 6.7 m/s chaotic. Checked against the exact piecewise-linear law simulated in the test
-(tests/gimballed_exact.py, an event at each gap edge): after a transient, two starts 1e-9
+at 6.7 m/s chaotic. Checked against the exact piecewise-linear law's motion written in the test
+(tests/gimballed_exact.py, each piece of the law in closed form): after a transient, two starts 1e-9
 delta apart part exponentially, at about the exponent whirl estimates, to the size of the
 motion itself, and the motion neither settles nor diverges."""
 

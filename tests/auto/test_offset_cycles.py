@@ -1,8 +1,8 @@
 """The lop-sided limit cycles about freeplay's offset equilibria (real AUTO-07p), in
 studies/freeplay/pitch_offset_cycles.yaml: Newton's method finds the offset equilibria, whose
 Hopf points (7.4913 m/s) start the families; their stable cycles are checked against the
-exact piecewise-linear law simulated in the test (tests/classical_exact.py, scipy with an
-event at each gap edge): from near the offset equilibrium at 7.6 and 8.3 m/s (above the
+exact piecewise-linear law's motion written in the test (tests/classical_exact.py, each piece
+of the law in closed form): from near the offset equilibrium at 7.6 and 8.3 m/s (above the
 linear onset) the motion settles on a cycle of the continued cycle's pitch range, and at
 7.4 m/s (below it, where the offset equilibrium is stable too) the stored stable orbit stays
 a cycle of its own range. The homoclinic end near 8.12 m/s is checked against the exact law's
@@ -24,7 +24,7 @@ from whirl_cli.pipeline import run_study
 from whirl_cli.results import PointType
 from whirl_cli.study import load_study
 
-from ..classical_exact import field, freeplay, linear_matrix, simulate
+from ..classical_exact import field, freeplay, freeplay_motion, linear_matrix
 from ..conftest import ROOT
 
 DELTA, K_OUT, K_PSI = math.radians(1.0), 0.4, 0.3
@@ -54,8 +54,8 @@ def stable_ranges(branch, v: float) -> list[np.ndarray]:
 def settled_range(v: float, y0, duration: float = 40.0) -> np.ndarray:
     """(theta min, theta max, psi min, psi max) / delta over the last 5 s of the exact law's
     motion from ``y0``."""
-    t, y = simulate({"K_psi": K_PSI, "V": v}, freeplay(DELTA, K_OUT), y0, duration,
-                    (DELTA, -DELTA), samples_per_second=1000)
+    t, y = freeplay_motion({"K_psi": K_PSI, "V": v}, DELTA, K_OUT, y0, duration,
+                           samples_per_second=1000)
     assert t[-1] == pytest.approx(duration)  # did not diverge
     last = y[t > duration - 5.0]
     return np.array([last[:, 0].min(), last[:, 0].max(), last[:, 1].min(),

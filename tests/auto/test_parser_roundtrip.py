@@ -198,10 +198,11 @@ def test_d_file_multipliers_are_the_monodromy_eigenvalues(runs):
         np.testing.assert_allclose(orbit.states, solution.u[:, :4] * scale, rtol=1e-12)
         start = solution.u[0, :4] * scale
 
-        def variational(_t, z, params=params):
+        field, jacobian = model.field_at(params)  # the model's numpy f and df/dy
+
+        def variational(_t, z, field=field, jacobian=jacobian):
             y, matrix = z[:4], z[4:].reshape(4, 4)
-            return np.concatenate([model.rhs_numpy(y, params),
-                                   (model.jacobian_numpy(y, params) @ matrix).ravel()])
+            return np.concatenate([field(y), (jacobian(y) @ matrix).ravel()])
 
         end = solve_ivp(variational, (0.0, period), np.concatenate([start, np.eye(4).ravel()]),
                         method="DOP853", rtol=1e-11, atol=1e-13).y[:, -1]

@@ -156,10 +156,11 @@ def test_monodromy_of_the_stored_orbits_has_its_pair_on_the_unit_circle_at_the_a
             params = model.parameter_vector({**overrides, **values})
             start = orbit.states[0]
 
-            def variational(_t, z, params=params):
+            field, jacobian = model.field_at(params)  # the model's numpy f and df/dy
+
+            def variational(_t, z, field=field, jacobian=jacobian):
                 y, matrix = z[:n], z[n:].reshape(n, n)
-                return np.concatenate([model.rhs_numpy(y, params),
-                                       (model.jacobian_numpy(y, params) @ matrix).ravel()])
+                return np.concatenate([field(y), (jacobian(y) @ matrix).ravel()])
 
             end = solve_ivp(variational, (0.0, orbit.period),
                             np.concatenate([start, np.eye(n).ravel()]), method="DOP853",

@@ -2,8 +2,8 @@
 its section several times a period repeats with that lag, a motion approaching a cycle is
 followed at the rate it converges, a torus never passes; the gimballed model with pitch
 freeplay (K_beta = 10, K_psi = 0.3, delta = 1 deg, K_out = 0.4) settles at 6.7 m/s on the cycle
-an exact-law simulation (tests/gimballed_exact.py, scipy's solve_ivp, events at the
-breakpoints) stays on; a study whose seeds found nothing and could not all be judged fails."""
+the exact law's motion (tests/gimballed_exact.py, each piece of the law in closed form)
+stays on; a study whose seeds found nothing and could not all be judged fails."""
 
 from __future__ import annotations
 
