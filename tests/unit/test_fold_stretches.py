@@ -92,3 +92,12 @@ def test_a_fold_too_far_from_the_crossing_gives_no_verdict():
     assert np.allclose(found[0.3], [0.45]) and np.allclose(found[0.2], [0.70])
     assert np.allclose(found[0.15], [0.825])
     assert stable_fold_stretches(LOCUS, {0.3: [(0.40, False)]}, 1e-3)[0] is LOCUS  # unknown
+
+
+def test_a_fold_beside_a_run_of_stable_cycles_to_a_hopf_counts_anywhere():
+    """The stable cycles beside the fold (-0.04) reach the Hopf point (-0.15) where the origin
+    is unstable (a divergence lobe): the fold still counts; its locus may bound an unsafe
+    region on other rows."""
+    k1 = np.array([-0.15, -0.10, -0.04, -0.041, -0.10, -0.148])
+    branches = (family(k1, [0, 0, 0, 1, 1, 1], [2]),)
+    assert slice_folds(branches, [-0.15], [(0.03, 0.32)]) == [(-0.04, True)]

@@ -139,9 +139,11 @@ def _paired(folds: list[float], anchors: list[float]) -> list[Interval]:
 def slice_folds(branches: tuple[Branch, ...], hopfs: list[float], stable: list[Interval]
                 ) -> list[tuple[float, bool]]:
     """The folds of cycles of one slice's periodic families, each with the verdict whether
-    its family has stable cycles (by their Floquet multipliers) between the fold and the Hopf
-    point of ``hopfs`` (the slice's) nearest it, where the undeflected equilibrium is linearly
-    stable (``stable``: the slice's stable intervals)."""
+    stable cycles (by their Floquet multipliers) lie beside it: its family's run of stable
+    cycles beside the fold covers 90 % of the way to one of ``hopfs`` (the slice's Hopf
+    points), or the family has stable cycles between the fold and the Hopf point nearest it
+    where the undeflected equilibrium is linearly stable (``stable``: the slice's stable
+    intervals; such cycles may lie beyond a torus point, the fold's own sides unstable)."""
     found = []
     for branch in branches:
         if branch.kind != BranchKind.PERIODIC:
@@ -149,9 +151,30 @@ def slice_folds(branches: tuple[Branch, ...], hopfs: list[float], stable: list[I
         cycles = branch.parameters[branch.stable & branch.stability_known, 0]
         for k in np.flatnonzero(branch.point_type == PointType.LPC):
             fold = float(branch.parameters[k, 0])
-            found.append((fold, bool(hopfs) and _any_between(
+            run = branch.parameters[_stable_run_beside(branch, int(k)), 0]
+            beside = bool(len(run)) and any(
+                _covered(run, fold, hopf) >= 0.9 * abs(hopf - fold) for hopf in hopfs)
+            found.append((fold, beside or bool(hopfs) and _any_between(
                 cycles, fold, min(hopfs, key=lambda h: abs(h - fold)), stable)))
     return found
+
+
+def _covered(run: np.ndarray, a: float, b: float) -> float:
+    """How much of the interval between ``a`` and ``b`` the extent of ``run`` covers."""
+    lo, hi = min(a, b), max(a, b)
+    return max(0.0, min(float(run.max()), hi) - max(float(run.min()), lo))
+
+
+def _stable_run_beside(branch: Branch, index: int) -> np.ndarray:
+    """Rows of the runs of known stable points of ``branch`` next to row ``index``."""
+    stable = branch.stable & branch.stability_known
+    rows = []
+    for step in (-1, 1):
+        k = index + step
+        while 0 <= k < len(branch) and stable[k]:
+            rows.append(k)
+            k += step
+    return np.array(sorted(rows), dtype=int)
 
 
 def _any_between(values: np.ndarray, a: float, b: float, allowed: list[Interval]) -> bool:
