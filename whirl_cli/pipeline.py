@@ -8,6 +8,7 @@ directories under ``workroot`` (the caller stores the result with :mod:`whirl_cl
 from __future__ import annotations
 
 import importlib
+import itertools
 from collections.abc import Callable, Sequence
 from contextlib import ExitStack
 from dataclasses import replace
@@ -373,7 +374,7 @@ def continue_two_parameter(stage: Stage, spec) -> tuple[ContinuationResult, Boun
     continuation = replace(continuation, seeds=outcomes)
     per_slice = [tuple(b for b in continuation.branches if on_slice(b.name, k) is not None)
                  for k in range(len(spec.slices))]
-    added = iter(range(len(spec.slices), 10**6))
+    added = itertools.count(1)
 
     def more_slices(values: list[float]) -> list[tuple]:
         """The branches of extra slices at ``values`` (not stored: they only judge folds)."""

@@ -12,7 +12,8 @@ each intersected with the linearly stable part of the slice. Two ways to get it:
 
 * ``loci``: cross the Hopf, LPC, BP and LP loci (two-parameter continuation) with each row;
   a fold-of-cycles locus counts only along its stretches where the slices' periodic families
-  (Floquet stability) find stable cycles on one side of its folds;
+  (Floquet stability) find stable cycles beside its folds; where two slices disagree, extra
+  slices place the edge;
 * ``slices`` (the thesis' method): from one-parameter runs with periodic branches per slice.
 
 Polygons of the region are assembled from the intervals of consecutive slices.
@@ -220,7 +221,9 @@ def disagreeing(curve: np.ndarray, folds: dict[float, list[tuple[float, bool]]],
 
 
 def refined_folds(folds: dict[float, list[tuple[float, bool]]], curves: list[np.ndarray],
-                  tolerance: float, step: float, judge) -> dict[float, list[tuple[float, bool]]]:
+                  tolerance: float, step: float,
+                  judge: Callable[[list[float]], dict[float, list[tuple[float, bool]]]]
+                  ) -> dict[float, list[tuple[float, bool]]]:
     """``folds`` (slice value -> its folds with verdicts) with more slices, bisecting every pair
     of slices between which a locus of ``curves`` changes verdict until the two lie within
     ``step``; ``judge(values)`` gives the folds of new slices at ``values`` (by value)."""
