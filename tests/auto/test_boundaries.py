@@ -153,6 +153,30 @@ def test_hardening_sliver_left_of_the_left_hopf(results):
         np.degrees(family.state_max[stable, 0].max()), rel=0.05)
 
 
+@pytest.mark.parametrize("k_psi, k1", [(0.295, 0.0445), (0.29, 0.0358)])
+def test_hardening_sliver_holds_stable_cycles_off_the_slice(results, k_psi, k1):
+    """Hardening rows near the sliver's lower tip: where the origin is linearly stable, starts
+    of 4-12 deg in pitch or yaw all settle on one stable cycle (the classical model written
+    out in tests/classical_exact.py, scipy), and the study's unsafe interval holds K1 there."""
+    from ..classical_exact import linear_matrix, polynomial
+    from ..classical_exact import simulate as exact_simulation
+
+    assert np.linalg.eigvals(linear_matrix({"K_psi": k_psi, "K_theta": k1})).real.max() < 0
+    for degrees in (4.0, 8.0):
+        for dof in (0, 1):
+            y0 = np.zeros(4)
+            y0[dof] = np.radians(degrees)
+            t, y = exact_simulation({"K_psi": k_psi, "K_theta": k1}, polynomial(k1, 10.0), y0,
+                                    60.0, samples_per_second=200)
+            late = np.abs(y[t > 55.0, :2]).max()
+            before = np.abs(y[(t > 50.0) & (t <= 55.0), :2]).max()
+            assert late > np.radians(2.0) and abs(late - before) < 0.01 * late, (degrees, dof)
+    _, result = results("boundary_hardening", grid="points: 81")
+    (boundary,) = result.boundaries
+    assert any(i.lower < k1 < i.upper for i in _slice_intervals(boundary, k_psi, "flutter")), \
+        _slice_intervals(boundary, k_psi)
+
+
 @pytest.mark.parametrize("name", ["boundary_hardening", "boundary_softening",
                                   "boundary_combined"])
 def test_loci_and_slices_methods_agree(results, name):

@@ -12,13 +12,16 @@ each intersected with the linearly stable part of the slice. Two ways to get it:
 
 * ``loci``: cross the Hopf, LPC, BP and LP loci (two-parameter continuation) with each row;
   a fold-of-cycles locus counts only along its stretches where the slices' periodic families
-  (Floquet stability) find stable cycles on one side of its folds;
+  (Floquet stability) find stable cycles beside its folds; where two slices disagree, extra
+  slices place the edge;
 * ``slices`` (the thesis' method): from one-parameter runs with periodic branches per slice.
 
 Polygons of the region are assembled from the intervals of consecutive slices.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 
@@ -134,21 +137,26 @@ def _paired(folds: list[float], anchors: list[float]) -> list[Interval]:
     return [tuple(sorted((f, min(anchors, key=lambda a: abs(a - f))))) for f in folds]
 
 
-def slice_folds(branches: tuple[Branch, ...], hopfs: list[float]
+def slice_folds(branches: tuple[Branch, ...], hopfs: list[float], stable: list[Interval]
                 ) -> list[tuple[float, bool]]:
     """The folds of cycles of one slice's periodic families, each with the verdict whether
-    the family carries stable cycles from the fold to a Hopf point: its run of stable cycles
-    beside the fold (by its Floquet multipliers) covers 90 % of the way to one of ``hopfs``
-    (the slice's Hopf points)."""
+    stable cycles (by their Floquet multipliers) lie beside it: its family's run of stable
+    cycles beside the fold covers 90 % of the way to one of ``hopfs`` (the slice's Hopf
+    points), or the family has stable cycles between the fold and the Hopf point nearest it
+    where the undeflected equilibrium is linearly stable (``stable``: the slice's stable
+    intervals; such cycles may lie beyond a torus point, the fold's own sides unstable)."""
     found = []
     for branch in branches:
         if branch.kind != BranchKind.PERIODIC:
             continue
+        cycles = branch.parameters[branch.stable & branch.stability_known, 0]
         for k in np.flatnonzero(branch.point_type == PointType.LPC):
             fold = float(branch.parameters[k, 0])
             run = branch.parameters[_stable_run_beside(branch, int(k)), 0]
-            found.append((fold, bool(len(run)) and any(
-                _covered(run, fold, hopf) >= 0.9 * abs(hopf - fold) for hopf in hopfs)))
+            beside = bool(len(run)) and any(
+                _covered(run, fold, hopf) >= 0.9 * abs(hopf - fold) for hopf in hopfs)
+            found.append((fold, beside or bool(hopfs) and _any_between(
+                cycles, fold, min(hopfs, key=lambda h: abs(h - fold)), stable)))
     return found
 
 
@@ -170,28 +178,63 @@ def _stable_run_beside(branch: Branch, index: int) -> np.ndarray:
     return np.array(sorted(rows), dtype=int)
 
 
+def _any_between(values: np.ndarray, a: float, b: float, allowed: list[Interval]) -> bool:
+    """Whether one of ``values`` lies strictly between ``a`` and ``b`` inside ``allowed``."""
+    lo, hi = min(a, b), max(a, b)
+    return any(np.any((values > max(lo, p)) & (values < min(hi, q))) for p, q in allowed)
+
+
 def stable_fold_stretches(curve: np.ndarray, folds: dict[float, list[tuple[float, bool]]],
                           tolerance: float) -> list[np.ndarray]:
     """The stretches of the fold-of-cycles locus ``curve`` (K, 2) that bound stable cycles.
 
     Where the locus crosses a slice (second parameter = a key of ``folds``), the slice's
-    fold within ``tolerance`` of the crossing says whether stable cycles lie beside it. Between
-    two such verdicts (or one and the locus's end) the locus counts when either says so (the
-    kind of fold may change anywhere between slices), never at a slice whose verdict is no;
-    a locus that meets no slice fold is kept whole (nothing known)."""
+    fold within ``tolerance`` of the crossing says whether stable cycles lie beside it. The
+    locus counts between two yes verdicts and from a yes to the locus's end; between a yes and
+    a no it counts up to the middle of their slices (the edge is not known closer than that:
+    :func:`refined_folds` narrows it); a locus that meets no slice fold is kept whole."""
     verdicts = _fold_verdicts(curve, folds, tolerance)
     if not verdicts:
         return [curve]
-    ends = [(0.0, None), *verdicts, (float(len(curve) - 1), None)]
+    ends = [(0.0, 0.0, None), *verdicts, (float(len(curve) - 1), 0.0, None)]
     pieces: list[list[float]] = []
-    for (a, yes_a), (b, yes_b) in zip(ends[:-1], ends[1:], strict=True):
-        if b > a and (yes_a or yes_b):
-            lo, hi = a + 1e-9 * (yes_a is False), b - 1e-9 * (yes_b is False)
-            if pieces and pieces[-1][1] == lo:
-                pieces[-1][1] = hi
-            else:
-                pieces.append([lo, hi])
+    for (a, value_a, yes_a), (b, value_b, yes_b) in zip(ends[:-1], ends[1:], strict=True):
+        if b <= a or not (yes_a or yes_b):
+            continue
+        if False in (yes_a, yes_b):
+            edge = _crossing_within(curve, a, b, 0.5 * (value_a + value_b))
+            a, b = (edge, b) if yes_a is False else (a, edge)
+        if pieces and pieces[-1][1] == a:
+            pieces[-1][1] = b
+        else:
+            pieces.append([a, b])
     return [_between(curve, lo, hi) for lo, hi in pieces]
+
+
+def disagreeing(curve: np.ndarray, folds: dict[float, list[tuple[float, bool]]],
+                tolerance: float) -> list[Interval]:
+    """Pairs of slice values (second parameter) between which the verdicts of ``folds`` on the
+    fold-of-cycles locus ``curve`` change, in order along the locus."""
+    verdicts = _fold_verdicts(curve, folds, tolerance)
+    return [(a, b) for (_, a, yes_a), (_, b, yes_b) in zip(verdicts[:-1], verdicts[1:],
+                                                              strict=True) if yes_a != yes_b]
+
+
+def refined_folds(folds: dict[float, list[tuple[float, bool]]], curves: list[np.ndarray],
+                  tolerance: float, step: float,
+                  judge: Callable[[list[float]], dict[float, list[tuple[float, bool]]]]
+                  ) -> dict[float, list[tuple[float, bool]]]:
+    """``folds`` (slice value -> its folds with verdicts) with more slices, bisecting every pair
+    of slices between which a locus of ``curves`` changes verdict until the two lie within
+    ``step``; ``judge(values)`` gives the folds of new slices at ``values`` (by value)."""
+    folds = dict(folds)
+    while True:
+        values = sorted({0.5 * (a + b) for curve in curves
+                         for a, b in disagreeing(curve, folds, tolerance)
+                         if abs(b - a) > step} - set(folds))
+        if not values:
+            return folds
+        folds.update(judge(values))
 
 
 def bounding_ends(curve: np.ndarray, folds: dict[float, list[tuple[float, bool]]],
@@ -199,16 +242,24 @@ def bounding_ends(curve: np.ndarray, folds: dict[float, list[tuple[float, bool]]
     """Whether the first and the last point of the fold-of-cycles locus ``curve`` lie on
     stretches that bound stable cycles (see :func:`stable_fold_stretches`)."""
     verdicts = _fold_verdicts(curve, folds, tolerance)
-    return (verdicts[0][1], verdicts[-1][1]) if verdicts else (True, True)
+    return (verdicts[0][2], verdicts[-1][2]) if verdicts else (True, True)
 
 
 def _fold_verdicts(curve: np.ndarray, folds: dict[float, list[tuple[float, bool]]],
-                   tolerance: float) -> list[tuple[float, bool]]:
-    """(position along ``curve`` in point indices, verdict) at each crossing of a slice of
-    ``folds`` where the slice has a fold within ``tolerance``, in order along the curve."""
-    return sorted((k + w, stable) for value, found in folds.items()
+                   tolerance: float) -> list[tuple[float, float, bool]]:
+    """(position along ``curve`` in point indices, slice value, verdict) at each crossing of a
+    slice of ``folds`` where the slice has a fold within ``tolerance``, in order along the
+    curve."""
+    return sorted((k + w, value, stable) for value, found in folds.items()
                   for k, w, x in _segment_crossings(curve, value)
                   for stable in _matched(found, x, tolerance))
+
+
+def _crossing_within(curve: np.ndarray, a: float, b: float, value: float) -> float:
+    """The first position between ``a`` and ``b`` where ``curve`` crosses second = ``value``
+    (their middle if none)."""
+    inside = [k + w for k, w, _ in _segment_crossings(curve, value) if a <= k + w <= b]
+    return inside[0] if inside else 0.5 * (a + b)
 
 
 def _between(curve: np.ndarray, lo: float, hi: float) -> np.ndarray:
@@ -364,20 +415,36 @@ def loci_curves(curves: list[Branch], amplitudes: np.ndarray | float = 1.0
 
 def boundary(name: str, model: Model, overrides: dict[str, float], pair: tuple[str, str],
              bounds: dict[str, Interval], method: BoundaryMethod, slices: tuple[float, ...],
-             resolution: int, curves: list[Branch], slice_branches: list[tuple[Branch, ...]]
+             resolution: int, curves: list[Branch], slice_branches: list[tuple[Branch, ...]],
+             more_slices: Callable[[list[float]], list[tuple[Branch, ...]]] | None = None
              ) -> Boundary:
     """The unsafe region of a two-parameter continuation, by ``method`` ("loci": on
     ``resolution`` rows across the second parameter's range plus the slices; "slices": on the
-    slices, from their one-parameter branches)."""
+    slices, from their one-parameter branches). ``more_slices(values)``: the branches of
+    slices at ``values``, run where two slices disagree whether a fold-of-cycles locus bounds
+    stable cycles, until the edge is known to a quarter of a row's spacing (without: to
+    the middle of the two)."""
     first, second = pair
     minimum = 1e-3 * (bounds[first][1] - bounds[first][0])  # narrower pieces are round-off
     curves_by_name = loci_curves(curves, np.array(model.typical_amplitudes))
-    folds = {value: slice_folds(branches, [x for curve in curves_by_name.get(LocusKind.HOPF, [])
-                                           for x in crossings(curve, value)])
-             for value, branches in zip(slices, slice_branches, strict=True)}
+    hopfs = curves_by_name.get(LocusKind.HOPF, [])
+
+    def judged(values: list[float], branches: list[tuple[Branch, ...]]
+               ) -> dict[float, list[tuple[float, bool]]]:
+        stable = stable_intervals(model, overrides, first, second, values, bounds[first])
+        return {value: slice_folds(found, [x for curve in hopfs for x in crossings(curve, value)],
+                                   part)
+                for value, found, part in zip(values, branches, stable, strict=True)}
+
+    folds = judged(list(slices), slice_branches)
     if method == BoundaryMethod.LOCI:
+        fold_curves = curves_by_name.get(LocusKind.FOLD_OF_CYCLES, [])
+        if more_slices is not None:
+            step = 0.25 * (bounds[second][1] - bounds[second][0]) / max(resolution - 1, 1)
+            folds = refined_folds(folds, fold_curves, 10 * minimum, step,
+                                  lambda values: judged(values, more_slices(values)))
         curves_by_name[LocusKind.FOLD_OF_CYCLES] = [
-            stretch for curve in curves_by_name.get(LocusKind.FOLD_OF_CYCLES, [])
+            stretch for curve in fold_curves
             for stretch in stable_fold_stretches(curve, folds, 10 * minimum)]
         rows = sorted(set(np.linspace(*bounds[second], resolution).tolist()) | set(slices))
         candidates = [loci_candidates(curves_by_name, value) for value in rows]

@@ -7,6 +7,7 @@ unsafe region. The study's continuation types (:mod:`whirl_cli.study.continuatio
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable
 from dataclasses import replace
 from typing import Any, NamedTuple
@@ -199,9 +200,20 @@ def continue_two_parameter(stage: Stage, spec) -> tuple[ContinuationResult, Boun
     continuation = replace(continuation, seeds=outcomes)
     per_slice = [tuple(b for b in continuation.branches if on_slice(b.name, k) is not None)
                  for k in range(len(spec.slices))]
+    added = itertools.count(1)
+
+    def more_slices(values: list[float]) -> list[tuple]:
+        """The branches of extra slices at ``values`` (not stored: they only judge folds)."""
+        def run(named: tuple[str, float]) -> tuple:
+            return one_parameter(engine, named[0], pair[0], spec.start, bounds[pair[0]],
+                                 {**parameters, pair[1]: named[1]}, numerics,
+                                 periodic=True).branches
+        named = [(f"{spec.name}.extra_{next(added)}", value) for value in values]
+        return thread_map(run, named, len(named))
+
     found = boundaries.boundary(spec.name, model, parameters, pair, bounds,
-                                BoundaryMethod(spec.method),
-                                spec.slice_values, spec.resolution, curves, per_slice)
+                                BoundaryMethod(spec.method), spec.slice_values,
+                                spec.resolution, curves, per_slice, more_slices)
     return continuation, found
 
 
