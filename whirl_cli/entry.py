@@ -23,6 +23,9 @@ def main() -> None:
         # package's entry points when the first study model is built, about 0.025 s a start)
         os.environ.setdefault("PYDANTIC_DISABLE_PLUGINS", "__all__")
         from .cli import main as run_cli
+        from .runtime import check
+
+        check()  # an interrupt Python dropped while the command line was imported
     except KeyboardInterrupt as error:
         interrupted(error)
     except Exception as error:  # an interrupt Python wrapped (e.g. in a class's __set_name__)

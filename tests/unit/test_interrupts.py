@@ -442,3 +442,30 @@ def test_an_interrupt_wrapped_while_the_command_line_is_imported_ends_whirl_too(
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                           timeout=60, check=False)
     assert (done.returncode, done.stderr) == (143, "interrupted\n")
+
+
+def test_a_sigterm_python_drops_while_the_command_line_is_imported_still_ends_whirl():
+    """The console script's import of the command line (:func:`whirl_cli.entry.main`), here a
+    stand-in module: SIGTERM lands inside a weakref callback the garbage collector runs
+    meanwhile, where Python prints "Exception ignored" and drops the handler's exception,
+    before any :func:`catching` block is in force. The command must not run: exit 143,
+    "interrupted" and nothing else."""
+    import subprocess
+
+    script = ("import gc, os, signal, sys, types, weakref\n"
+              "class Thing: pass\n"
+              "def attribute(name):\n"
+              "    thing = Thing()\n"
+              "    ref = weakref.ref(thing, lambda _r: os.kill(os.getpid(), signal.SIGTERM))\n"
+              "    del thing\n"
+              "    gc.collect()\n"
+              "    assert ref\n"
+              "    return lambda: print('the command ran')\n"
+              "stand_in = types.ModuleType('whirl_cli.cli')\n"
+              "stand_in.__getattr__ = attribute\n"
+              "sys.modules['whirl_cli.cli'] = stand_in\n"
+              "from whirl_cli.entry import main\n"
+              "main()\n")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=60, check=False)
+    assert (done.returncode, done.stdout, done.stderr) == (143, "", "interrupted\n")

@@ -9,7 +9,7 @@ import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
-from .signals import Interrupted
+from .signals import Interrupted, dropped_interrupt
 
 #: The signals whirl handles: held back while worker processes are forked.
 HELD = frozenset({signal.SIGINT, signal.SIGTERM})
@@ -91,10 +91,17 @@ def catching(on_first: Callable[[], None] | None = None) -> Iterator[None]:
 
 def check() -> None:
     """Raise now, in the main thread, an interrupt that a ``__del__`` or weakref callback
-    swallowed inside the innermost :func:`catching` block (a no-op otherwise)."""
-    if _blocks and _blocks[-1].swallowed and \
-            threading.current_thread() is threading.main_thread():
-        raise Interrupted(_blocks[-1].take())
+    swallowed inside the innermost :func:`catching` block, or outside any block after
+    :func:`~.signals.terminate_as_interrupt` (a no-op otherwise)."""
+    if threading.current_thread() is not threading.main_thread():
+        return
+    if _blocks:
+        if _blocks[-1].swallowed:
+            raise Interrupted(_blocks[-1].take())
+        return
+    signum = dropped_interrupt()
+    if signum is not None:
+        raise Interrupted(signum)
 
 
 @contextmanager

@@ -1,15 +1,23 @@
 """The exception SIGINT and SIGTERM raise in whirl, and SIGTERM's handler from the first moment.
 
-Only :mod:`signal` is imported here (and light modules by the package):
+Only :mod:`signal` and :mod:`sys` are imported here (and light modules by the package):
 :func:`whirl_cli.entry.main` installs :func:`raise_interrupted` for SIGTERM before it imports
 anything else, so that a batch system's
 cancel ends whirl as Ctrl-C does (Python's own handler raises KeyboardInterrupt for SIGINT)
-instead of by the signal's default action, however early it lands.
+instead of by the signal's default action, however early it lands. An interrupt Python drops
+(raised inside a ``__del__`` or weakref callback, where it only prints "Exception ignored")
+before any :func:`whirl_cli.runtime.catching` block is in force is kept, and raised by the next
+:func:`whirl_cli.runtime.check` (the console script checks once the command line is imported,
+and every ``catching`` block checks when it begins).
 """
 
 from __future__ import annotations
 
 import signal
+import sys
+
+#: Signal numbers of interrupts Python dropped outside any ``catching`` block, oldest first.
+_dropped: list[int] = []
 
 
 class Interrupted(KeyboardInterrupt):
@@ -46,5 +54,23 @@ def raise_interrupted(signum: int, _frame: object) -> None:
 
 
 def terminate_as_interrupt() -> None:
-    """From now on SIGTERM raises :class:`Interrupted`, as SIGINT raises KeyboardInterrupt."""
+    """From now on SIGTERM raises :class:`Interrupted`, as SIGINT raises KeyboardInterrupt,
+    and an interrupt Python drops is kept for :func:`dropped_interrupt` instead of printed."""
     signal.signal(signal.SIGTERM, raise_interrupted)
+    default = sys.unraisablehook
+
+    def unraisable(hook: sys.UnraisableHookArgs) -> None:
+        if isinstance(hook.exc_value, KeyboardInterrupt):
+            _dropped.append(getattr(hook.exc_value, "signum", signal.SIGINT))
+        else:
+            default(hook)
+
+    sys.unraisablehook = unraisable
+
+
+def dropped_interrupt() -> int | None:
+    """The signal number of the first interrupt Python dropped outside any ``catching`` block
+    since the last call (None: none); forgets them all."""
+    first = _dropped[0] if _dropped else None
+    _dropped.clear()
+    return first
