@@ -422,50 +422,50 @@ def test_an_interrupt_python_wrapped_in_another_exception_ends_whirl_as_an_inter
     assert capsys.readouterr().err == "interrupted\n"
 
 
-def test_an_interrupt_wrapped_while_the_command_line_is_imported_ends_whirl_too():
-    """The console script's import of the command line (:func:`whirl_cli.entry.main`): here
-    a stand-in module whose ``main`` is a class interrupted while it is made."""
+def entry_with_stand_in(attribute: str):
+    """Run the console script (:func:`whirl_cli.entry.main`) in a fresh interpreter with a
+    stand-in for the command line's module: ``attribute``, Python source defining
+    ``attribute(name)``, its module ``__getattr__`` (what ``from .cli import main`` calls)."""
     import subprocess
 
-    script = ("import signal, sys, types\n"
-              "from whirl_cli.runtime import Interrupted\n"
-              "class Interrupting:\n"
-              "    def __set_name__(self, owner, name): raise Interrupted(signal.SIGTERM)\n"
-              "def attribute(name):\n"
-              "    class Model:\n"
-              "        field = Interrupting()\n"
-              "stand_in = types.ModuleType('whirl_cli.cli')\n"
-              "stand_in.__getattr__ = attribute\n"
-              "sys.modules['whirl_cli.cli'] = stand_in\n"
-              "from whirl_cli.entry import main\n"
-              "main()\n")
-    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+    script = (attribute
+              + "import sys, types\n"
+                "stand_in = types.ModuleType('whirl_cli.cli')\n"
+                "stand_in.__getattr__ = attribute\n"
+                "sys.modules['whirl_cli.cli'] = stand_in\n"
+                "from whirl_cli.entry import main\n"
+                "main()\n")
+    return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                           timeout=60, check=False)
+
+
+def test_an_interrupt_wrapped_while_the_command_line_is_imported_ends_whirl_too():
+    """The console script's import of the command line: a stand-in module whose ``main`` is
+    a class interrupted while it is made."""
+    done = entry_with_stand_in(
+        "import signal\n"
+        "from whirl_cli.runtime import Interrupted\n"
+        "class Interrupting:\n"
+        "    def __set_name__(self, owner, name): raise Interrupted(signal.SIGTERM)\n"
+        "def attribute(name):\n"
+        "    class Model:\n"
+        "        field = Interrupting()\n")
     assert (done.returncode, done.stderr) == (143, "interrupted\n")
 
 
 def test_a_sigterm_python_drops_while_the_command_line_is_imported_still_ends_whirl():
-    """The console script's import of the command line (:func:`whirl_cli.entry.main`), here a
-    stand-in module: SIGTERM lands inside a weakref callback the garbage collector runs
-    meanwhile, where Python prints "Exception ignored" and drops the handler's exception,
-    before any :func:`catching` block is in force. The command must not run: exit 143,
-    "interrupted" and nothing else."""
-    import subprocess
-
-    script = ("import gc, os, signal, sys, types, weakref\n"
-              "class Thing: pass\n"
-              "def attribute(name):\n"
-              "    thing = Thing()\n"
-              "    ref = weakref.ref(thing, lambda _r: os.kill(os.getpid(), signal.SIGTERM))\n"
-              "    del thing\n"
-              "    gc.collect()\n"
-              "    assert ref\n"
-              "    return lambda: print('the command ran')\n"
-              "stand_in = types.ModuleType('whirl_cli.cli')\n"
-              "stand_in.__getattr__ = attribute\n"
-              "sys.modules['whirl_cli.cli'] = stand_in\n"
-              "from whirl_cli.entry import main\n"
-              "main()\n")
-    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
-                          timeout=60, check=False)
+    """The console script's import of the command line, a stand-in module: SIGTERM lands
+    inside a weakref callback the garbage collector runs meanwhile, where Python prints
+    "Exception ignored" and drops the handler's exception, before any :func:`catching` block
+    is in force. The command must not run: exit 143, "interrupted" and nothing else."""
+    done = entry_with_stand_in(
+        "import gc, os, signal, weakref\n"
+        "class Thing: pass\n"
+        "def attribute(name):\n"
+        "    thing = Thing()\n"
+        "    ref = weakref.ref(thing, lambda _r: os.kill(os.getpid(), signal.SIGTERM))\n"
+        "    del thing\n"
+        "    gc.collect()\n"
+        "    assert ref\n"
+        "    return lambda: print('the command ran')\n")
     assert (done.returncode, done.stdout, done.stderr) == (143, "", "interrupted\n")
