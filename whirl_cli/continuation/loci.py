@@ -124,11 +124,11 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
                     and same_point(named, other, width, amplitudes)
                     for other, _ in starts):
                 starts.append((named, runs[point.branch]))
-    checked = partial(locus_points, engine.model, pair=pair, parameters=parameters)
-    curves = _loci(engine, name, pair, bounds, numerics, starts, checked,
+    traced = _loci(engine, name, pair, bounds, numerics, starts,
+                   partial(locus_points, engine.model, pair=pair, parameters=parameters),
                    outermost=snaking_folds == "outermost")
-    for curve in curves:
-        points += checked(curve)
+    curves = [curve for curve, _ in traced]
+    points += [point for _, found in traced for point in found]
     return (ContinuationResult(name, ContinuationKind.TWO_PARAMETER, tuple(branches + curves),
                                tuple(points)), curves)
 
@@ -157,11 +157,11 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
           bounds: dict[str, tuple[float, float]], numerics: Numerics,
           starts: list[tuple[SpecialPoint, str]],
           checked: Callable[[Branch], list[SpecialPoint]] | None = None,
-          outermost: bool = False) -> list[Branch]:
+          outermost: bool = False) -> list[tuple[Branch, list[SpecialPoint]]]:
     """Locus branches from the start points, both directions, each locus once (``outermost``:
-    of the folds of cycles of a snaking family only the outermost, :func:`_outermost_folds`;
-    ``checked``: a locus's special points with their verdicts, :func:`locus_points`, whose
-    located codimension-2 points may end a locus).
+    of the folds of cycles of a snaking family only the outermost, :func:`_outermost_folds`),
+    each with its special points after its start as ``checked`` gives them (with their
+    verdicts, :func:`locus_points`; their located codimension-2 points may end a locus).
 
     Starts are taken slice by slice (a wave per slice): a start lying on a locus of its type
     already traced from an earlier slice is the same locus and is not run again, nor is a
@@ -224,10 +224,12 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
         {k: (kind, None, curve) for k, (kind, curve) in enumerate(
             sorted(curves, key=lambda c: c[1].name))}, [], width)[0].values()]
     checked = checked or partial(special_points, skip_first=True)
-    codim2 = [p for c in kept for p in checked(c)
+    found = [(curve, checked(curve)) for curve in kept]
+    codim2 = [p for _, points in found for p in points
               if p.point_type in CODIM2 and p.status == LocateStatus.LOCATED]
     points = tuple(point for point, _ in starts)
-    return [_locus_end(c, codim2, bounds, width, points, numerics.max_steps) for c in kept]
+    return [(_locus_end(c, codim2, bounds, width, points, numerics.max_steps), on_it)
+            for c, on_it in found]
 
 
 def _wave(engine: Engine, pair: tuple[str, str], bounds: dict[str, tuple[float, float]],
