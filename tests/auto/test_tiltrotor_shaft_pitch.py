@@ -1,5 +1,5 @@
 """The tiltrotor gimbal (1.05/rev) with blade pitch held relative to the shaft on the real
-AUTO-07p: study ``studies/gimballed/tiltrotor_shaft_pitch.yaml`` and its model file, every
+AUTO-07p: study ``studies/gimballed/tiltrotor_shaft_pitch.yaml`` (``pitch_on_disc: 0``), every
 critical point against numpy eigenvalues of the strip theory derived in
 tests/gimbal_strip_theory.py, never against whirl's own output.
 """
