@@ -35,7 +35,7 @@ GIMBAL_LAWS = (np.array([0, 0, -0.21, -0.21]), np.array([0, 0, 7.4, 7.4]))
 PITCH_LAWS = (np.array([-10, 0, 0.5, 0.5]), np.array([350, 0, 0, 0]))
 #: whirl's (thesis) frame to the derivation frame of gimbal_strip_theory: psi, beta_z negated
 FRAME = np.array([1, -1, 1, -1, 1, -1, 1, -1], dtype=float)
-#: the onset study's K_beta range, 1.02 and 1.10 per rev (I_d Omega^2 (nu^2 - 1), 2 digits)
+#: K_beta at 1.02 and 1.10 per rev (I_d Omega^2 (nu^2 - 1), 2 digits), the onset study's range
 K_BETA_ENDS = (0.0033, 0.0173)
 
 
@@ -291,8 +291,8 @@ def test_the_onset_loci_are_the_numpy_onset_across_tiltrotor_gimbals(onset_loci)
     of opposite sign (a Hopf point, or past a Bogdanov-Takens point a neutral saddle), a pair on
     the imaginary axis at the locus' period where that is below 5 s (1e-3); each point of a
     branch-point locus has a singular K (its smallest eigenvalue below 1e-5 of its largest).
-    The first onset is flutter at 1.02/rev and divergence at 1.10/rev, both points of the loci
-    (1e-4)."""
+    The first onset is flutter at 1.02/rev and divergence at 1.10/rev, where the loci cross
+    those gimbals (1e-3, interpolated between locus points)."""
     loci = {kind: [b for b in onset_loci.branches if b.name.startswith(kind)]
             for kind in ("hopf", "branch_point")}
     checked = 0
@@ -319,13 +319,22 @@ def test_the_onset_loci_are_the_numpy_onset_across_tiltrotor_gimbals(onset_loci)
     assert all(first < v for v in _roots(_stiffness_determinant, 10.0, 25.0, low))
     divergence = _roots(_stiffness_determinant, 10.0, 25.0, high)[0]
     assert not _hopf_speeds(10.0, divergence, high)
-    ends = {kind: np.concatenate([b.parameters[:, :2] for b in branches])
-            for kind, branches in loci.items()}
     for kind, (v, k_beta) in (("hopf", (first, K_BETA_ENDS[0])),
                               ("branch_point", (divergence, K_BETA_ENDS[1]))):
-        distance = np.abs(ends[kind][:, 0] - v) / v + np.abs(ends[kind][:, 1] - k_beta) / k_beta
-        print(f"\n  {kind} locus end near V = {v:.4f}, K_beta = {k_beta:.5f}: {distance.min():.2e}")
-        assert distance.min() < 1e-4
+        crossings = [_at_k_beta(branch.parameters[:, :2], k_beta) for branch in loci[kind]]
+        crossings = np.concatenate(crossings)
+        print(f"\n  {kind} locus at K_beta = {k_beta}: V = {np.round(crossings, 5)}; "
+              f"numpy {v:.5f}")
+        assert np.min(np.abs(crossings - v)) < 1e-3 * v
+
+
+def _at_k_beta(points: np.ndarray, k_beta: float) -> np.ndarray:
+    """V where the locus through ``points`` (rows V, K_beta) crosses or touches ``k_beta``,
+    linearly interpolated."""
+    v, k = points[:, 0], points[:, 1] - k_beta
+    found = [v[i] if k[i] == 0 else v[i] + (v[i + 1] - v[i]) * k[i] / (k[i] - k[i + 1])
+             for i in range(len(k) - 1) if k[i] * k[i + 1] <= 0 and k[i] != k[i + 1]]
+    return np.array(found + ([v[-1]] if k[-1] == 0 else []))
 
 
 def _benettin(v: float, transient: float, steps: int, laws=PITCH_LAWS) -> float:
