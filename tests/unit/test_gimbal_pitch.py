@@ -1,9 +1,10 @@
 """How the gimballed rotor holds blade pitch, checked against strip theory derived here
-(tests/gimbal_strip_theory.py): the built-in ``gimballed`` model is the derivation with blade
-pitch held relative to the tilted disc; ``studies/gimballed/tiltrotor_shaft_pitch.model.yaml``
-the one with pitch held relative to the shaft (a swashplate's pitch links, delta3 = 0). Only
-the second has the rotating frame's flap damping, and only the first has the low-speed flutter
-of the gimbal's low-frequency mode at tiltrotor gimbals (1.02-1.10/rev).
+(tests/gimbal_strip_theory.py): the built-in ``gimballed`` model at ``pitch_on_disc = 1`` (the
+datum) is the derivation with blade pitch held relative to the tilted disc, at 0 the one with
+pitch held relative to the shaft (a swashplate's pitch links, delta3 = 0), in between the linear
+interpolation of the two. Only the shaft pitch has the rotating frame's flap damping, and only
+the disc pitch the low-speed flutter of the gimbal's low-frequency mode at tiltrotor gimbals
+(1.02-1.10/rev).
 """
 
 from __future__ import annotations
@@ -15,14 +16,15 @@ import pytest
 import sympy as sp
 from scipy.optimize import brentq
 
-from tests.conftest import ROOT
 from tests.gimbal_strip_theory import A_LEVER, MU, aerodynamic, matrices
 from tests.gimballed_exact import DATUM
 from whirl_cli.analysis import linear
-from whirl_cli.models import get_model, load_model_file
+from whirl_cli.models import get_model
 from whirl_cli.models.symbolic import Symbolic
 
-SHAFT_FILE = ROOT / "studies" / "gimballed" / "tiltrotor_shaft_pitch.model.yaml"
+MODEL = get_model("gimballed")
+#: the parameter that holds blade pitch on the shaft
+SHAFT = {"pitch_on_disc": 0.0}
 #: whirl's (thesis) frame to the derivation frame: psi and beta_z negated
 FRAME = np.array([1, -1, 1, -1], dtype=float)
 #: K_beta of a gimbal at nu per rev: I_d Omega^2 (nu^2 - 1), the datum I_d and Omega
@@ -36,10 +38,6 @@ FEATHERING[0:2, 2:4] = FEATHERING[2, 3] = FEATHERING[3, 2] = True
 CASES = [{"V": 0.5}, {"V": 6.7, "K_beta": 0.01}, {"V": 15.0},
          {"V": 4.0, "a": 0.4, "c": 0.03, "R": 0.17, "Omega": 55.0, "rho": 1.1, "N": 3.0,
           "I_x": 0.00012, "I_d": 0.00006, "K_beta": 0.5, "C_beta": 0.002}]
-
-
-def _shaft_model():
-    return get_model(load_model_file(SHAFT_FILE))
 
 
 @cache
@@ -73,8 +71,7 @@ def test_the_built_in_model_is_the_derivation_with_pitch_held_on_the_tilted_disc
     """Every stiffness and damping term of every row of the built-in model equals strip theory
     with pitch relative to the tilted disc (1e-9 of the row's largest term); the shaft-pitch
     derivation differs from it in exactly the terms the blades' feathering touches."""
-    model = get_model("gimballed")
-    generated = _model_terms(model, values)
+    generated = _model_terms(MODEL, values)
     disc, shaft = _derived_terms(values, False), _derived_terms(values, True)
     scale = np.abs(disc).max(axis=1, keepdims=True)
     np.testing.assert_allclose(generated / scale, disc / scale, rtol=0, atol=1e-9)
@@ -83,12 +80,17 @@ def test_the_built_in_model_is_the_derivation_with_pitch_held_on_the_tilted_disc
 
 
 @pytest.mark.parametrize("values", CASES)
-def test_the_shaft_pitch_model_file_is_the_derivation_with_pitch_held_on_the_shaft(values):
-    """The model file's terms equal strip theory with pitch relative to the shaft (1e-9)."""
-    generated = _model_terms(_shaft_model(), values)
-    shaft = _derived_terms(values, True)
+def test_pitch_on_disc_0_is_the_derivation_with_pitch_held_on_the_shaft(values):
+    """At pitch_on_disc = 0 the model's terms equal strip theory with pitch relative to the
+    shaft (1e-9); at 1 (given or the datum) the disc's, and at 0.3 the linear interpolation
+    0.3 disc + 0.7 shaft of the two derivations."""
+    disc, shaft = _derived_terms(values, False), _derived_terms(values, True)
     scale = np.abs(shaft).max(axis=1, keepdims=True)
-    np.testing.assert_allclose(generated / scale, shaft / scale, rtol=0, atol=1e-9)
+    for fraction in (0.0, 0.3, 1.0):
+        generated = _model_terms(MODEL, {**values, "pitch_on_disc": fraction})
+        expected = fraction * disc + (1 - fraction) * shaft
+        np.testing.assert_allclose(generated / scale, expected / scale, rtol=0, atol=1e-9)
+    assert MODEL.parameter("pitch_on_disc").default == 1.0
 
 
 def test_the_two_derivations_differ_by_the_feathering_of_the_blades():
@@ -111,8 +113,8 @@ def test_at_hover_the_shaft_pitch_gimbal_has_the_rotating_frames_flap_damping():
     """V = 0, nacelle held (K_theta = K_psi = 1e9): the rotating frame's flap equation
     b'' + (gamma/8) Omega b' + nu^2 Omega^2 b = 0 (Lock number gamma = rho C_l_alpha c R^4 /
     (I_x / N), nu^2 = 1 + K_beta / (I_d Omega^2)) seen from the nacelle puts both gimbal modes
-    at Re = -gamma Omega / 16 and Im = Omega (1 +- sqrt(nu^2 - (gamma/16)^2)). The shaft-pitch
-    model file has them (1e-6); the built-in model's disc pitch does not (its low mode is
+    at Re = -gamma Omega / 16 and Im = Omega (1 +- sqrt(nu^2 - (gamma/16)^2)). The model with
+    pitch on the shaft has them (1e-6); with pitch on the disc it does not (its low mode is
     damped at a third of that rate or less)."""
     v = DATUM
     gamma = v["rho"] * v["C_l_alpha"] * v["c"] * v["R"] ** 4 / (v["I_x"] / v["N"])
@@ -120,9 +122,9 @@ def test_at_hover_the_shaft_pitch_gimbal_has_the_rotating_frames_flap_damping():
     held = {"V": 0.0, "K_theta": 1e9, "K_psi": 1e9, "K_beta": TILTROTOR[nu]}
     rotating = np.sqrt(nu**2 - (gamma / 16) ** 2)
     expected = np.sort(omega * np.array([1 + rotating, abs(1 - rotating)]))
-    for model, textbook in ((_shaft_model(), True), (get_model("gimballed"), False)):
-        values = np.linalg.eigvals(model.jacobian_numpy(np.zeros(8),
-                                                        model.parameter_vector(held)))
+    for pitch, textbook in ((SHAFT, True), ({}, False)):
+        values = np.linalg.eigvals(MODEL.jacobian_numpy(
+            np.zeros(8), MODEL.parameter_vector({**held, **pitch})))
         gimbal = values[(np.abs(values) < 3 * omega) & (values.imag > 0)]
         gimbal = gimbal[np.argsort(gimbal.imag)]
         assert len(gimbal) == 2
@@ -145,15 +147,15 @@ def test_the_low_speed_gimbal_flutter_is_the_disc_pitchs(nu):
     """Tiltrotor gimbal, K_psi = 0.3, eigenvalues of the derived matrices: with pitch on the
     tilted disc the origin is stable at V = 0.05 and loses stability below 1.5 m/s, where the
     built-in model's first critical point lies (1e-6); with pitch on the shaft no eigenvalue
-    has Re >= 0 from 0 to 15 m/s, and the model file's first critical point is the derived
-    first one (1e-6), above 15 m/s."""
+    has Re >= 0 from 0 to 15 m/s, and the model's first critical point at pitch_on_disc = 0 is
+    the derived first one (1e-6), above 15 m/s."""
     values = {"K_psi": 0.3, "K_beta": TILTROTOR[nu]}
     speeds = np.linspace(0.05, 1.5, 30)
     growth = [_growth(v, values, False) for v in speeds]
     assert growth[0] < 0 < growth[-1]
     k = int(np.argmax(np.array(growth) > 0))
     onset = brentq(_growth, speeds[k - 1], speeds[k], args=(values, False), xtol=1e-12)
-    (first, *_) = linear.critical_points(get_model("gimballed"), values, "V", 0.0, 3.0)
+    (first, *_) = linear.critical_points(MODEL, values, "V", 0.0, 3.0)
     assert first.value == pytest.approx(onset, rel=1e-6)
 
     speeds = np.linspace(0.0, 30.0, 601)
@@ -161,5 +163,6 @@ def test_the_low_speed_gimbal_flutter_is_the_disc_pitchs(nu):
     assert (growth[speeds <= 15.0] < 0).all()
     k = int(np.argmax(growth > 0))
     onset = brentq(_growth, speeds[k - 1], speeds[k], args=(values, True), xtol=1e-12)
-    (first, *_) = linear.critical_points(_shaft_model(), values, "V", 0.0, 30.0, points=6001)
+    (first, *_) = linear.critical_points(MODEL, {**values, **SHAFT}, "V", 0.0, 30.0,
+                                         points=6001)
     assert first.value == pytest.approx(onset, rel=1e-6) and onset > 15.0

@@ -87,6 +87,19 @@ def test_hopf_cycle_is_periodic_at_its_closed_form_frequency():
     assert np.abs(motion.section[:, 1] + np.sqrt(mu - level**2)).max() < 1e-4
 
 
+def test_a_cycle_faster_than_the_window_resolves_is_sampled_again_finer():
+    """A 0.92 Hz cycle sampled every 0.6 s (Nyquist 0.83 Hz) reads as 0.75 Hz, its alias; the
+    window's power near its Nyquist frequency has it simulated again finer, and the cycle is
+    periodic at its closed-form frequency (1e-3)."""
+    mu, omega, shear = 1.0, 2 * np.pi, 0.5
+    field, jacobian = hopf(mu, omega, shear)
+    motion = classify(field, jacobian, [0.1, 0.0], transient=20.0, duration=60.0, dt=0.6,
+                      section_state=0)
+    assert motion.kind == "periodic", motion.evidence
+    assert motion.frequencies[0] == pytest.approx((omega - shear * mu) / (2 * np.pi), rel=1e-3)
+    assert "finer" in motion.evidence
+
+
 def test_a_cycle_not_yet_reached_is_periodic_and_said_unsettled():
     # attraction at -2 mu = -0.1 1/s: after 10 s the radius is still 0.16 of the cycle's 0.224
     field, jacobian = hopf(0.05, 2 * np.pi, 0.0)
