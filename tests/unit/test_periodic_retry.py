@@ -4,10 +4,18 @@ the finer mesh too, not back on the coarse one where it failed."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from whirl_cli.continuation.engine import RunSpec
-from whirl_cli.continuation.periodic import FamilySide, _retry, _segment_constants
+from whirl_cli.continuation.periodic import (
+    MAX_REFINEMENTS,
+    FamilySide,
+    _next_segment,
+    _retry,
+    _segment_constants,
+)
 from whirl_cli.results import Branch, BranchKind, Origin, PointType, RunStatus
 
 ROWS = 6
@@ -42,3 +50,42 @@ def test_a_retried_family_keeps_its_finer_mesh_for_its_later_segments():
     family.pieces.append(_piece(RunStatus.MX))  # and failed again further on: finer still
     again = _retry(family, family.pieces[-1])
     assert (again.constants["NTST"], again.constants["DSMAX"]) == (160, 0.0025)
+
+
+def _family() -> FamilySide:
+    constants = {"NTST": 40, "DSMAX": 0.01, "DS": 0.001, "UZSTOP": {}}
+    return FamilySide("periodic_1", 0.2, RunSpec("a/periodic_1.0", constants,
+                                                 BranchKind.PERIODIC, Origin("test"), ("V",)), [])
+
+
+def _unlabelled_failure() -> Branch:
+    """A retry that failed (MX) before AUTO labelled any point of it."""
+    piece = _piece(RunStatus.MX)
+    return replace(piece, label=np.zeros(ROWS, int), runs=("a.periodic_1.1r1",))
+
+
+def test_a_retry_that_fails_before_its_first_label_restarts_further_back():
+    family = _family()
+    family.pieces.append(_piece(RunStatus.MX))
+    first = _retry(family, family.pieces[-1])
+    assert first.restart == ("a.periodic_1.0", 2) and len(family.pieces[-1]) == 4
+    family.pieces.append(_unlabelled_failure())
+    again = _retry(family, family.pieces[-1])
+    # the failed retry is dropped; the family restarts from the label before label 2
+    assert again is not None and again.restart == ("a.periodic_1.0", 1)
+    assert len(family.pieces) == 1 and len(family.pieces[-1]) == 1
+    assert again.constants["NTST"] == 160
+
+
+def test_failures_far_apart_each_get_their_retries_up_to_a_total():
+    family = _family()
+    family.pieces.append(_piece(RunStatus.OK))
+    retried = []
+    for _ in range(MAX_REFINEMENTS + 1):
+        family.pieces.append(_piece(RunStatus.MX))
+        retried.append(_next_segment(family, None, [], 0.0))
+        family.pieces.append(_piece(RunStatus.OK))
+        family.retries = 0  # the retry reached the next fold: _next_segment's new count
+    assert all(run is not None for run in retried[:MAX_REFINEMENTS])
+    assert retried[-1] is None  # the mesh is not refined without end
+    assert family.refinements == MAX_REFINEMENTS

@@ -45,9 +45,12 @@ PERIOD_CAP = 25.0
 ORBIT_EVERY = 20
 #: A family is continued fold by fold (AUTO stops at each fold of cycles); at most this many.
 MAX_SEGMENTS = 24
-#: After MX, a family is restarted with a finer mesh and smaller steps at most this often
-#: (each time twice the mesh intervals and half the largest step, kept for its later segments).
+#: After MX, a family is restarted with a finer mesh and smaller steps at most this often in a
+#: row (each time twice the mesh intervals and half the largest step, kept for its later
+#: segments); a segment that ends without MX starts the count again ...
 MAX_RETRIES = 2
+#: ... up to this many retries in all (the mesh grows 2**MAX_REFINEMENTS times at most).
+MAX_REFINEMENTS = 3
 #: A family that came back onto its own Hopf point is computed again with this many times
 #: the mesh intervals.
 RETRACE_MESH_FACTOR = 2
@@ -96,6 +99,7 @@ class FamilySide:
     hopf: int | None = None
     grows: bool = False
     retries: int = 0
+    refinements: int = 0
 
 
 def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[float, float],
@@ -133,7 +137,7 @@ def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
     # On too coarse a mesh AUTO can turn back along a family of long orbits and retrace it to
     # its own Hopf point (combined case 5 at 40 mesh intervals): such families are computed
     # once more on a finer mesh, kept if they then do not come back
-    again = [replace(f, pieces=[], retries=0, spec=replace(
+    again = [replace(f, pieces=[], retries=0, refinements=0, spec=replace(
         f.spec, name=f"{name}/{f.name}m.0",
         constants=dict(f.spec.constants, NTST=RETRACE_MESH_FACTOR * f.spec.constants["NTST"])))
         for f in families.values() if _back_at_own_hopf(f, hopfs, width, scale)]
@@ -398,9 +402,11 @@ def _next_segment(family: FamilySide, model: Model, hopfs: list[SpecialPoint],
                   width: float) -> RunSpec | None:
     """The run continuing ``family`` after its last piece, or None if the family has ended."""
     piece = family.pieces[-1]
+    if piece.status == RunStatus.MX:
+        return _retry(family, piece) if family.retries < MAX_RETRIES and \
+            family.refinements < MAX_REFINEMENTS else None
+    family.retries = 0
     scale = np.asarray(model.state_scale, dtype=float)
-    if piece.status == RunStatus.MX and family.retries < MAX_RETRIES:
-        return _retry(family, piece)
     if not len(piece) or piece.status != RunStatus.OK or len(family.pieces) >= MAX_SEGMENTS:
         return None
     last = PointType(int(piece.point_type[-1]))
@@ -444,13 +450,19 @@ def _columns(family: FamilySide) -> tuple[np.ndarray, np.ndarray]:
 
 def _retry(family: FamilySide, piece: Branch) -> RunSpec | None:
     """After MX (no convergence): restart from the last good labelled point of the piece with
-    twice the mesh intervals and half the largest step; the piece is cut back to that point."""
-    labelled = [k for k in np.flatnonzero(piece.label) if piece.point_type[k] != PointType.MX]
-    if not labelled or global_bifurcations.in_blowup(piece, family.period):
+    twice the mesh intervals and half the largest step; the piece is cut back to that point.
+    A retry that failed before its first label is dropped and the family restarts from the
+    label before the one that retry started from."""
+    row = _last_good_label(piece, len(piece))
+    if row is None and family.retries and len(family.pieces) > 1:
+        family.pieces.pop()
+        piece = family.pieces[-1]
+        row = _last_good_label(piece, len(piece) - 1)
+    if row is None or global_bifurcations.in_blowup(piece, family.period):
         return None
-    row = int(labelled[-1])
     family.pieces[-1] = head(piece, row + 1)
     family.retries += 1
+    family.refinements += 1
     # the family keeps the finer mesh for its later segments: back on the coarse one, the
     # next segment fails where the last one did
     first = family.spec.constants
@@ -460,6 +472,13 @@ def _retry(family: FamilySide, piece: Branch) -> RunSpec | None:
                    f"{len(family.pieces)}r{family.retries}",
                    constants=_segment_constants(family),
                    restart=(piece.runs[-1], int(piece.label[row])), data=None)
+
+
+def _last_good_label(piece: Branch, before: int) -> int | None:
+    """The last row before ``before`` of ``piece`` with a label that is no MX point."""
+    rows = [k for k in np.flatnonzero(piece.label[:before])
+            if piece.point_type[k] != PointType.MX]
+    return int(rows[-1]) if rows else None
 
 
 def _periodic_end(family: Branch, model: Model, hopfs: list[SpecialPoint],
