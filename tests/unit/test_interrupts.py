@@ -397,6 +397,35 @@ def test_an_interrupted_command_says_interrupted_on_one_line(monkeypatch, capsys
     assert capsys.readouterr().err == "interrupted\n"
 
 
+def test_an_interrupt_a_library_turned_into_its_own_error_ends_whirl_as_an_interrupt(
+        monkeypatch, capsys):
+    """Seen as "internal error: SchemaError: Error building "literal" validator: Interrupted:
+    SIGTERM" for a SIGTERM early in ``whirl figures``: pydantic-core's compiled code catches
+    the interrupt raised inside a call back into Python and raises its own error, with no
+    cause. The signal reached whirl's handler, so: exit 143 and "interrupted"."""
+    from whirl_cli import cli
+    from whirl_cli.runtime import signals
+
+    monkeypatch.setattr(signals, "_delivered", [])
+
+    def command(**_options):
+        previous = signal.signal(signal.SIGTERM, signals.raise_interrupted)
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(5)  # the handler raises before this ends
+        except KeyboardInterrupt:
+            pass  # what the compiled code does with it
+        finally:
+            signal.signal(signal.SIGTERM, previous)
+        raise RuntimeError('Error building "literal" validator: Interrupted: SIGTERM')
+
+    monkeypatch.setattr(cli.cli, "main", command)
+    with pytest.raises(SystemExit) as ended:
+        cli.main()
+    assert ended.value.code == 128 + signal.SIGTERM
+    assert capsys.readouterr().err == "interrupted\n"
+
+
 class _Interrupting:
     """A descriptor whose ``__set_name__`` is interrupted (as by a signal while a class such as
     a pydantic model is made): Python 3.11 wraps the interrupt in a RuntimeError."""

@@ -9,7 +9,7 @@ import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
-from .signals import Interrupted, dropped_interrupt
+from .signals import Interrupted, delivered, dropped_interrupt
 
 #: The signals whirl handles: held back while worker processes are forked.
 HELD = frozenset({signal.SIGINT, signal.SIGTERM})
@@ -57,13 +57,14 @@ def catching(on_first: Callable[[], None] | None = None) -> Iterator[None]:
     block = _Block()
 
     def handler(signum: int, frame: object) -> None:
+        interrupt = delivered(signum)
         first = not block.pending
         block.pending.append(signum)
         if first and on_first is not None:
             on_first()
         if first or block.swallowed:
             block.swallowed.clear()
-            raise Interrupted(signum)
+            raise interrupt
 
     def unraisable(hook: sys.UnraisableHookArgs) -> None:  # the "Exception ignored" print
         if isinstance(hook.exc_value, Interrupted):  # ours: raised again (see above)

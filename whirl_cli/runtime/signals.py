@@ -1,14 +1,14 @@
-"""The exception SIGINT and SIGTERM raise in whirl, and SIGTERM's handler from the first moment.
+"""The exception SIGINT and SIGTERM raise in whirl, and their handler from the first moment.
 
 Only :mod:`signal` and :mod:`sys` are imported here (and light modules by the package):
-:func:`whirl_cli.entry.main` installs :func:`raise_interrupted` for SIGTERM before it imports
-anything else, so that a batch system's
-cancel ends whirl as Ctrl-C does (Python's own handler raises KeyboardInterrupt for SIGINT)
-instead of by the signal's default action, however early it lands. An interrupt Python drops
-(raised inside a ``__del__`` or weakref callback, where it only prints "Exception ignored")
-before any :func:`whirl_cli.runtime.catching` block is in force is kept, and raised by the next
-:func:`whirl_cli.runtime.check` (the console script checks once the command line is imported,
-and every ``catching`` block checks when it begins).
+:func:`whirl_cli.entry.main` installs :func:`raise_interrupted` for SIGINT and SIGTERM before
+it imports anything else, so that a batch system's cancel ends whirl as Ctrl-C does instead of
+by the signal's default action, however early it lands; every signal a handler of whirl's
+receives is noted, so that an error a library made of the interrupt is still taken as one. An
+interrupt Python drops (raised inside a ``__del__`` or weakref callback, where it only prints
+"Exception ignored") before any :func:`whirl_cli.runtime.catching` block is in force is kept,
+and raised by the next :func:`whirl_cli.runtime.check` (the console script checks once the
+command line is imported, and every ``catching`` block checks when it begins).
 """
 
 from __future__ import annotations
@@ -18,6 +18,8 @@ import sys
 
 #: Signal numbers of interrupts Python dropped outside any ``catching`` block, oldest first.
 _dropped: list[int] = []
+#: Signal numbers of the SIGINTs and SIGTERMs whirl's handlers received, oldest first.
+_delivered: list[int] = []
 
 
 class Interrupted(KeyboardInterrupt):
@@ -38,24 +40,36 @@ class Interrupted(KeyboardInterrupt):
 def wrapped_interrupt(error: BaseException) -> KeyboardInterrupt | None:
     """The interrupt that caused ``error`` (its ``__cause__`` or ``__context__``, at any
     depth), if any: Python turns an interrupt raised inside some of its hooks into another
-    exception (3.11: a RuntimeError for one inside ``__set_name__``)."""
+    exception (3.11: a RuntimeError for one inside ``__set_name__``). An error with no
+    interrupt behind it, once whirl has raised one, is taken as that interrupt's doing too:
+    libraries' compiled code turns an exception raised inside a call back into Python into
+    its own error without a cause (pydantic-core: a SchemaError "Error building ...
+    validator: Interrupted: SIGTERM" while a model's validator is built)."""
     seen: set[int] = set()
     while error is not None and id(error) not in seen:
         if isinstance(error, KeyboardInterrupt):
             return error
         seen.add(id(error))
         error = error.__cause__ or error.__context__
-    return None
+    return Interrupted(_delivered[-1]) if _delivered else None
+
+
+def delivered(signum: int) -> Interrupted:
+    """Note that a handler of whirl's received ``signum``; its :class:`Interrupted`."""
+    _delivered.append(int(signum))
+    return Interrupted(signum)
 
 
 def raise_interrupted(signum: int, _frame: object) -> None:
     """A signal handler: raise :class:`Interrupted` for ``signum``."""
-    raise Interrupted(signum)
+    raise delivered(signum)
 
 
 def terminate_as_interrupt() -> None:
-    """From now on SIGTERM raises :class:`Interrupted`, as SIGINT raises KeyboardInterrupt,
-    and an interrupt Python drops is kept for :func:`dropped_interrupt` instead of printed."""
+    """From now on SIGINT and SIGTERM raise :class:`Interrupted` (a KeyboardInterrupt, as
+    Python's SIGINT handler raises), and an interrupt Python drops is kept for
+    :func:`dropped_interrupt` instead of printed."""
+    signal.signal(signal.SIGINT, raise_interrupted)
     signal.signal(signal.SIGTERM, raise_interrupted)
     default = sys.unraisablehook
 
