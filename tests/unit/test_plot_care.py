@@ -576,3 +576,41 @@ def test_a_point_whirl_rejected_gets_no_marker_in_a_study_plot_or_a_sheet_panel(
     draw(result, "bifurcation", ax)
     assert _torus_markers(ax) == 1
     plt.close(figure)
+
+
+def _veering_sweep():
+    """Two oscillatory modes along V in 0-20 m/s: one stays a damped gimbal FW mode, the other
+    starts as a nacelle FW mode, its energy passing to the gimbal from 14 m/s and its whirl
+    turning BW from 15.5 m/s; its damping ratio crosses zero at 16 m/s (flutter)."""
+    from whirl_cli.results import LinearSweep
+
+    values = np.linspace(0.0, 20.0, 81)
+    zeta = np.column_stack([0.05 + 0 * values, 0.1 - 0.1 * values / 16.0])
+    freq = np.column_stack([80.0 + 0 * values, 50.0 - 2.0 * values])
+    roots = freq * (-zeta + 1j * np.sqrt(1 - zeta ** 2))
+    eigenvalues = np.column_stack([roots[:, 1], np.conj(roots[:, 1]),
+                                   roots[:, 0], np.conj(roots[:, 0])])
+    group = np.where(values < 14.0, "nacelle", "gimbal")
+    whirl = np.where(values < 15.5, "FW", "BW")
+    groups = np.column_stack([group, group, ["gimbal"] * 81, ["gimbal"] * 81])
+    whirls = np.column_stack([whirl, whirl, ["FW"] * 81, ["FW"] * 81])
+    return LinearSweep("V", "m/s", values, eigenvalues, -eigenvalues.real / np.abs(eigenvalues),
+                       np.abs(eigenvalues.imag), whirls.astype(object), groups.astype(object))
+
+
+def test_a_linear_sweep_legend_names_the_modes_as_stored_along_them_and_at_the_onset():
+    """The mode that flutters was a nacelle mode for most of the sweep but is stored as the
+    gimbal BW mode where it goes unstable: the legend names every stored label along its
+    line (not the majority alone) and the label stored at the onset."""
+    from whirl_cli.plots.linear import linear_sweep_plot
+
+    sweep = _veering_sweep()
+    ax_freq, ax_damp = linear_sweep_plot(sweep).axes
+    texts = [t.get_text() for t in ax_freq.get_legend().get_texts()]
+    (fluttering,) = [line.get_label() for line in ax_freq.lines
+                     if line.get_label() in texts and line.get_linewidth() > 1.5]
+    for label in ("nacelle", "gimbal", "FW", "BW"):
+        assert label in fluttering
+    (onset,) = [text for text in texts if text.startswith("damping ratio 0")]
+    assert "V = 16 m/s" in onset and onset.endswith("gimbal BW)")
+    assert "gimbal FW" in texts  # a mode stored alike all along keeps its one label
