@@ -614,3 +614,42 @@ def test_a_linear_sweep_legend_names_the_modes_as_stored_along_them_and_at_the_o
     (onset,) = [text for text in texts if text.startswith("damping ratio 0")]
     assert "V = 16 m/s" in onset and onset.endswith("gimbal BW)")
     assert "gimbal FW" in texts  # a mode stored alike all along keeps its one label
+
+
+def _cluster_bars(ax) -> list[tuple[np.ndarray, float]]:
+    """The span bars of fold clusters on ``ax`` as (ends in display coordinates, line width
+    [points]): an error bar's vertical segment, or a capped line of two vertices at one x."""
+    from matplotlib.container import ErrorbarContainer
+
+    bars = []
+    for container in ax.containers:
+        if isinstance(container, ErrorbarContainer):
+            for segments in container.lines[2]:
+                for segment in segments.get_segments():
+                    bars.append((ax.transData.transform(segment),
+                                 float(segments.get_linewidth()[0])))
+    for line in ax.lines:
+        xy = line.get_xydata()
+        if (len(xy) == 2 and np.ptp(xy[:, 0]) == 0.0 and line.get_marker() == "_"
+                and line.get_linestyle() not in ("None", "none", "")):
+            bars.append((line.get_transform().transform(xy), line.get_linewidth()))
+    return bars
+
+
+def test_a_cluster_bar_leaves_the_family_curve_beside_it_in_view():
+    """A snaking family runs up and down the span of its folds: the cluster's bar is drawn
+    beside the curve, clear of it by the half widths of both lines, not over it."""
+    from whirl_cli.plots.blowup import blowup_plot
+    from whirl_cli.plots.diagrams import period_plot
+
+    continuation = _snaking_family(6)
+    for ax in (period_plot(continuation).axes[0], blowup_plot(continuation).axes[0]):
+        ax.figure.canvas.draw()
+        ((ends, width),) = _cluster_bars(ax)
+        curves = [line for line in ax.lines if line.get_marker() in ("None", "", None)]
+        per_point = ax.figure.dpi / 72.0
+        for curve in curves:
+            xy = curve.get_transform().transform(curve.get_xydata())
+            beside = xy[(xy[:, 1] >= ends[:, 1].min()) & (xy[:, 1] <= ends[:, 1].max())]
+            clear = 0.5 * (curve.get_linewidth() + width) * per_point
+            assert (np.abs(beside[:, 0] - ends[0, 0]) > clear).all()

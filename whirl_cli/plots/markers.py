@@ -92,34 +92,50 @@ def _cluster_key(cluster: list[Mark]) -> tuple:
     return len(cluster), f"{cluster[0].x:.9g}", f"{min(ys):.9g}", f"{max(ys):.9g}"
 
 
+#: The gap [points] between a cluster's outermost fold and its bar beside the curve.
+BAR_GAP = 6.0
+
+
 def draw_cluster(ax: Axes, cluster: list[Mark], first: dict, left: bool = False) -> Line2D:
     """One fold marker at the cluster's first fold, a capped bar over the values of all its
-    folds, and their count beside the bar (on its ``left`` or right); the marker's line."""
+    folds beside the family's curve (:data:`BAR_GAP` points right of its rightmost fold, or
+    left of its leftmost if ``left``: the curve snakes between its folds, so it stays in
+    view), and their count beyond the bar; the marker's line."""
+    from matplotlib.transforms import ScaledTranslation
+
     anchor = cluster[0]
+    xs = np.array([m.x for m in cluster])
     ys = np.array([m.y for m in cluster])
     low, high = float(ys.min()), float(ys.max())
+    side = -1.0 if left else 1.0
+    edge = float(xs.min() if left else xs.max())
     style = PLOT_KEY["fold"]
-    bar = ax.errorbar([anchor.x], [anchor.y], yerr=[[anchor.y - low], [high - anchor.y]],
-                      fmt="o", markersize=8.0, markerfacecolor=style["markerfacecolor"],
-                      markeredgecolor=style["markeredgecolor"], ecolor=BLACK,
-                      elinewidth=1.2, capsize=4, zorder=3, label="_fold cluster")
-    ax.annotate(f"\u00d7{len(cluster)}", xy=(anchor.x, (low + high) / 2),
-                xytext=(-6 if left else 6, 0), textcoords="offset points",
+    (marker,) = ax.plot([anchor.x], [anchor.y], marker="o", markersize=8.0, linestyle="none",
+                        markerfacecolor=style["markerfacecolor"],
+                        markeredgecolor=style["markeredgecolor"], zorder=3,
+                        label="_fold cluster")
+    beside = ax.transData + ScaledTranslation(side * BAR_GAP / 72.0, 0.0,
+                                              ax.figure.dpi_scale_trans)
+    ax.plot([edge, edge], [low, high], color=BLACK, linewidth=1.2, marker="_",
+            markersize=8.0, markeredgewidth=1.2, zorder=3, transform=beside,
+            label="_fold cluster span")
+    ax.annotate(f"\u00d7{len(cluster)}", xy=(edge, (low + high) / 2),
+                xytext=(side * (BAR_GAP + 4.0), 0), textcoords="offset points",
                 ha="right" if left else "left", va="center", fontsize="x-small", zorder=6,
                 bbox={"boxstyle": "round,pad=0.1", "facecolor": "white", "edgecolor": "none",
                       "alpha": 0.8})  # legible over a marker beside it
     first.setdefault(CLUSTER, _cluster_handle())
-    return bar.lines[0]
+    return marker
 
 
 def _cluster_handle():
-    """The legend's picture of a cluster: a fold's dot on a capped bar."""
+    """The legend's picture of a cluster: a fold's dot with a capped bar beside it."""
     from matplotlib.lines import Line2D
     from matplotlib.path import Path
 
-    circle = Path.circle((0.0, 0.0), 0.42)
-    bar = Path([(0.0, -1.0), (0.0, 1.0), (-0.35, 1.0), (0.35, 1.0), (-0.35, -1.0),
-                (0.35, -1.0)], [Path.MOVETO, Path.LINETO] * 3)
+    circle = Path.circle((-0.45, 0.0), 0.42)
+    bar = Path([(0.45, -1.0), (0.45, 1.0), (0.2, 1.0), (0.7, 1.0), (0.2, -1.0),
+                (0.7, -1.0)], [Path.MOVETO, Path.LINETO] * 3)
     return Line2D([], [], marker=Path.make_compound_path(circle, bar), markersize=13,
                   markerfacecolor=BLACK, markeredgecolor=BLACK, markeredgewidth=1.2,
                   linestyle="none")
