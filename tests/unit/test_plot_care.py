@@ -653,3 +653,52 @@ def test_a_cluster_bar_leaves_the_family_curve_beside_it_in_view():
             beside = xy[(xy[:, 1] >= ends[:, 1].min()) & (xy[:, 1] <= ends[:, 1].max())]
             clear = 0.5 * (curve.get_linewidth() + width) * per_point
             assert (np.abs(beside[:, 0] - ends[0, 0]) > clear).all()
+
+
+def _overhang_under_a_marker():
+    """A subcritical Hopf point at K1 = 0.3 whose family folds at 0.38 (the overhang
+    0.3-0.38), and a period-doubling point at the top of the data in the band's middle."""
+    from whirl_cli.results import ContinuationResult, Criticality
+
+    from .plot_data import make_point
+
+    equilibrium = make_branch("main_down", BranchKind.EQUILIBRIUM,
+                              [0.5, 0.4, 0.3, 0.2, 0.1], [0.0] * 5, [1, 1, 0, 0, 0])
+    family = make_branch("periodic_1", BranchKind.PERIODIC, [0.3, 0.33, 0.36, 0.38, 0.34],
+                         [0.0, 0.1, 0.2, 0.25, 0.3], [0, 0, 0, 1, 1])
+    hopf = replace(make_point("main_down", PointType.HB, 0.3, 0.0), index=2,
+                   criticality=Criticality.SUBCRITICAL)
+    fold = replace(make_point("periodic_1", PointType.LPC, 0.38, 0.25), index=3)
+    doubling = replace(make_point("periodic_1", PointType.PD, 0.34, 0.3), index=4)
+    return ContinuationResult("k1", "one-parameter", (equilibrium, family),
+                              (hopf, fold, doubling))
+
+
+def _marker_boxes(ax) -> list:
+    """Each marker of ``ax``'s lines as a box of its size around its centre (display)."""
+    from matplotlib.transforms import Bbox
+
+    per_point = ax.figure.dpi / 72.0
+    boxes = []
+    for line in ax.lines:
+        if line.get_marker() in ("None", "", None, " ") or not line.get_visible():
+            continue
+        half = 0.5 * line.get_markersize() * per_point
+        for x, y in line.get_transform().transform(line.get_xydata()):
+            boxes.append(Bbox([[x - half, y - half], [x + half, y + half]]))
+    return boxes
+
+
+def test_an_overhang_width_label_overlaps_no_marker():
+    from whirl_cli.plots.diagrams import bifurcation_diagram, overhangs
+
+    continuation = _overhang_under_a_marker()
+    assert overhangs(continuation) == [(0.3, 0.38)]
+    ax = bifurcation_diagram(continuation).axes[0]
+    ax.figure.canvas.draw()
+    renderer = ax.figure.canvas.get_renderer()
+    (label,) = [t for t in ax.texts if t.get_text() == "0.08 N m/rad"]
+    box = label.get_window_extent(renderer)
+    assert ax.get_window_extent().contains(box.x0, box.y0)
+    assert ax.get_window_extent().contains(box.x1, box.y1)
+    assert not [m for m in _marker_boxes(ax) if m.overlaps(box)]

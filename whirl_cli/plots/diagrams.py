@@ -27,7 +27,7 @@ from .key import (
     plot_styled,
     stability_curves,
 )
-from .markers import Mark, draw_marks, unstack
+from .markers import Mark, band_label, draw_marks, unstack
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -120,17 +120,16 @@ def _stable_side(branch: Branch | None, index: int, at: float) -> float:
 
 
 def _shade_overhangs(ax: Axes, bands: list[tuple[float, float]], unit: str):
-    """Each band shaded across the axes, its width written at its top; the legend handle."""
+    """Each band shaded across the axes, its width written at its top, or where no marker
+    hides it (:func:`~whirl_cli.plots.markers.band_label`); the legend handle."""
     from matplotlib.patches import Patch
 
     style = BOUNDARY_KEY["unsafe"]
     for low, high in bands:
         ax.axvspan(low, high, color=style["color"], alpha=OVERHANG_ALPHA, linewidth=0,
                    zorder=0)
-        ax.annotate(f"{high - low:.3g} {unit}".strip(), xy=((low + high) / 2, 1.0),
-                    xycoords=("data", "axes fraction"), xytext=(0, -3),
-                    textcoords="offset points", ha="center", va="top", fontsize="small",
-                    annotation_clip=True, in_layout=False)  # inside the axes, or not drawn
+        band_label(ax, f"{high - low:.3g} {unit}".strip(), low, high, fontsize="small",
+                   in_layout=False)  # inside the axes, or not drawn
     return Patch(color=style["color"], alpha=OVERHANG_ALPHA, linewidth=0)
 
 

@@ -4,6 +4,7 @@ one cluster, and markers at one place set apart so that none hides another."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cache
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -215,3 +216,118 @@ def _split_by_shift(ax: Axes, line: Line2D, shifts: np.ndarray) -> None:
         if shift:
             target.set_transform(ax.transData + ScaledTranslation(
                 shift / 72.0, 0.0, ax.figure.dpi_scale_trans))
+
+
+#: The gap [points] between a band's label and the edge of the axes or of the band beside it.
+_LABEL_GAP = 3.0
+
+
+def band_label(ax: Axes, text: str, low: float, high: float, **style):
+    """A label of the band ``low``-``high`` (the x data) inside ``ax``, placed when drawn:
+    at the top in the band's middle, or, if its box would overlap a marker, another text or
+    the legend of ``ax`` there (or, if a clear place is off the curves, a curve), at the
+    first clear place of: the top beside the band (right,
+    left), the bottom (middle, right, left), rows between, from the top down; the first if
+    none is. Returns the annotation."""
+    label = _band_label_class()(text, xy=((low + high) / 2, 1.0),
+                                xycoords=("data", "axes fraction"), xytext=(0, -_LABEL_GAP),
+                                textcoords="offset points", ha="center", va="top",
+                                annotation_clip=True, **style)
+    label.band = (low, high)
+    ax._add_text(label)  # as Axes.annotate adds its annotations
+    return label
+
+
+@cache
+def _band_label_class():
+    """The class of :func:`band_label`'s annotations (made once, matplotlib imported then)."""
+    from matplotlib.text import Annotation
+
+    class BandLabel(Annotation):
+        """An annotation that takes the first clear place of its band when drawn."""
+
+        band = (0.0, 0.0)
+
+        def draw(self, renderer) -> None:
+            if self.get_visible() and self.axes is not None:
+                _place(self, renderer)
+            super().draw(renderer)
+
+    return BandLabel
+
+
+def _place(label, renderer) -> None:
+    """Move ``label`` to the first of its places (:func:`band_label`) inside its axes and
+    clear of their markers, texts and legend: of those, the first off every curve's
+    vertices too, if one is."""
+    ax = label.axes
+    inside = ax.get_window_extent(renderer)
+    obstacles = _obstacles(ax, label, renderer)
+    curves = _curve_points(ax)
+    places = _places(label, renderer, inside)
+    for strict in (True, False):
+        for place in places:
+            _put(label, place)
+            box = label.get_window_extent(renderer)
+            within = (inside.x0 <= box.x0 and box.x1 <= inside.x1 and inside.y0 <= box.y0
+                      and box.y1 <= inside.y1)
+            if not within or any(box.overlaps(other) for other in obstacles):
+                continue
+            if not strict or not box.count_contains(curves):
+                return
+    _put(label, places[0])
+
+
+def _curve_points(ax: Axes) -> np.ndarray:
+    """The vertices of ``ax``'s drawn lines without markers (curves), in display coordinates."""
+    points = [line.get_transform().transform(line.get_xydata()) for line in ax.lines
+              if line.get_visible() and line.get_marker() in ("None", "none", "", " ", None)
+              and len(line.get_xdata())]
+    xy = np.concatenate(points) if points else np.zeros((0, 2))
+    return xy[np.isfinite(xy).all(axis=1)]
+
+
+def _put(label, place: tuple) -> None:
+    (x, y), offset, ha, va = place
+    label.xy = (x, y)
+    label.xyann = offset
+    label.set_horizontalalignment(ha)
+    label.set_verticalalignment(va)
+
+
+def _places(label, renderer, inside) -> list[tuple]:
+    """(xy, offset [points], ha, va) of ``label``'s places in order: rows top, bottom, then
+    between from the top down; in each the band's middle, right of it, left of it."""
+    low, high = label.band
+    _put(label, (((low + high) / 2, 1.0), (0.0, -_LABEL_GAP), "center", "top"))
+    height = label.get_window_extent(renderer).height * 72.0 / label.figure.dpi
+    rows = [(1.0, -_LABEL_GAP, "top"), (0.0, _LABEL_GAP, "bottom")]
+    step = 1
+    span = inside.height * 72.0 / label.figure.dpi
+    while height > 0 and _LABEL_GAP + (step + 1) * height < span - _LABEL_GAP:
+        rows.append((1.0, -_LABEL_GAP - step * height, "top"))
+        step += 1
+    return [((x, y), (dx, dy), ha, va) for y, dy, va in rows
+            for x, dx, ha in (((low + high) / 2, 0.0, "center"), (high, _LABEL_GAP, "left"),
+                              (low, -_LABEL_GAP, "right"))]
+
+
+def _obstacles(ax: Axes, label, renderer) -> list:
+    """The boxes (display) ``label`` must keep clear of: each marker of ``ax``'s lines (its
+    size around its centre), its other visible texts, its legend."""
+    from matplotlib.transforms import Bbox
+
+    per_point = ax.figure.dpi / 72.0
+    boxes = []
+    for line in ax.lines:
+        if not line.get_visible() or line.get_marker() in ("None", "none", "", " ", None):
+            continue
+        half = 0.5 * (line.get_markersize() + line.get_markeredgewidth()) * per_point
+        for x, y in line.get_transform().transform(line.get_xydata()):
+            if np.isfinite(x) and np.isfinite(y):
+                boxes.append(Bbox([[x - half, y - half], [x + half, y + half]]))
+    boxes += [text.get_window_extent(renderer) for text in ax.texts
+              if text is not label and text.get_visible() and text.get_text().strip()]
+    if ax.get_legend() is not None:
+        boxes.append(ax.get_legend().get_window_extent(renderer))
+    return boxes
