@@ -702,3 +702,57 @@ def test_an_overhang_width_label_overlaps_no_marker():
     assert ax.get_window_extent().contains(box.x0, box.y0)
     assert ax.get_window_extent().contains(box.x1, box.y1)
     assert not [m for m in _marker_boxes(ax) if m.overlaps(box)]
+
+
+def test_crowd_is_the_largest_group_of_overlapping_markers():
+    from whirl_cli.plots.markers import CROWD, crowd
+
+    chain = np.column_stack([np.arange(CROWD) * 7.0, np.zeros(CROWD)])  # each touches the next
+    apart = np.array([[200.0, 0.0], [300.0, 0.0], [300.0, 30.0]])
+    centres = np.concatenate([apart, chain])
+    assert crowd(centres, np.full(len(centres), 4.0)).tolist() == list(range(3, 3 + CROWD))
+    assert crowd(centres[:-1], np.full(len(centres) - 1, 4.0)).tolist() == []  # one too few
+    assert crowd(centres, np.full(len(centres), 3.0)).tolist() == []  # 7 apart, 6 across
+
+
+def _crowded_diagram():
+    """A Hopf point feeding a family, and six special points of six kinds within 0.004 of
+    K1 = 0.15 and 0.3 deg of theta on it: together under one marker's size at full scale."""
+    from whirl_cli.results import ContinuationResult
+
+    from .plot_data import hopf_continuation, make_point
+
+    base = hopf_continuation()
+    kinds = (PointType.LPC, PointType.BPC, PointType.PD, PointType.TR, PointType.HOMOCLINIC,
+             PointType.LP)
+    crowd = tuple(make_point("periodic_1", kind, 0.33 + 0.0008 * k, 0.2 + 0.001 * k)
+                  for k, kind in enumerate(kinds))
+    return ContinuationResult(base.name, base.kind, base.branches,
+                              (*base.special_points, *crowd))
+
+
+def test_a_crowded_bifurcation_diagram_gets_a_zoom_panel_that_sets_its_markers_apart():
+    """The study's bifurcation figure of a diagram whose markers crowd has a second panel
+    whose limits hold the crowd, where no marker hides another; an uncrowded one stays one
+    panel."""
+    from whirl_cli.plots.files import study_figures
+
+    from .plot_data import hopf_continuation, result_with
+
+    ((_, figure),) = list(study_figures(result_with(_crowded_diagram(), 0.0),
+                                        ("bifurcation",)))
+    diagram, zoom = [ax for ax in figure.axes if ax.lines]
+    figure.canvas.draw()
+    (x0, x1), (y0, y1) = zoom.get_xlim(), zoom.get_ylim()
+    assert x0 < 0.33 and 0.334 < x1 and y0 < np.degrees(0.2) and np.degrees(0.205) < y1
+    assert x1 - x0 < 0.5 * np.ptp(diagram.get_xlim())
+    assert _hidden_markers(zoom) == []
+    per_point = figure.dpi / 72.0
+    centres = np.concatenate([line.get_transform().transform(line.get_xydata())
+                              for line in zoom.lines if line.get_linestyle() == "None"])
+    inside = centres[_inside(centres, zoom.get_window_extent())]
+    gaps = np.linalg.norm(inside[:, None] - inside[None, :], axis=2)
+    assert (gaps[np.triu_indices(len(inside), 1)] >= 8.0 * per_point).all()
+    ((_, single),) = list(study_figures(result_with(hopf_continuation(), 0.0),
+                                        ("bifurcation",)))
+    assert len([ax for ax in single.axes if ax.lines]) == 1

@@ -1,5 +1,6 @@
 """Special-point markers of the one-parameter plots: the folds of a snaking family drawn as
-one cluster, and markers at one place set apart so that none hides another."""
+one cluster, markers at one place set apart so that none hides another, the crowd of
+markers a diagram zooms on, and a band's label placed clear of the markers."""
 
 from __future__ import annotations
 
@@ -331,3 +332,62 @@ def _obstacles(ax: Axes, label, renderer) -> list:
     if ax.get_legend() is not None:
         boxes.append(ax.get_legend().get_window_extent(renderer))
     return boxes
+
+
+#: Fewest markers, each within a marker's size of another of them, that crowd a diagram.
+CROWD = 5
+
+
+def crowd(centres: np.ndarray, reach: np.ndarray) -> np.ndarray:
+    """Indices of the largest group of markers (``centres`` (N, 2) in display units, each
+    reaching ``reach`` (N,) from its centre) linked by overlaps: two markers link if their
+    centres are closer than the sum of their reaches. Empty if no group has :data:`CROWD`."""
+    n = len(centres)
+    if n < CROWD:
+        return np.zeros(0, dtype=int)
+    gaps = np.linalg.norm(centres[:, None, :] - centres[None, :, :], axis=2)
+    linked = gaps < reach[:, None] + reach[None, :]
+    group = -np.ones(n, dtype=int)
+    for start in range(n):
+        if group[start] >= 0:
+            continue
+        group[start] = start
+        todo = [start]
+        while todo:
+            k = todo.pop()
+            for m in np.flatnonzero(linked[k] & (group < 0)):
+                group[m] = start
+                todo.append(m)
+    labels, counts = np.unique(group, return_counts=True)
+    if counts.max() < CROWD:
+        return np.zeros(0, dtype=int)
+    return np.flatnonzero(group == labels[np.argmax(counts)])
+
+
+def crowded_box(ax: Axes) -> tuple[tuple[float, float], tuple[float, float]] | None:
+    """(x limits, y limits) in data of the largest crowd (:func:`crowd`) of ``ax``'s
+    special-point markers as the axes are laid out now, with a margin of half its span (at
+    least 3 % of the axes' limits) on each side; None if the markers crowd nowhere."""
+    per_point = ax.figure.dpi / 72.0
+    data, centres, reach = [], [], []
+    for line in ax.lines:
+        if line.get_linestyle() not in ("None", "none", "") or line.get_marker() in (
+                "None", "none", "", " ", None) or not line.get_visible():
+            continue
+        xy = line.get_xydata()
+        xy = xy[np.isfinite(xy).all(axis=1)]
+        data.append(xy)
+        centres.append(line.get_transform().transform(xy))
+        reach.append(np.full(len(xy), 0.5 * line.get_markersize() * per_point))
+    if not data:
+        return None
+    chosen = crowd(np.concatenate(centres), np.concatenate(reach))
+    if not len(chosen):
+        return None
+    points = np.concatenate(data)[chosen]
+    limits = []
+    for axis, view in ((0, ax.get_xlim()), (1, ax.get_ylim())):
+        low, high = float(points[:, axis].min()), float(points[:, axis].max())
+        margin = max(0.5 * (high - low), 0.03 * abs(view[1] - view[0]))
+        limits.append((low - margin, high + margin))
+    return limits[0], limits[1]
