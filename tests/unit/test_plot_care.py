@@ -756,3 +756,20 @@ def test_a_crowded_bifurcation_diagram_gets_a_zoom_panel_that_sets_its_markers_a
     ((_, single),) = list(study_figures(result_with(hopf_continuation(), 0.0),
                                         ("bifurcation",)))
     assert len([ax for ax in single.axes if ax.lines]) == 1
+
+
+def test_an_overhang_width_label_takes_one_place_in_every_format():
+    """The label's place is chosen from its glyphs' outlines, not a renderer's metrics: the
+    PNG at two resolutions, the PDF and the SVG put it at the same place."""
+    import io
+
+    from whirl_cli.plots.diagrams import bifurcation_diagram
+
+    figure = bifurcation_diagram(_overhang_under_a_marker())
+    (label,) = [t for t in figure.axes[0].texts if t.get_text() == "0.08 N m/rad"]
+    places = []
+    for fmt, dpi in (("png", 100), ("png", 150), ("pdf", 72), ("svg", 72)):
+        figure.savefig(io.BytesIO(), format=fmt, dpi=dpi)
+        places.append((label.xy, tuple(label.xyann), label.get_ha(), label.get_va()))
+    assert places[0] != (((0.3 + 0.38) / 2, 1.0), (0.0, -3.0), "center", "top")
+    assert all(place == places[0] for place in places)

@@ -260,21 +260,22 @@ def _band_label_class():
 def _place(label, renderer) -> None:
     """Move ``label`` to the first of its places (:func:`band_label`) inside its axes and
     clear of their markers, texts and legend: of those, the first off every curve's
-    vertices too, if one is."""
+    vertices too, if one is. Its box is measured from its glyphs' outlines (:func:`_box`),
+    so every renderer (PNG, PDF, SVG) puts it at the same place."""
     ax = label.axes
     inside = ax.get_window_extent(renderer)
     obstacles = _obstacles(ax, label, renderer)
     curves = _curve_points(ax)
-    places = _places(label, renderer, inside)
+    places = _places(label, inside)
     for strict in (True, False):
         for place in places:
-            _put(label, place)
-            box = label.get_window_extent(renderer)
+            box = _box(label, place)
             within = (inside.x0 <= box.x0 and box.x1 <= inside.x1 and inside.y0 <= box.y0
                       and box.y1 <= inside.y1)
             if not within or any(box.overlaps(other) for other in obstacles):
                 continue
             if not strict or not box.count_contains(curves):
+                _put(label, place)
                 return
     _put(label, places[0])
 
@@ -296,16 +297,47 @@ def _put(label, place: tuple) -> None:
     label.set_verticalalignment(va)
 
 
-def _places(label, renderer, inside) -> list[tuple]:
+def _size(label) -> tuple[float, float]:
+    """(width, height) [points] of ``label``'s one line of text, from its glyphs' outlines
+    (the height a line of its font takes, "lp")."""
+    from matplotlib.textpath import TextToPath
+
+    measure = TextToPath().get_text_width_height_descent
+    font = label.get_fontproperties()
+    width = measure(label.get_text(), font, ismath=False)[0]
+    _, height, descent = measure("lp", font, ismath=False)
+    return width, height + descent
+
+
+def _box(label, place: tuple):
+    """The display box ``label`` takes at ``place``, :data:`_LABEL_PAD` around its text."""
+    from matplotlib.transforms import Bbox, blended_transform_factory
+
+    (x, y), (dx, dy), ha, va = place
+    per_point = label.figure.dpi / 72.0
+    anchor = blended_transform_factory(label.axes.transData, label.axes.transAxes).transform(
+        (x, y)) + np.array([dx, dy]) * per_point
+    width, height = (np.array(_size(label)) + 2 * _LABEL_PAD) * per_point
+    x0 = anchor[0] - {"left": 0.0, "center": 0.5, "right": 1.0}[ha] * width + \
+        {"left": -1.0, "center": 0.0, "right": 1.0}[ha] * _LABEL_PAD * per_point
+    y0 = anchor[1] - {"bottom": 0.0, "top": 1.0}[va] * height + \
+        {"bottom": -1.0, "top": 1.0}[va] * _LABEL_PAD * per_point
+    return Bbox.from_bounds(x0, y0, width, height)
+
+
+#: The margin [points] kept around a band label's text.
+_LABEL_PAD = 1.0
+
+
+def _places(label, inside) -> list[tuple]:
     """(xy, offset [points], ha, va) of ``label``'s places in order: rows top, bottom, then
     between from the top down; in each the band's middle, right of it, left of it."""
     low, high = label.band
-    _put(label, (((low + high) / 2, 1.0), (0.0, -_LABEL_GAP), "center", "top"))
-    height = label.get_window_extent(renderer).height * 72.0 / label.figure.dpi
+    height = _size(label)[1]
     rows = [(1.0, -_LABEL_GAP, "top"), (0.0, _LABEL_GAP, "bottom")]
     step = 1
     span = inside.height * 72.0 / label.figure.dpi
-    while height > 0 and _LABEL_GAP + (step + 1) * height < span - _LABEL_GAP:
+    while _LABEL_GAP + (step + 1) * height < span - _LABEL_GAP:
         rows.append((1.0, -_LABEL_GAP - step * height, "top"))
         step += 1
     return [((x, y), (dx, dy), ha, va) for y, dy, va in rows
