@@ -81,7 +81,6 @@ def bifurcation_figure(continuation: ContinuationResult, state: str | None = Non
     from matplotlib.patches import Rectangle
 
     figure = bifurcation_diagram(continuation, state, title=title)
-    figure.draw_without_rendering()
     box = crowded_box(figure.axes[0]) if zoom else None
     if box is None:
         return figure

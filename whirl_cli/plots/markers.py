@@ -398,8 +398,10 @@ def crowd(centres: np.ndarray, reach: np.ndarray) -> np.ndarray:
 
 def crowded_box(ax: Axes) -> tuple[tuple[float, float], tuple[float, float]] | None:
     """(x limits, y limits) in data of the largest crowd (:func:`crowd`) of ``ax``'s
-    special-point markers as the axes are laid out now, with a margin of half its span (at
-    least 3 % of the axes' limits) on each side; None if the markers crowd nowhere."""
+    special-point markers as the axes are laid out now (their limits autoscaled), with a
+    margin of half its span (at least 3 % of the axes' limits) on each side; None if the
+    markers crowd nowhere."""
+    ax.autoscale_view()
     per_point = ax.figure.dpi / 72.0
     data, centres, reach = [], [], []
     for line in ax.lines:
