@@ -91,7 +91,8 @@ def bifurcation_figure(continuation: ContinuationResult, state: str | None = Non
     panel.set_xlim(*box[0])  # before the markers are set apart, at this scale
     panel.set_ylim(*box[1])
     bifurcation_diagram(continuation, state, ax=panel, title="zoom on the box at left")
-    panel.get_legend().remove()
+    if panel.get_legend() is not None:
+        panel.get_legend().remove()
     (x0, x1), (y0, y1) = box
     main.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, fill=False, edgecolor=BLACK,
                              linewidth=0.8, zorder=5, label="_zoom"))

@@ -224,12 +224,12 @@ _LABEL_GAP = 3.0
 
 
 def band_label(ax: Axes, text: str, low: float, high: float, **style):
-    """A label of the band ``low``-``high`` (the x data) inside ``ax``, placed when drawn:
-    at the top in the band's middle, or, if its box would overlap a marker, another text or
-    the legend of ``ax`` there (or, if a clear place is off the curves, a curve), at the
-    first clear place of: the top beside the band (right,
-    left), the bottom (middle, right, left), rows between, from the top down; the first if
-    none is. Returns the annotation."""
+    """A label of the band ``low``-``high`` (the x data) inside ``ax``, placed when drawn
+    (:func:`_place`): at the top in the band's middle, or, if its box would overlap a
+    marker, another text or the legend of ``ax`` there (or a curve, if a place off the
+    curves is clear), at the first clear place of: the top beside the band (right, left),
+    the bottom (middle, right, left), rows between from the top down; the first if none
+    is. Returns the annotation."""
     label = _band_label_class()(text, xy=((low + high) / 2, 1.0),
                                 xycoords=("data", "axes fraction"), xytext=(0, -_LABEL_GAP),
                                 textcoords="offset points", ha="center", va="top",
