@@ -576,3 +576,200 @@ def test_a_point_whirl_rejected_gets_no_marker_in_a_study_plot_or_a_sheet_panel(
     draw(result, "bifurcation", ax)
     assert _torus_markers(ax) == 1
     plt.close(figure)
+
+
+def _veering_sweep():
+    """Two oscillatory modes along V in 0-20 m/s: one stays a damped gimbal FW mode, the other
+    starts as a nacelle FW mode, its energy passing to the gimbal from 14 m/s and its whirl
+    turning BW from 15.5 m/s; its damping ratio crosses zero at 16 m/s (flutter)."""
+    from whirl_cli.results import LinearSweep
+
+    values = np.linspace(0.0, 20.0, 81)
+    zeta = np.column_stack([0.05 + 0 * values, 0.1 - 0.1 * values / 16.0])
+    freq = np.column_stack([80.0 + 0 * values, 50.0 - 2.0 * values])
+    roots = freq * (-zeta + 1j * np.sqrt(1 - zeta ** 2))
+    eigenvalues = np.column_stack([roots[:, 1], np.conj(roots[:, 1]),
+                                   roots[:, 0], np.conj(roots[:, 0])])
+    group = np.where(values < 14.0, "nacelle", "gimbal")
+    whirl = np.where(values < 15.5, "FW", "BW")
+    groups = np.column_stack([group, group, ["gimbal"] * 81, ["gimbal"] * 81])
+    whirls = np.column_stack([whirl, whirl, ["FW"] * 81, ["FW"] * 81])
+    return LinearSweep("V", "m/s", values, eigenvalues, -eigenvalues.real / np.abs(eigenvalues),
+                       np.abs(eigenvalues.imag), whirls.astype(object), groups.astype(object))
+
+
+def test_a_linear_sweep_legend_names_the_modes_as_stored_along_them_and_at_the_onset():
+    """The mode that flutters was a nacelle mode for most of the sweep but is stored as the
+    gimbal BW mode where it goes unstable: the legend names every stored label along its
+    line (not the majority alone) and the label stored at the onset."""
+    from whirl_cli.plots.linear import linear_sweep_plot
+
+    sweep = _veering_sweep()
+    ax_freq, ax_damp = linear_sweep_plot(sweep).axes
+    texts = [t.get_text() for t in ax_freq.get_legend().get_texts()]
+    (fluttering,) = [line.get_label() for line in ax_freq.lines
+                     if line.get_label() in texts and line.get_linewidth() > 1.5]
+    for label in ("nacelle", "gimbal", "FW", "BW"):
+        assert label in fluttering
+    (onset,) = [text for text in texts if text.startswith("damping ratio 0")]
+    assert "V = 16 m/s" in onset and onset.endswith("gimbal BW)")
+    assert "gimbal FW" in texts  # a mode stored alike all along keeps its one label
+
+
+def _cluster_bars(ax) -> list[tuple[np.ndarray, float]]:
+    """The span bars of fold clusters on ``ax`` as (ends in display coordinates, line width
+    [points]): an error bar's vertical segment, or a capped line of two vertices at one x."""
+    from matplotlib.container import ErrorbarContainer
+
+    bars = []
+    for container in ax.containers:
+        if isinstance(container, ErrorbarContainer):
+            for segments in container.lines[2]:
+                for segment in segments.get_segments():
+                    bars.append((ax.transData.transform(segment),
+                                 float(segments.get_linewidth()[0])))
+    for line in ax.lines:
+        xy = line.get_xydata()
+        if (len(xy) == 2 and np.ptp(xy[:, 0]) == 0.0 and line.get_marker() == "_"
+                and line.get_linestyle() not in ("None", "none", "")):
+            bars.append((line.get_transform().transform(xy), line.get_linewidth()))
+    return bars
+
+
+def test_a_cluster_bar_leaves_the_family_curve_beside_it_in_view():
+    """A snaking family runs up and down the span of its folds: the cluster's bar is drawn
+    beside the curve, clear of it by the half widths of both lines, not over it."""
+    from whirl_cli.plots.blowup import blowup_plot
+    from whirl_cli.plots.diagrams import period_plot
+
+    continuation = _snaking_family(6)
+    for ax in (period_plot(continuation).axes[0], blowup_plot(continuation).axes[0]):
+        ax.figure.canvas.draw()
+        ((ends, width),) = _cluster_bars(ax)
+        curves = [line for line in ax.lines if line.get_marker() in ("None", "", None)]
+        per_point = ax.figure.dpi / 72.0
+        for curve in curves:
+            xy = curve.get_transform().transform(curve.get_xydata())
+            beside = xy[(xy[:, 1] >= ends[:, 1].min()) & (xy[:, 1] <= ends[:, 1].max())]
+            clear = 0.5 * (curve.get_linewidth() + width) * per_point
+            assert (np.abs(beside[:, 0] - ends[0, 0]) > clear).all()
+
+
+def _overhang_under_a_marker():
+    """A subcritical Hopf point at K1 = 0.3 whose family folds at 0.38 (the overhang
+    0.3-0.38), and a period-doubling point at the top of the data in the band's middle."""
+    from whirl_cli.results import ContinuationResult, Criticality
+
+    from .plot_data import make_point
+
+    equilibrium = make_branch("main_down", BranchKind.EQUILIBRIUM,
+                              [0.5, 0.4, 0.3, 0.2, 0.1], [0.0] * 5, [1, 1, 0, 0, 0])
+    family = make_branch("periodic_1", BranchKind.PERIODIC, [0.3, 0.33, 0.36, 0.38, 0.34],
+                         [0.0, 0.1, 0.2, 0.25, 0.3], [0, 0, 0, 1, 1])
+    hopf = replace(make_point("main_down", PointType.HB, 0.3, 0.0), index=2,
+                   criticality=Criticality.SUBCRITICAL)
+    fold = replace(make_point("periodic_1", PointType.LPC, 0.38, 0.25), index=3)
+    doubling = replace(make_point("periodic_1", PointType.PD, 0.34, 0.3), index=4)
+    return ContinuationResult("k1", "one-parameter", (equilibrium, family),
+                              (hopf, fold, doubling))
+
+
+def _marker_boxes(ax) -> list:
+    """Each marker of ``ax``'s lines as a box of its size around its centre (display)."""
+    from matplotlib.transforms import Bbox
+
+    per_point = ax.figure.dpi / 72.0
+    boxes = []
+    for line in ax.lines:
+        if line.get_marker() in ("None", "", None, " ") or not line.get_visible():
+            continue
+        half = 0.5 * line.get_markersize() * per_point
+        for x, y in line.get_transform().transform(line.get_xydata()):
+            boxes.append(Bbox([[x - half, y - half], [x + half, y + half]]))
+    return boxes
+
+
+def test_an_overhang_width_label_overlaps_no_marker():
+    from whirl_cli.plots.diagrams import bifurcation_diagram, overhangs
+
+    continuation = _overhang_under_a_marker()
+    assert overhangs(continuation) == [(0.3, 0.38)]
+    ax = bifurcation_diagram(continuation).axes[0]
+    ax.figure.canvas.draw()
+    renderer = ax.figure.canvas.get_renderer()
+    (label,) = [t for t in ax.texts if t.get_text() == "0.08 N m/rad"]
+    box = label.get_window_extent(renderer)
+    assert ax.get_window_extent().contains(box.x0, box.y0)
+    assert ax.get_window_extent().contains(box.x1, box.y1)
+    assert not [m for m in _marker_boxes(ax) if m.overlaps(box)]
+
+
+def test_crowd_is_the_largest_group_of_overlapping_markers():
+    from whirl_cli.plots.markers import CROWD, crowd
+
+    chain = np.column_stack([np.arange(CROWD) * 7.0, np.zeros(CROWD)])  # each touches the next
+    apart = np.array([[200.0, 0.0], [300.0, 0.0], [300.0, 30.0]])
+    centres = np.concatenate([apart, chain])
+    assert crowd(centres, np.full(len(centres), 4.0)).tolist() == list(range(3, 3 + CROWD))
+    assert crowd(centres[:-1], np.full(len(centres) - 1, 4.0)).tolist() == []  # one too few
+    assert crowd(centres, np.full(len(centres), 3.0)).tolist() == []  # 7 apart, 6 across
+
+
+def _crowded_diagram():
+    """A Hopf point feeding a family, and six special points of six kinds within 0.004 of
+    K1 = 0.15 and 0.3 deg of theta on it: together under one marker's size at full scale."""
+    from whirl_cli.results import ContinuationResult
+
+    from .plot_data import hopf_continuation, make_point
+
+    base = hopf_continuation()
+    kinds = (PointType.LPC, PointType.BPC, PointType.PD, PointType.TR, PointType.HOMOCLINIC,
+             PointType.LP)
+    crowd = tuple(make_point("periodic_1", kind, 0.33 + 0.0008 * k, 0.2 + 0.001 * k)
+                  for k, kind in enumerate(kinds))
+    return ContinuationResult(base.name, base.kind, base.branches,
+                              (*base.special_points, *crowd))
+
+
+def test_a_crowded_bifurcation_diagram_gets_a_zoom_panel_that_sets_its_markers_apart():
+    """The study's bifurcation figure of a diagram whose markers crowd has a second panel
+    whose limits hold the crowd, where no marker hides another; an uncrowded one stays one
+    panel."""
+    from whirl_cli.plots.files import study_figures
+
+    from .plot_data import hopf_continuation, result_with
+
+    ((_, figure),) = list(study_figures(result_with(_crowded_diagram(), 0.0),
+                                        ("bifurcation",)))
+    diagram, zoom = [ax for ax in figure.axes if ax.lines]
+    figure.canvas.draw()
+    (x0, x1), (y0, y1) = zoom.get_xlim(), zoom.get_ylim()
+    assert x0 < 0.33 and 0.334 < x1 and y0 < np.degrees(0.2) and np.degrees(0.205) < y1
+    assert x1 - x0 < 0.5 * np.ptp(diagram.get_xlim())
+    assert _hidden_markers(zoom) == []
+    per_point = figure.dpi / 72.0
+    centres = np.concatenate([line.get_transform().transform(line.get_xydata())
+                              for line in zoom.lines if line.get_linestyle() == "None"])
+    inside = centres[_inside(centres, zoom.get_window_extent())]
+    gaps = np.linalg.norm(inside[:, None] - inside[None, :], axis=2)
+    assert (gaps[np.triu_indices(len(inside), 1)] >= 8.0 * per_point).all()
+    ((_, single),) = list(study_figures(result_with(hopf_continuation(), 0.0),
+                                        ("bifurcation",)))
+    assert len([ax for ax in single.axes if ax.lines]) == 1
+
+
+def test_an_overhang_width_label_takes_one_place_in_every_format():
+    """The label's place is chosen from its glyphs' outlines, not a renderer's metrics: the
+    PNG at two resolutions, the PDF and the SVG put it at the same place."""
+    import io
+
+    from whirl_cli.plots.diagrams import bifurcation_diagram
+
+    figure = bifurcation_diagram(_overhang_under_a_marker())
+    (label,) = [t for t in figure.axes[0].texts if t.get_text() == "0.08 N m/rad"]
+    places = []
+    for fmt, dpi in (("png", 100), ("png", 150), ("pdf", 72), ("svg", 72)):
+        figure.savefig(io.BytesIO(), format=fmt, dpi=dpi)
+        places.append((label.xy, tuple(label.xyann), label.get_ha(), label.get_va()))
+    assert places[0] != (((0.3 + 0.38) / 2, 1.0), (0.0, -3.0), "center", "top")
+    assert all(place == places[0] for place in places)

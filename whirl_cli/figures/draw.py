@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..errors import WhirlError
-from ..plots.key import new_figure
+from ..plots.key import legend_columns, new_figure
 from ..plots.panels import PanelChoice, draw, draw_overlay
 from ..results import StudyResult
 from .sheet import PanelSpec, Sheet
@@ -60,23 +60,6 @@ def draw_sheet(sheet: Sheet, results: Mapping[Path, StudyResult]) -> Figure:
     return figure
 
 
-_ENTRY_EMS = 2.0 + 0.8 + 2.0  # a legend entry's handle, its gap to the text, the column gap
-
-
-def _legend_columns(labels: list[str], width: float) -> int:
-    """How many columns of ``labels`` (small text, at the current font size) fit in 95 % of
-    ``width`` inches, each as wide as the widest entry (measured as its glyphs' outlines)."""
-    from matplotlib.font_manager import FontProperties
-    from matplotlib.textpath import TextToPath
-
-    font = FontProperties(size="small")
-    points = font.get_size_in_points()
-    measure = TextToPath().get_text_width_height_descent
-    widest = max(measure(label, font, ismath=label.count("$") >= 2)[0] for label in labels)
-    entry = (widest + _ENTRY_EMS * points) / 72.0
-    return max(1, min(len(labels), int(0.95 * width / entry)))
-
-
 def figure_legend(figure: Figure) -> None:
     """The panels' legends as one legend of ``figure`` below its panels: every entry once
     (by its label, the first panel's artist), the panels' own legends removed."""
@@ -91,7 +74,7 @@ def figure_legend(figure: Figure) -> None:
     if not entries:
         return
     entries = _one_per_style(entries)
-    columns = _legend_columns(list(entries), figure.get_size_inches()[0])
+    columns = legend_columns(list(entries), figure.get_size_inches()[0])
     figure.legend(list(entries.values()), list(entries), loc="outside lower center",
                   ncols=columns, fontsize="small", frameon=False)
 

@@ -27,7 +27,7 @@ from .key import (
     plot_styled,
     stability_curves,
 )
-from .markers import Mark, draw_marks, unstack
+from .markers import Mark, band_label, crowded_box, draw_marks, unstack
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -70,6 +70,37 @@ def bifurcation_diagram(continuation: ContinuationResult, state: str | None = No
         ax.legend(handles, labels, fontsize="small")
     ax.set_title(continuation.name if title is None else title)
     return ax.figure
+
+
+def bifurcation_figure(continuation: ContinuationResult, state: str | None = None,
+                       title: str | None = None, zoom: bool = True) -> Figure:
+    """:func:`bifurcation_diagram` on a figure of its own; where its special-point markers
+    crowd (:func:`~whirl_cli.plots.markers.crowded_box`) and ``zoom``, a zoom panel on the
+    largest crowd to its right, the diagram drawn again there (no legend, its markers set
+    apart at that scale), the zoomed region outlined on the diagram."""
+    from matplotlib.patches import Rectangle
+
+    figure = bifurcation_diagram(continuation, state, title=title)
+    box = crowded_box(figure.axes[0]) if zoom else None
+    if box is None:
+        return figure
+    width, height = figure.get_size_inches()
+    figure = new_figure(figsize=(width * ZOOM_WIDTH, height))
+    main, panel = figure.subplots(1, 2, width_ratios=(1.0, ZOOM_WIDTH - 1.0))
+    bifurcation_diagram(continuation, state, ax=main, title=title)
+    panel.set_xlim(*box[0])  # before the markers are set apart, at this scale
+    panel.set_ylim(*box[1])
+    bifurcation_diagram(continuation, state, ax=panel, title="zoom on the box at left")
+    if panel.get_legend() is not None:
+        panel.get_legend().remove()
+    (x0, x1), (y0, y1) = box
+    main.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, fill=False, edgecolor=BLACK,
+                             linewidth=0.8, zorder=5, label="_zoom"))
+    return figure
+
+
+#: The width of a bifurcation figure with a zoom panel, in widths of one without.
+ZOOM_WIDTH = 1.7
 
 
 #: The legend entry of a shaded overhang, and its shade (the unsafe region's colour, lighter:
@@ -120,17 +151,16 @@ def _stable_side(branch: Branch | None, index: int, at: float) -> float:
 
 
 def _shade_overhangs(ax: Axes, bands: list[tuple[float, float]], unit: str):
-    """Each band shaded across the axes, its width written at its top; the legend handle."""
+    """Each band shaded across the axes, its width written at its top, or where no marker
+    hides it (:func:`~whirl_cli.plots.markers.band_label`); the legend handle."""
     from matplotlib.patches import Patch
 
     style = BOUNDARY_KEY["unsafe"]
     for low, high in bands:
         ax.axvspan(low, high, color=style["color"], alpha=OVERHANG_ALPHA, linewidth=0,
                    zorder=0)
-        ax.annotate(f"{high - low:.3g} {unit}".strip(), xy=((low + high) / 2, 1.0),
-                    xycoords=("data", "axes fraction"), xytext=(0, -3),
-                    textcoords="offset points", ha="center", va="top", fontsize="small",
-                    annotation_clip=True, in_layout=False)  # inside the axes, or not drawn
+        band_label(ax, f"{high - low:.3g} {unit}".strip(), low, high, fontsize="small",
+                   in_layout=False)  # inside the axes, or not drawn
     return Patch(color=style["color"], alpha=OVERHANG_ALPHA, linewidth=0)
 
 

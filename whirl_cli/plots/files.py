@@ -18,7 +18,7 @@ from ..errors import OutputError, WhirlError
 from ..output.guard import PLOT_CHARACTERS, plot_stem
 from ..results import Branch, ContinuationResult, PointType, StudyResult
 from .captions import Captions, Fixed, captions
-from .key import PLOTTED_KINDS, drawn_points
+from .key import PLOTTED_KINDS, drawn_points, legend_columns
 from .kinds import Figures, plot_kinds, registry
 
 if TYPE_CHECKING:
@@ -186,8 +186,9 @@ def legends_off_data(figure: Figure) -> None:
             entries.setdefault(text.get_text(), handle)
         legend.remove()
     if entries:
+        columns = min(3, legend_columns(list(entries), figure.get_size_inches()[0]))
         figure.legend(list(entries.values()), list(entries), loc="outside lower center",
-                      fontsize="small", ncols=min(len(entries), 3), frameon=False)
+                      fontsize="small", ncols=columns, frameon=False)
 
 
 def _right_of_texts(ax) -> float:

@@ -338,6 +338,23 @@ def next_colour(figure) -> str:
     return FIGURE_COLOURS[taken % len(FIGURE_COLOURS)]
 
 
+_ENTRY_EMS = 2.0 + 0.8 + 2.0  # a legend entry's handle, its gap to the text, the column gap
+
+
+def legend_columns(labels: list[str], width: float) -> int:
+    """How many columns of ``labels`` (small text, at the current font size) fit in 95 % of
+    ``width`` inches, each as wide as the widest entry (measured as its glyphs' outlines)."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import TextToPath
+
+    font = FontProperties(size="small")
+    points = font.get_size_in_points()
+    measure = TextToPath().get_text_width_height_descent
+    widest = max(measure(label, font, ismath=label.count("$") >= 2)[0] for label in labels)
+    entry = (widest + _ENTRY_EMS * points) / 72.0
+    return max(1, min(len(labels), int(0.95 * width / entry)))
+
+
 def patch_proxy(style: dict[str, object]):
     """A legend handle for a filled area of ``style``'s colour (and alpha)."""
     from matplotlib.patches import Patch

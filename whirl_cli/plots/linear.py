@@ -25,12 +25,13 @@ def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = 
     the parameter.
 
     One line per column of ``sweep.eigenvalues``, drawn only where Im(lambda) > 0 so each
-    conjugate pair appears once (real eigenvalues are not drawn). Lines are labelled with their
-    whirl direction ("BW"/"FW", after the mode group for models with several: "nacelle BW";
-    numbered if repeated); a mode whose damping ratio falls below zero somewhere (flutter) is
+    conjugate pair appears once (real eigenvalues are not drawn). Lines are labelled with the
+    stored labels along them (:func:`_mode_labels`); a mode whose damping ratio falls below
+    zero somewhere (flutter) is
     drawn in :data:`UNSTABLE_COLOURS`, the others in :data:`STABLE_COLOURS`. Each crossing of
     zero by a damping ratio (:func:`zero_crossings`) is marked on both panels and named with
-    its value in the legend; the damping panel has a zero line. The parameter axis is log if
+    its value in the legend (and the stored label there, on a line with several); the
+    damping panel has a zero line. The parameter axis is log if
     the sweep spans decades or samples log (:func:`~.key.log_scale_if_decades`).
     Title: ``title`` (None: ``"linear analysis vs <parameter>"``). Draws on ``axes``
     (frequency, damping) if given, else on a new figure; returns the figure.
@@ -43,7 +44,9 @@ def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = 
     crossings = zero_crossings(sweep)
     unstable = iter(UNSTABLE_COLOURS * len(sweep.eigenvalues.T))
     stable = iter(STABLE_COLOURS * len(sweep.eigenvalues.T))
+    stored = stored_labels(sweep)
     for column, label in _mode_labels(sweep):
+        several = len(set(stored[sweep.eigenvalues[:, column].imag > 0, column])) > 1
         upper = sweep.eigenvalues[:, column].imag > 0
         freq = np.where(upper, sweep.frequency[:, column], np.nan) * scale
         damp = np.where(upper, sweep.damping_ratio[:, column], np.nan)
@@ -54,8 +57,9 @@ def linear_sweep_plot(sweep: LinearSweep, hz: bool = False, title: str | None = 
         ax_damp.plot(sweep.values, damp, label=label, **style)
         for value, frequency in crossings.get(column, ()):
             ax_freq.plot([value], [frequency * scale], **ONSET_STYLE, label="_onset")
+            mode = f", {_label_at(sweep, stored[:, column], value)}" if several else ""
             ax_damp.plot([value], [0.0], **ONSET_STYLE,
-                         label=f"damping ratio 0 ({_onset_text(sweep, value)})")
+                         label=f"damping ratio 0 ({_onset_text(sweep, value)}{mode})")
     for ax in (ax_freq, ax_damp):
         for value in sorted({v for found in crossings.values() for v, _ in found}):
             ax.axvline(value, color="black", linewidth=0.6, linestyle=":", label="_onset",
@@ -192,11 +196,7 @@ def least_damped(sweep: LinearSweep) -> tuple[np.ndarray, np.ndarray, np.ndarray
     zeta = np.where(some, np.take_along_axis(damping, column, axis=1)[:, 0], np.nan)
     freq = np.where(some, np.take_along_axis(np.asarray(sweep.frequency), column,
                                              axis=1)[:, 0], np.nan)
-    labels = np.take_along_axis(np.asarray(sweep.whirl).astype(str), column, axis=1)[:, 0]
-    if sweep.mode_group is not None:
-        groups = np.take_along_axis(np.asarray(sweep.mode_group).astype(str), column,
-                                    axis=1)[:, 0]
-        labels = np.char.add(np.char.add(groups, " "), labels)
+    labels = np.take_along_axis(stored_labels(sweep), column, axis=1)[:, 0]
     return zeta, freq, np.where(some, labels, "")
 
 
@@ -257,20 +257,41 @@ def damping_multiples_plot(sweeps: Sequence[LinearSweep],
     return figure
 
 
+def stored_labels(sweep: LinearSweep) -> np.ndarray:
+    """(M, n) str: each eigenvalue's stored whirl label, after its mode group for a model
+    with several ("gimbal FW")."""
+    labels = np.asarray(sweep.whirl).astype(str)
+    if sweep.mode_group is None:
+        return labels
+    return np.char.add(np.char.add(np.asarray(sweep.mode_group).astype(str), " "), labels)
+
+
+def _label_at(sweep: LinearSweep, labels: np.ndarray, value: float) -> str:
+    """The one of ``labels`` (M,) stored at the sweep's point nearest ``value``."""
+    return str(labels[int(np.argmin(np.abs(np.asarray(sweep.values, dtype=float) - value)))])
+
+
 def _mode_labels(sweep: LinearSweep) -> list[tuple[int, str]]:
-    """(column, label) of the columns with Im(lambda) > 0 somewhere; label = majority whirl
-    (with its mode group first, "gimbal FW", for a model with several groups)."""
+    """(column, label) of the columns with Im(lambda) > 0 somewhere; label = the stored
+    labels (:func:`stored_labels`) along the column where Im(lambda) > 0, each once in the
+    order they first appear ("BW", "BW, FW"; for several mode groups each group's
+    directions after it, "nacelle FW, BW → gimbal FW, BW"); numbered if repeated."""
+    stored = stored_labels(sweep)
     modes = []
     for column in range(sweep.eigenvalues.shape[1]):
         upper = sweep.eigenvalues[:, column].imag > 0
         if not upper.any():
             continue
-        labels = np.asarray(sweep.whirl)[upper, column].astype(str)
-        if sweep.mode_group is not None:
-            labels = np.char.add(np.char.add(
-                np.asarray(sweep.mode_group)[upper, column].astype(str), " "), labels)
-        names, counts = np.unique(labels, return_counts=True)
-        modes.append((column, str(names[np.argmax(counts)])))
+        shown = dict.fromkeys(stored[upper, column].tolist())
+        if sweep.mode_group is None:
+            modes.append((column, ", ".join(shown)))
+            continue
+        groups: dict[str, list[str]] = {}
+        for label in shown:
+            group, _, whirl = label.rpartition(" ")
+            groups.setdefault(group, []).append(whirl)
+        modes.append((column, " → ".join(f"{group} {', '.join(whirls)}"
+                                              for group, whirls in groups.items())))
     totals = {label: sum(1 for _, other in modes if other == label) for _, label in modes}
     seen: dict[str, int] = {}
     labelled = []

@@ -39,9 +39,11 @@ def _bifurcation_files(figures: Figures) -> list[FigureJob]:
 
 
 def _bifurcation_figure(continuation, state: str | None, figures: Figures):
-    from ..diagrams import bifurcation_diagram
+    from ..diagrams import bifurcation_figure
 
-    return bifurcation_diagram(continuation, state, title=figures.title(continuation))
+    view = figures.view
+    return bifurcation_figure(continuation, state, title=figures.title(continuation),
+                              zoom=view.xlim is None and view.ylim is None)
 
 
 def _bifurcation_panel(result, ax, choice, caption) -> list[Axes]:
