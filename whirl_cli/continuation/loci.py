@@ -161,7 +161,8 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
     """Locus branches from the start points, both directions, each locus once (``outermost``:
     of the folds of cycles of a snaking family only the outermost, :func:`_outermost_folds`),
     each with its special points after its start as ``checked`` gives them (with their
-    verdicts, :func:`locus_points`; their located codimension-2 points may end a locus).
+    verdicts, :func:`locus_points`, computed once per locus; their located codimension-2
+    points may end a locus, and a locus ending at one is not retried).
 
     Starts are taken slice by slice (a wave per slice): a start lying on a locus of its type
     already traced from an earlier slice is the same locus and is not run again, nor is a
@@ -176,6 +177,7 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
     leaves idle; those then found on its loci are set aside (the others are traced then), so
     the loci are those of tracing wave after wave."""
     width = np.array([bounds[p][1] - bounds[p][0] for p in pair])
+    checked = _once(checked or partial(special_points, skip_first=True))
     numbered = list(enumerate(starts, 1))
     waves: dict[str, list] = {}
     for k, (point, runs) in numbered:
@@ -212,7 +214,8 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
         traced = dict(enumerate((kind, spec, branch) for _, kind, spec, branch in sorted(
             (row for row in ahead if row[0] in position),
             key=lambda row: (row[2].name.endswith("2"), position[row[0]], row[2].name))))
-        tasks = [partial(_wave, engine, pair, bounds, numerics, traced, list(curves), width)]
+        tasks = [partial(_wave, engine, pair, bounds, numerics, traced, list(curves), width,
+                         checked)]
         now, later = following(later)
         if now is not None:  # not those on this wave's first chunks either
             tasks.append(partial(_trace, engine, name, pair, bounds, numerics, todo(
@@ -223,10 +226,8 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
     kept = [curve for _, _, curve in _distinct(
         {k: (kind, None, curve) for k, (kind, curve) in enumerate(
             sorted(curves, key=lambda c: c[1].name))}, [], width)[0].values()]
-    checked = checked or partial(special_points, skip_first=True)
     found = [(curve, checked(curve)) for curve in kept]
-    codim2 = [p for _, points in found for p in points
-              if p.point_type in CODIM2 and p.status == LocateStatus.LOCATED]
+    codim2 = _codim2(kept, checked)
     points = tuple(point for point, _ in starts)
     return [(_locus_end(c, codim2, bounds, width, points, numerics.max_steps), on_it)
             for c, on_it in found]
@@ -234,13 +235,14 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
 
 def _wave(engine: Engine, pair: tuple[str, str], bounds: dict[str, tuple[float, float]],
           numerics: Numerics, traced: dict[int, tuple[int, RunSpec, Branch]],
-          curves: list[tuple[int, Branch]], width: np.ndarray) -> list[tuple[int, Branch]]:
+          curves: list[tuple[int, Branch]], width: np.ndarray,
+          checked: Callable[[Branch], list[SpecialPoint]]) -> list[tuple[int, Branch]]:
     """(point type, locus) of every one of the loci ``traced`` (their first chunks, by
     index), grown chunk by chunk side by side beside the ``curves`` known (:func:`_grown`);
-    those ending in MX away from a known codimension-2 point retried once
-    (:func:`_retried`)."""
+    those ending in MX away from a located codimension-2 point of the known loci (as
+    ``checked`` judges their points) retried once (:func:`_retried`)."""
     fresh, uncut = _grown(engine, traced, curves, numerics, bounds, width)
-    ends = _codim2([c for _, c in curves + [(kind, c) for kind, _, c in fresh.values()]])
+    ends = _codim2([c for _, c in curves] + [c for _, _, c in fresh.values()], checked)
     unclosed = {k: fresh[k] for k in uncut
                 if not _ending_at(fresh[k][2].parameters[-1, :2], ends, width)}
     retried = _retried(engine, unclosed, numerics)
@@ -250,10 +252,24 @@ def _wave(engine: Engine, pair: tuple[str, str], bounds: dict[str, tuple[float, 
     return [(kind, curve) for kind, _, curve in fresh.values()]
 
 
-def _codim2(curves: list[Branch]) -> list[SpecialPoint]:
-    """The codimension-2 points found on ``curves``."""
-    return [p for c in curves for p in special_points(c, skip_first=True)
-            if PointType(p.point_type) in CODIM2]
+def _codim2(curves: list[Branch], checked: Callable[[Branch], list[SpecialPoint]]
+            ) -> list[SpecialPoint]:
+    """The located codimension-2 points of ``curves``, as ``checked`` gives their special
+    points (a GH point whose first Lyapunov coefficient does not change sign is rejected)."""
+    return [p for c in curves for p in checked(c)
+            if p.point_type in CODIM2 and p.status == LocateStatus.LOCATED]
+
+
+def _once(checked: Callable[[Branch], list[SpecialPoint]]
+          ) -> Callable[[Branch], list[SpecialPoint]]:
+    """``checked`` computed once per locus (loci are frozen: by identity, each kept)."""
+    seen: dict[int, tuple[Branch, list[SpecialPoint]]] = {}
+
+    def points(curve: Branch) -> list[SpecialPoint]:
+        if id(curve) not in seen:
+            seen[id(curve)] = (curve, checked(curve))
+        return seen[id(curve)][1]
+    return points
 
 
 def _ending_at(last: np.ndarray, codim2: list[SpecialPoint], width: np.ndarray
