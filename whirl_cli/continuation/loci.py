@@ -510,15 +510,19 @@ def _reached(curve: Branch, starts: tuple[SpecialPoint, ...], width: np.ndarray
 def _locus_end(curve: Branch, codim2: list[SpecialPoint], bounds: dict[str, tuple[float, float]],
                width: np.ndarray, starts: tuple[SpecialPoint, ...] = (),
                max_steps: int = Numerics.max_steps) -> Branch:
-    """The locus with its end classified: range edge, closed (or back at its start's
-    parameters with another orbit: at another of the ``starts`` of its type, if one is
-    there), a codimension-2 point (where AUTO typically stops with MX: that is the locus'
-    natural end, not a failure), its study's step limit (``max_steps`` points), or a chunk
-    of steps after which whirl did not continue it (:func:`_grown`)."""
+    """The locus with its end classified: range edge, closed (back at its start's
+    parameters after leaving them; or there with another orbit: at another of the
+    ``starts`` of its type, if one is there), a codimension-2 point (where AUTO typically
+    stops with MX: that is the locus' natural end, not a failure), its study's step limit
+    (``max_steps`` points), or a chunk of steps after which whirl did not continue it
+    (:func:`_grown`)."""
     last = curve.parameters[-1, :2]
     if at_range_edge(curve, bounds, width):
         return replace(curve, end="range")
-    if len(curve) > 2 and np.abs((last - curve.parameters[0, :2]) / width).max() < 0.005:
+    from_start = np.abs((curve.parameters[:, :2] - curve.parameters[0, :2]) / width).max(axis=1)
+    # back within 0.005 of the ranges of a start it had left by more than 0.02 (as
+    # cut_closed): a locus that stopped a few steps from its start has not closed
+    if len(curve) > 2 and from_start[-1] < 0.005 and from_start.max() > 0.02:
         if not _other_orbit(curve):
             return replace(curve, end="closed")
         # e.g. the folds of cycles of a family snaking toward a homoclinic orbit: the locus
