@@ -1,12 +1,13 @@
-"""A Hopf locus that AUTO stopped with MX is retried unless it ends at a located
-codimension-2 point: a GH point AUTO flags there is one only where the first Lyapunov
-coefficient changes sign beside it (tests/data/bautin.model.yaml: at nu = 0.5549; its linear
-variant, without the nonlinear terms, has l1 = 0 everywhere and so no Bautin point). The
-AUTO runs are stand-ins recording what they are asked for: this is the recipe's decision,
-not a continuation result."""
+"""A locus that AUTO stopped with MX is retried unless it ends at a located codimension-2
+point: a GH point AUTO flags there is one only where the first Lyapunov coefficient changes
+sign beside it (tests/data/bautin.model.yaml: at nu = 0.5549; its linear variant, without the
+nonlinear terms, has l1 = 0 everywhere and so no Bautin point); and it is retried also when
+AUTO labelled none of its points but the MX. The AUTO runs are stand-ins recording what they
+are asked for: this is the recipe's decision, not a continuation result."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import partial
 
 import numpy as np
@@ -19,6 +20,7 @@ from whirl_cli.models import get_model, load_model_file
 from whirl_cli.results import Branch, BranchKind, Origin, PointType, RunStatus, SpecialPoint
 
 from ..conftest import ROOT
+from .locus_data import make_locus
 
 PAIR = ("mu", "nu")
 BOUNDS = {"mu": (-0.5, 0.5), "nu": (-0.5, 1.5)}
@@ -111,3 +113,38 @@ def test_a_locus_ending_at_a_rejected_gh_point_is_retried(monkeypatch, tmp_path,
         assert gh.status == loci.LocateStatus.LOCATED
         assert engine.asked == []
         assert up.end.startswith("GH at") and up.status == RunStatus.OK
+
+
+def test_a_locus_of_cycles_labelled_only_at_its_mx_end_is_retried_from_its_start(monkeypatch):
+    """A fold-of-cycles locus's second stage that ends in MX within its first chunk carries no
+    label but the MX's: it is retried from the point its run started from, on twice the mesh,
+    and what the retry gives replaces it after that point."""
+    steps = 8
+    failed = replace(make_locus(np.column_stack([np.full(steps, 0.5),
+                                                 np.linspace(0.2, 0.3, steps)])),
+                     name="fold_of_cycles_1a2", status=RunStatus.MX,
+                     point_type=np.r_[np.zeros(steps - 1, int), int(PointType.MX)],
+                     label=np.r_[np.zeros(steps - 1, int), 9], runs=("c.fold_of_cycles_1a2",))
+    spec = RunSpec("c/fold_of_cycles_1a2", {"NTST": 20, "DSMAX": 0.05, "NMX": 100},
+                   BranchKind.FOLD_OF_CYCLES_LOCUS, Origin(""), ("p", "q"),
+                   restart=("c.fold_of_cycles_1a", 5))
+
+    def trace(_engine, _name, _pair, _bounds, _numerics, starts, background=False):
+        return [(k, PointType.LPC, spec, failed) for k, _, _ in starts]
+
+    def retry_run(_engine, spec, _outcome) -> Branch:
+        """The retry: from the same start, on to q = 0.45, ending of itself."""
+        return replace(make_locus(np.column_stack([np.full(12, 0.5), np.linspace(0.2, 0.45, 12)])),
+                       name="fold_of_cycles_1a2r", runs=(spec.name.replace("/", "."),))
+
+    monkeypatch.setattr(loci, "_trace", trace)
+    monkeypatch.setattr(loci, "read_run", retry_run)
+    engine = _Engine()
+    start = SpecialPoint("slice_0.periodic_1", 5, int(PointType.LPC), ("p", "q"),
+                         np.array([0.5, 0.2]), np.zeros(1), 1.0, False)
+    ((curve, _),) = loci._loci(engine, "c", ("p", "q"), {"p": (0.0, 1.0), "q": (0.0, 1.0)},
+                               Numerics(), [(start, ("c.slice_0.periodic_1",))])
+    assert [(s.name, s.restart, s.constants["NTST"]) for s in engine.asked] == [
+        ("c/fold_of_cycles_1a2r", ("c.fold_of_cycles_1a", 5), 40)]
+    assert len(curve) == 12 and curve.parameters[-1, 1] == 0.45
+    assert curve.status == RunStatus.OK

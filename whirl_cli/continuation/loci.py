@@ -453,21 +453,20 @@ CODIM2 = {PointType.BT, PointType.CP, PointType.ZH, PointType.GH, PointType.R1, 
 def _retried(engine: Engine, loci: dict[int, tuple[int, RunSpec, Branch]], numerics: Numerics
              ) -> dict[int, tuple[int, RunSpec, Branch]]:
     """Loci (point type, last run, branch by index) that ended in MX continued once more from
-    their last good labelled point with twice the mesh and half the largest step, joined to
-    what they had: (point type, retry run, locus) by index, for those retried."""
+    their last good labelled point (:func:`_retry_from`) with twice the mesh and half the
+    largest step, joined to what they had: (point type, retry run, locus) by index, for those
+    retried."""
     again, where = [], []
     for k, (_, spec, curve) in loci.items():
-        labelled = [r for r in np.flatnonzero(curve.label) if curve.point_type[r] != PointType.MX]
-        if curve.status != RunStatus.MX or not labelled or labelled[-1] == 0:
+        start = _retry_from(engine, spec, curve) if curve.status == RunStatus.MX else None
+        if start is None:
             continue
-        row = int(labelled[-1])
+        row, restart = start
         constants = dict(spec.constants, NTST=spec.constants["NTST"] * 2,
                          DSMAX=spec.constants["DSMAX"] / 2)
         if spec.kind in CHUNKED:
             constants["NMX"] = min(LOCUS_CHUNK, numerics.max_steps - row)
-        again.append(replace(spec, name=spec.name + "r", constants=constants,
-                             restart=(engine.run_with_label(curve.runs, int(curve.label[row])),
-                                      int(curve.label[row]))))
+        again.append(replace(spec, name=spec.name + "r", constants=constants, restart=restart))
         where.append((k, row))
     done: dict[int, tuple[int, RunSpec, Branch]] = {}
     for spec, (k, row), outcome in zip(again, where, engine.run_many(again), strict=True):
@@ -476,6 +475,22 @@ def _retried(engine: Engine, loci: dict[int, tuple[int, RunSpec, Branch]], numer
         if len(extra):
             done[k] = (kind, spec, join(head(curve, row + 1), extra, curve.name))
     return done
+
+
+def _retry_from(engine: Engine, spec: RunSpec, curve: Branch
+                ) -> tuple[int, tuple[str, int]] | None:
+    """(row, AUTO restart) of a locus's last good labelled point: its last labelled row
+    other than the MX, or, for a locus of one run that AUTO labelled nowhere else (a locus of
+    cycles ending in MX within its first chunk: only the MX is labelled), the point its run
+    started from (its first row); None if neither."""
+    labelled = [r for r in np.flatnonzero(curve.label) if curve.point_type[r] != PointType.MX]
+    if labelled and labelled[-1] > 0:
+        row = int(labelled[-1])
+        label = int(curve.label[row])
+        return row, (engine.run_with_label(curve.runs, label), label)
+    if len(curve.runs) == 1 and len(curve) > 1 and spec.restart is not None:
+        return 0, spec.restart
+    return None
 
 
 def _period_tolerance(curve: Branch) -> float:
