@@ -331,3 +331,17 @@ def test_a_locus_back_at_its_start_with_another_orbit_reached_the_next_fold():
     round_trip = 0.525 + 0.05 * np.sin(np.linspace(0, 2 * np.pi, len(loop) + 1)[:-1])
     near_own = dataclasses.replace(curve, period=round_trip)
     assert _locus_end(near_own, [], bounds, width, (own, next_fold)).end == "closed"
+
+
+def test_a_locus_stopped_a_few_steps_from_its_start_has_not_closed():
+    """Four points within 1e-4 of the ranges of its start, then MX: a failure, not a loop."""
+    from whirl_cli.continuation.loci import _locus_end
+    from whirl_cli.results import PointType, RunStatus
+
+    width = np.array([0.8, 0.5])
+    bounds = {"p": (-0.3, 0.5), "q": (0.0, 0.5)}
+    stalled = dataclasses.replace(
+        make_locus(np.array([[0.27485, 0.2], [0.27484, 0.20001], [0.27482, 0.20003],
+                             [0.27481, 0.20004]])),
+        status=RunStatus.MX, point_type=np.array([0, 0, 0, int(PointType.MX)]))
+    assert _locus_end(stalled, [], bounds, width).end == "no convergence (MX)"

@@ -107,7 +107,7 @@ def test_a_next_wave_start_on_a_locus_of_the_wave_before_is_set_aside(monkeypatc
                     [point.parameters, point.parameters + [0.0, 0.1 if tag == "a" else -0.1]]))))
         return rows[::-1]  # any order: the recipe puts them in its own
 
-    def wave(_engine, _pair, _bounds, _numerics, traced, curves, _width):
+    def wave(_engine, _pair, _bounds, _numerics, traced, curves, _width, _checked):
         grown.append([spec.name for _, spec, _ in traced.values()])
         if len(grown) == 1:  # wave 0's locus runs through (0.5, 0.3), wave 1's first start
             return [(PointType.LPC, make_locus(np.array([[0.5, 0.0], [0.5, 0.5]])))]

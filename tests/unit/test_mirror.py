@@ -3,13 +3,24 @@ mirror which, and a family mapped onto its mirror image."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
 
+from whirl_cli.continuation import shrinking
 from whirl_cli.continuation.mirror import mirror_sources, mirrored_branch, mirrored_point
+from whirl_cli.continuation.persistence import Recomputed
 from whirl_cli.models import FAMILIES, Model
-from whirl_cli.results import Branch, BranchKind, Orbit, PointType, SpecialPoint
+from whirl_cli.results import (
+    Branch,
+    BranchKind,
+    ContinuationKind,
+    ContinuationResult,
+    Orbit,
+    PointType,
+    SpecialPoint,
+)
 
 MODEL = Model(FAMILIES["classical"], ("polynomial",) * 2)
 PARAMETERS = {"K_psi": 0.3, "K2_theta": 10.0}
@@ -69,3 +80,41 @@ def test_a_mirrored_family_negates_its_states_and_keeps_the_rest():
     moved = mirrored_point(saddle, image)
     np.testing.assert_array_equal(moved.state, -STATE)
     assert moved.branch == "periodic_5" and moved.note.startswith("mirror image of the point")
+
+
+def test_a_mapped_familys_points_share_their_sources_shrinking_restarts(monkeypatch):
+    """The short runs at reduced smoothing restart from a point's labelled AUTO solution; a
+    mapped family holds its source's runs, so its fold would restart from the source's (the
+    other well's) orbit: it is recomputed once, for the source's fold, and its image takes
+    those values. (Runs are stand-ins recording what they are asked for.)"""
+    rows = 3
+    source = Branch("periodic_1", BranchKind.PERIODIC, "HB", ("V",), ("m/s",),
+                    MODEL.state_names, ("rad",) * 2 + ("rad/s",) * 2,
+                    np.array([[7.5], [7.4], [7.3]]), np.full((rows, 4), 0.1),
+                    np.full((rows, 4), 0.05), np.ones(rows), np.full(rows, 0.3),
+                    np.ones(rows, bool), np.array([3, 0, 5]), np.array([1, 2, 3]),
+                    np.zeros((rows, 4), complex), runs=("a.periodic_1.0",))
+    image = mirrored_branch(source, "periodic_2", "HB", source.end)
+    fold = SpecialPoint("periodic_1", 2, int(PointType.LPC), ("V",), np.array([7.3]),
+                        source.state_max[2], 0.3, True, label=3)
+    other = replace(fold, label=2, index=1, parameters=np.array([7.4]))  # another solution
+    points = (fold, other, mirrored_point(fold, image))
+    asked = []
+
+    def restarted(_engine, _name, todo, _runs, _widths, factors):
+        asked.extend(todo)
+        return {k: Recomputed(p.parameters[0] + np.array([1e-4, 2e-4]), shrinking.RESTART)
+                for k, p in todo.items()}
+
+    monkeypatch.setattr(shrinking, "_restarted", restarted)
+    monkeypatch.setattr(shrinking, "_by_locus", lambda *args: {})
+    model = SimpleNamespace(parameters=[SimpleNamespace(name="epsilon")],
+                            parameter_vector=lambda values: np.array([values["epsilon"]]))
+    continuation = ContinuationResult("airspeed", ContinuationKind.ONE_PARAMETER,
+                                      (source, image), points)
+    found = shrinking.recompute(SimpleNamespace(model=model), "airspeed", continuation,
+                                {"epsilon": 1e-3}, ("epsilon",), (0.5, 0.25),
+                                frozenset({int(PointType.LPC)}), (6.0, 9.0), None, 0.01)
+    assert asked == [0, 1]
+    assert set(found) == {0, 1, 2}
+    np.testing.assert_array_equal(found[2].values, found[0].values)

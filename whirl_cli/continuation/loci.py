@@ -161,7 +161,8 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
     """Locus branches from the start points, both directions, each locus once (``outermost``:
     of the folds of cycles of a snaking family only the outermost, :func:`_outermost_folds`),
     each with its special points after its start as ``checked`` gives them (with their
-    verdicts, :func:`locus_points`; their located codimension-2 points may end a locus).
+    verdicts, :func:`locus_points`, computed once per locus; their located codimension-2
+    points may end a locus, and a locus ending at one is not retried).
 
     Starts are taken slice by slice (a wave per slice): a start lying on a locus of its type
     already traced from an earlier slice is the same locus and is not run again, nor is a
@@ -176,6 +177,7 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
     leaves idle; those then found on its loci are set aside (the others are traced then), so
     the loci are those of tracing wave after wave."""
     width = np.array([bounds[p][1] - bounds[p][0] for p in pair])
+    checked = _once(checked or partial(special_points, skip_first=True))
     numbered = list(enumerate(starts, 1))
     waves: dict[str, list] = {}
     for k, (point, runs) in numbered:
@@ -212,7 +214,8 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
         traced = dict(enumerate((kind, spec, branch) for _, kind, spec, branch in sorted(
             (row for row in ahead if row[0] in position),
             key=lambda row: (row[2].name.endswith("2"), position[row[0]], row[2].name))))
-        tasks = [partial(_wave, engine, pair, bounds, numerics, traced, list(curves), width)]
+        tasks = [partial(_wave, engine, pair, bounds, numerics, traced, list(curves), width,
+                         checked)]
         now, later = following(later)
         if now is not None:  # not those on this wave's first chunks either
             tasks.append(partial(_trace, engine, name, pair, bounds, numerics, todo(
@@ -223,10 +226,8 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
     kept = [curve for _, _, curve in _distinct(
         {k: (kind, None, curve) for k, (kind, curve) in enumerate(
             sorted(curves, key=lambda c: c[1].name))}, [], width)[0].values()]
-    checked = checked or partial(special_points, skip_first=True)
     found = [(curve, checked(curve)) for curve in kept]
-    codim2 = [p for _, points in found for p in points
-              if p.point_type in CODIM2 and p.status == LocateStatus.LOCATED]
+    codim2 = _codim2(kept, checked)
     points = tuple(point for point, _ in starts)
     return [(_locus_end(c, codim2, bounds, width, points, numerics.max_steps), on_it)
             for c, on_it in found]
@@ -234,13 +235,14 @@ def _loci(engine: Engine, name: str, pair: tuple[str, str],
 
 def _wave(engine: Engine, pair: tuple[str, str], bounds: dict[str, tuple[float, float]],
           numerics: Numerics, traced: dict[int, tuple[int, RunSpec, Branch]],
-          curves: list[tuple[int, Branch]], width: np.ndarray) -> list[tuple[int, Branch]]:
+          curves: list[tuple[int, Branch]], width: np.ndarray,
+          checked: Callable[[Branch], list[SpecialPoint]]) -> list[tuple[int, Branch]]:
     """(point type, locus) of every one of the loci ``traced`` (their first chunks, by
     index), grown chunk by chunk side by side beside the ``curves`` known (:func:`_grown`);
-    those ending in MX away from a known codimension-2 point retried once
-    (:func:`_retried`)."""
+    those ending in MX away from a located codimension-2 point of the known loci (as
+    ``checked`` judges their points) retried once (:func:`_retried`)."""
     fresh, uncut = _grown(engine, traced, curves, numerics, bounds, width)
-    ends = _codim2([c for _, c in curves + [(kind, c) for kind, _, c in fresh.values()]])
+    ends = _codim2([c for _, c in curves] + [c for _, _, c in fresh.values()], checked)
     unclosed = {k: fresh[k] for k in uncut
                 if not _ending_at(fresh[k][2].parameters[-1, :2], ends, width)}
     retried = _retried(engine, unclosed, numerics)
@@ -250,10 +252,24 @@ def _wave(engine: Engine, pair: tuple[str, str], bounds: dict[str, tuple[float, 
     return [(kind, curve) for kind, _, curve in fresh.values()]
 
 
-def _codim2(curves: list[Branch]) -> list[SpecialPoint]:
-    """The codimension-2 points found on ``curves``."""
-    return [p for c in curves for p in special_points(c, skip_first=True)
-            if PointType(p.point_type) in CODIM2]
+def _codim2(curves: list[Branch], checked: Callable[[Branch], list[SpecialPoint]]
+            ) -> list[SpecialPoint]:
+    """The located codimension-2 points of ``curves``, as ``checked`` gives their special
+    points (a GH point whose first Lyapunov coefficient does not change sign is rejected)."""
+    return [p for c in curves for p in checked(c)
+            if p.point_type in CODIM2 and p.status == LocateStatus.LOCATED]
+
+
+def _once(checked: Callable[[Branch], list[SpecialPoint]]
+          ) -> Callable[[Branch], list[SpecialPoint]]:
+    """``checked`` computed once per locus (loci are frozen: by identity, each kept)."""
+    seen: dict[int, tuple[Branch, list[SpecialPoint]]] = {}
+
+    def points(curve: Branch) -> list[SpecialPoint]:
+        if id(curve) not in seen:
+            seen[id(curve)] = (curve, checked(curve))
+        return seen[id(curve)][1]
+    return points
 
 
 def _ending_at(last: np.ndarray, codim2: list[SpecialPoint], width: np.ndarray
@@ -437,21 +453,20 @@ CODIM2 = {PointType.BT, PointType.CP, PointType.ZH, PointType.GH, PointType.R1, 
 def _retried(engine: Engine, loci: dict[int, tuple[int, RunSpec, Branch]], numerics: Numerics
              ) -> dict[int, tuple[int, RunSpec, Branch]]:
     """Loci (point type, last run, branch by index) that ended in MX continued once more from
-    their last good labelled point with twice the mesh and half the largest step, joined to
-    what they had: (point type, retry run, locus) by index, for those retried."""
+    their last good labelled point (:func:`_retry_from`) with twice the mesh and half the
+    largest step, joined to what they had: (point type, retry run, locus) by index, for those
+    retried."""
     again, where = [], []
     for k, (_, spec, curve) in loci.items():
-        labelled = [r for r in np.flatnonzero(curve.label) if curve.point_type[r] != PointType.MX]
-        if curve.status != RunStatus.MX or not labelled or labelled[-1] == 0:
+        start = _retry_from(engine, spec, curve) if curve.status == RunStatus.MX else None
+        if start is None:
             continue
-        row = int(labelled[-1])
+        row, restart = start
         constants = dict(spec.constants, NTST=spec.constants["NTST"] * 2,
                          DSMAX=spec.constants["DSMAX"] / 2)
         if spec.kind in CHUNKED:
             constants["NMX"] = min(LOCUS_CHUNK, numerics.max_steps - row)
-        again.append(replace(spec, name=spec.name + "r", constants=constants,
-                             restart=(engine.run_with_label(curve.runs, int(curve.label[row])),
-                                      int(curve.label[row]))))
+        again.append(replace(spec, name=spec.name + "r", constants=constants, restart=restart))
         where.append((k, row))
     done: dict[int, tuple[int, RunSpec, Branch]] = {}
     for spec, (k, row), outcome in zip(again, where, engine.run_many(again), strict=True):
@@ -460,6 +475,22 @@ def _retried(engine: Engine, loci: dict[int, tuple[int, RunSpec, Branch]], numer
         if len(extra):
             done[k] = (kind, spec, join(head(curve, row + 1), extra, curve.name))
     return done
+
+
+def _retry_from(engine: Engine, spec: RunSpec, curve: Branch
+                ) -> tuple[int, tuple[str, int]] | None:
+    """(row, AUTO restart) of a locus's last good labelled point: its last labelled row
+    other than the MX, or, for a locus of one run that AUTO labelled nowhere else (a locus of
+    cycles ending in MX within its first chunk: only the MX is labelled), the point its run
+    started from (its first row); None if neither."""
+    labelled = [r for r in np.flatnonzero(curve.label) if curve.point_type[r] != PointType.MX]
+    if labelled and labelled[-1] > 0:
+        row = int(labelled[-1])
+        label = int(curve.label[row])
+        return row, (engine.run_with_label(curve.runs, label), label)
+    if len(curve.runs) == 1 and len(curve) > 1 and spec.restart is not None:
+        return 0, spec.restart
+    return None
 
 
 def _period_tolerance(curve: Branch) -> float:
@@ -494,15 +525,19 @@ def _reached(curve: Branch, starts: tuple[SpecialPoint, ...], width: np.ndarray
 def _locus_end(curve: Branch, codim2: list[SpecialPoint], bounds: dict[str, tuple[float, float]],
                width: np.ndarray, starts: tuple[SpecialPoint, ...] = (),
                max_steps: int = Numerics.max_steps) -> Branch:
-    """The locus with its end classified: range edge, closed (or back at its start's
-    parameters with another orbit: at another of the ``starts`` of its type, if one is
-    there), a codimension-2 point (where AUTO typically stops with MX: that is the locus'
-    natural end, not a failure), its study's step limit (``max_steps`` points), or a chunk
-    of steps after which whirl did not continue it (:func:`_grown`)."""
+    """The locus with its end classified: range edge, closed (back at its start's
+    parameters after leaving them; or there with another orbit: at another of the
+    ``starts`` of its type, if one is there), a codimension-2 point (where AUTO typically
+    stops with MX: that is the locus' natural end, not a failure), its study's step limit
+    (``max_steps`` points), or a chunk of steps after which whirl did not continue it
+    (:func:`_grown`)."""
     last = curve.parameters[-1, :2]
     if at_range_edge(curve, bounds, width):
         return replace(curve, end="range")
-    if len(curve) > 2 and np.abs((last - curve.parameters[0, :2]) / width).max() < 0.005:
+    from_start = np.abs((curve.parameters[:, :2] - curve.parameters[0, :2]) / width).max(axis=1)
+    # back within 0.005 of the ranges of a start it had left by more than 0.02 (as
+    # cut_closed): a locus that stopped a few steps from its start has not closed
+    if len(curve) > 2 and from_start[-1] < 0.005 and from_start.max() > 0.02:
         if not _other_orbit(curve):
             return replace(curve, end="closed")
         # e.g. the folds of cycles of a family snaking toward a homoclinic orbit: the locus

@@ -73,12 +73,30 @@ def recompute(engine: Engine, name: str, continuation: ContinuationResult,
     runs = {b.name: b.runs for b in continuation.branches}
     todo = {k: p for k, p in enumerate(continuation.special_points)
             if p.point_type in checked and p.label and p.branch in runs}
+    shared = _same_solution(todo, runs)
+    todo = {k: p for k, p in todo.items() if k not in shared}
     found = _close(_restarted(engine, name, todo, runs, widths, factors), todo, reach)
     folds = {k: p for k, p in todo.items() if k not in found and p.point_type == PointType.LPC}
     if len(widths) == 1 and folds:
         found |= _close(_by_locus(engine, name, folds, runs, widths, factors, bounds,
                                   numerics), todo, reach)
-    return found
+    return found | {k: found[j] for k, j in shared.items() if j in found}
+
+
+def _same_solution(points: dict[int, SpecialPoint], runs: dict[str, tuple[str, ...]]
+                   ) -> dict[int, int]:
+    """{k: j} for every point k (by index) of the type and label of an earlier point j in the
+    same AUTO runs: both would restart from one solution (a mirror family mapped from another
+    holds its runs, and its points are the images of the other's: of one parameter value)."""
+    first: dict[tuple, int] = {}
+    shared: dict[int, int] = {}
+    for k, point in points.items():
+        key = (runs[point.branch], point.label, point.point_type)
+        if key in first:
+            shared[k] = first[key]
+        else:
+            first[key] = k
+    return shared
 
 
 def _close(found: dict[int, Recomputed], points: dict[int, SpecialPoint],
