@@ -105,11 +105,7 @@ def simulate(values: dict, law, y0, duration: float, breakpoints: tuple[float, .
     return np.concatenate(times), np.concatenate(states)
 
 
-def freeplay_motion(values: dict, delta: float, k_out: float, y0, duration: float,
-                    k_in: float = 0.0, samples_per_second: int = 2000, limit: float = 1.5):
-    """:func:`simulate` with the law ``freeplay(delta, k_out, k_in)``, each piece of it (where
-    the model is linear) in closed form (:mod:`tests.piecewise_linear`): (t, y) sampled from 0
-    to ``duration`` s; the samples end where |theta| or |psi| exceeds ``limit`` rad."""
+def _freeplay_pieces(values: dict, delta: float, k_out: float, k_in: float):
     v = {**DATUM, **values}
 
     def a_of(piece: int) -> np.ndarray:
@@ -118,5 +114,29 @@ def freeplay_motion(values: dict, delta: float, k_out: float, y0, duration: floa
     def b_of(piece: int) -> np.ndarray:  # beyond the gap: k_out x - piece delta (k_out - k_in)
         return np.array([0.0, 0.0, piece * delta * (k_out - k_in) / v["I_y"], 0.0])
 
+    return affine_pieces(a_of, b_of)
+
+
+def freeplay_map(values: dict, delta: float, k_out: float, y0, duration: float,
+                 k_in: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """The exact freeplay law's state after ``duration`` s from ``y0`` and the derivative of
+    that state by ``y0`` (over a period: the monodromy matrix): the product of each piece's
+    exp(A s). The law is continuous at the gap's edges, so the field is too and no jump
+    (saltation) term enters at a crossing."""
+    pieces, visits = _freeplay_pieces(values, delta, k_out, k_in), []
+    _, y = motion(pieces, 0, 2, delta, y0, np.array([duration / 2, duration]), visits=visits)
+    derivative = np.eye(4)
+    for piece, s in visits:
+        p = pieces[piece]
+        derivative = (p.modes @ np.diag(np.exp(p.rates * s)) @ p.inverse).real @ derivative
+    return y[-1], derivative
+
+
+def freeplay_motion(values: dict, delta: float, k_out: float, y0, duration: float,
+                    k_in: float = 0.0, samples_per_second: int = 2000, limit: float = 1.5):
+    """:func:`simulate` with the law ``freeplay(delta, k_out, k_in)``, each piece of it (where
+    the model is linear) in closed form (:mod:`tests.piecewise_linear`): (t, y) sampled from 0
+    to ``duration`` s; the samples end where |theta| or |psi| exceeds ``limit`` rad."""
     grid = np.arange(1, math.floor(duration * samples_per_second) + 1) / samples_per_second
-    return motion(affine_pieces(a_of, b_of), 0, 2, delta, y0, grid, limit=((0, 1), limit))
+    return motion(_freeplay_pieces(values, delta, k_out, k_in), 0, 2, delta, y0, grid,
+                  limit=((0, 1), limit))

@@ -83,11 +83,13 @@ def _exit(p: Piece, y: np.ndarray, j: int, rate: int, piece: int, delta: float,
 
 
 def motion(pieces: Mapping[int, Piece], j: int, rate: int, delta: float, y0, grid: np.ndarray,
-           limit: tuple[tuple[int, ...], float] | None = None):
+           limit: tuple[tuple[int, ...], float] | None = None, visits: list | None = None):
     """(t, y): the motion from ``y0`` at time 0, at the times ``grid`` (evenly spaced, from 0),
     of the model whose dof ``j`` (its rate: state ``rate``) meets a freeplay law of half-gap
     ``delta``; ``pieces`` as :func:`affine_pieces` gives them. ``limit`` (states, size): the
-    samples end before the first where one of those states exceeds size (diverged)."""
+    samples end before the first where one of those states exceeds size (diverged).
+    ``visits``, if given, receives (piece, time spent in it) for each piece the motion passes
+    through up to the grid's end."""
     fastest = max(abs(r) for p in pieces.values() for r in p.rates)
     step = min(grid[1] - grid[0], 2 * np.pi / fastest / 20)
     duration = grid[-1]
@@ -107,6 +109,8 @@ def motion(pieces: Mapping[int, Piece], j: int, rate: int, delta: float, y0, gri
                     break
             start, count = s[-1], min(2 * count, 4096)
         end = duration if hit is None else min(duration, t0 + hit)
+        if visits is not None:
+            visits.append((piece, end - t0))
         times = grid[(grid >= t0) & (grid <= end)] if not out_t else \
             grid[(grid > t0) & (grid <= end)]
         states = p.states(y, times - t0)

@@ -12,6 +12,7 @@ outside the gap, re-enters it on the stable manifold (found by bisection in airs
 from __future__ import annotations
 
 import math
+from itertools import pairwise
 
 import numpy as np
 import pytest
@@ -24,7 +25,7 @@ from whirl_cli.pipeline import run_study
 from whirl_cli.results import PointType
 from whirl_cli.study import load_study
 
-from ..classical_exact import field, freeplay, freeplay_motion, linear_matrix
+from ..classical_exact import field, freeplay, freeplay_map, freeplay_motion, linear_matrix
 from ..conftest import ROOT
 
 DELTA, K_OUT, K_PSI = math.radians(1.0), 0.4, 0.3
@@ -233,3 +234,81 @@ def test_no_fold_between_the_onset_and_the_lower_fold_under_the_exact_law(contin
     assert errors[0] < 5e-3 and np.all(np.diff(errors) < 0)  # converges as epsilon shrinks
     print(f"lower fold: {fold.fun:.6f} m/s (exact law), whirl {lowest.parameters[0]:.6f}, "
           f"{lowest.refined[0]:.6f}, {lowest.refined[1]:.6f} at epsilon, /2, /4")
+
+
+def exact_cycle_of_period(period: float, guess) -> tuple[np.ndarray, np.ndarray]:
+    """((theta, psi, psi', V) of the exact law's cycle of ``period`` s started at theta' = 0,
+    its Floquet multipliers): Newton's method on the closing condition, its derivative by
+    the state from the monodromy matrix, by V by central differences."""
+    def closing(x):
+        y0 = np.array([x[0], x[1], 0.0, x[2]])
+        end, monodromy = freeplay_map({"K_psi": K_PSI, "V": x[3]}, DELTA, K_OUT, y0, period)
+        return end - y0, monodromy
+
+    x = np.array(guess, dtype=float)
+    for _ in range(20):
+        gap, monodromy = closing(x)
+        by_v = (closing(x + [0, 0, 0, 1e-7])[0] - closing(x - [0, 0, 0, 1e-7])[0]) / 2e-7
+        step = np.linalg.solve(np.column_stack([(monodromy - np.eye(4))[:, [0, 1, 3]], by_v]),
+                               -gap)
+        x = x + step
+        if np.all(np.abs(step) < [1e-15, 1e-15, 1e-13, 1e-11]):
+            break
+    gap, monodromy = closing(x)
+    assert np.abs(gap).max() < 1e-9 * DELTA, gap
+    return x, np.linalg.eigvals(monodromy)
+
+
+def exact_period_doublings(period: float, guess, end: float, step: float = 2e-3) -> list:
+    """(period, V) of each cycle of the exact law's family, from the cycle of ``period`` s
+    (near ``guess``) to that of ``end`` s, with a real Floquet multiplier at -1."""
+    def below(_x, multipliers):  # how far the lowest multiplier is beyond -1
+        return float(np.sort(multipliers.real)[0]) + 1.0
+
+    rows = []
+    x, multipliers = exact_cycle_of_period(period, guess)
+    for t in np.arange(period, end, step):
+        predicted = x if len(rows) < 2 else 2 * rows[-1][1] - rows[-2][1]
+        x, multipliers = exact_cycle_of_period(t, predicted)
+        rows.append((t, x, below(x, multipliers)))
+    found = []
+    for (t0, x0, g0), (t1, x1, g1) in pairwise(rows):
+        if g0 * g1 < 0:
+            def g(t, t0=t0, x0=x0, t1=t1, x1=x1):
+                return below(*exact_cycle_of_period(t, x0 + (x1 - x0) * (t - t0) / (t1 - t0)))
+            t = brentq(g, t0, t1, xtol=1e-10)
+            x, multipliers = exact_cycle_of_period(t, x0 + (x1 - x0) * (t - t0) / (t1 - t0))
+            closest = multipliers[np.argmin(np.abs(multipliers + 1))]
+            assert abs(closest + 1) < 1e-6  # a real multiplier at -1
+            found.append((t, x[3]))
+    return found
+
+
+def test_period_doublings_near_the_homoclinic_persist_against_the_exact_law(continuation):
+    """Between the 8.06 m/s fold and the homoclinic orbit a real Floquet multiplier of the
+    exact law's cycles passes -1: twice, barely (to -1.005), at 0.406 and 0.410 s, then at
+    0.539 s. whirl reports each of these period doublings (on a finer mesh than the study's:
+    on its own AUTO's multipliers err by more than that dip) and judges them as they are:
+    they persist as epsilon shrinks, towards the exact law's."""
+    family = continuation.branch("periodic_1")
+    fold = min((p for p in continuation.special_points if p.branch == "periodic_1"
+                and p.point_type == PointType.LPC and 8.0 < p.parameters[0] < 8.1),
+               key=lambda p: p.period)
+    (orbit,) = [o for o in family.orbits if o.index == fold.index]
+    top = orbit.states[np.argmax(orbit.states[:, 0])]  # theta' = 0 there: a guess
+    exact = exact_period_doublings(fold.period, [top[0], top[1], top[3], fold.parameters[0]],
+                                   0.56)
+    assert len(exact) == 3
+    for name in ("periodic_1", "periodic_2"):
+        doublings = sorted((p for p in continuation.special_points
+                            if p.branch == name and p.point_type == PointType.PD),
+                           key=lambda p: p.period)
+        assert len(doublings) == len(exact)
+        for point, (period, v) in zip(doublings, exact, strict=True):
+            assert not point.artefact, point.note
+            assert point.parameters[0] == pytest.approx(v, abs=5e-3)
+            assert point.refined[-1] == pytest.approx(v, abs=1e-3)
+            assert point.period == pytest.approx(period, abs=2e-3)
+    for point, (period, v) in zip(doublings, exact, strict=True):
+        print(f"PD: {v:.6f} m/s, {period:.6f} s (exact law); whirl {point.parameters[0]:.6f}, "
+              f"{point.refined[0]:.6f}, {point.refined[1]:.6f} at epsilon, /2, /4")

@@ -87,3 +87,27 @@ def test_a_grazing_between_two_edge_tests_changes_piece():
     expected = DELTA + v * np.sinh(t[-1] - t_edge)
     assert y[-1, 0] > 1e3 * DELTA
     assert y[-1, 0] == pytest.approx(expected, rel=1e-6)
+
+
+def test_the_visits_give_the_flow_map_derivative():
+    """The pieces a motion passes through and the time in each (``visits``): with a law
+    continuous at the edges, the product of each piece's exp(A s) is the derivative of the
+    final state by the initial one, as central differences of the closed-form map give it."""
+    law = pieces(0.4, 0.0)
+    y0, duration = np.array([4.0 * DELTA, 0.0, 0.0, 0.0]), 12.0
+
+    def final(y):
+        return motion(law, 0, 2, DELTA, y, np.array([duration / 2, duration]))[1][-1]
+
+    visits = []
+    motion(law, 0, 2, DELTA, y0, np.array([duration / 2, duration]), visits=visits)
+    assert {piece for piece, _ in visits} == {-1, 0, 1}  # crosses the gap both ways
+    assert sum(s for _, s in visits) == pytest.approx(duration, abs=1e-12)
+    product = np.eye(4)
+    for piece, s in visits:
+        p = law[piece]
+        product = (p.modes @ np.diag(np.exp(p.rates * s)) @ p.inverse).real @ product
+    h = 1e-7 * DELTA
+    differences = np.column_stack([(final(y0 + h * e) - final(y0 - h * e)) / (2 * h)
+                                   for e in np.eye(4)])
+    np.testing.assert_allclose(product, differences, rtol=1e-5, atol=1e-6 * np.abs(product).max())

@@ -7,7 +7,9 @@ with every smoothing width halved and quartered, by short runs near it where the
 and looking for it there (the same type, the nearest in the principal parameter).
 :func:`annotate` stores the two values (``SpecialPoint.refined``, and how they were found in
 ``refined_by``) and flags a point that is not found again, or moves by more than ``tolerance``
-of the range, as a smoothing artefact (``artefact``, and why in its ``note``).
+of the range, as a smoothing artefact (``artefact``, and why in its ``note``). A point the
+short runs located again at the study's smoothing on a finer mesh (a period doubling) is
+moved there first, its note saying from where.
 
 A global bifurcation bracketed by a snaking approach (its family's folds of cycles alternate
 around it) is recomputed from those folds (:func:`snaking_recomputed`): its estimate is a
@@ -45,10 +47,12 @@ FOLD_MATCH = 1e-2
 @dataclass(frozen=True)
 class Recomputed:
     """A special point's principal parameter at each reduced smoothing (in the order of the
-    factors) and how it was found (``SpecialPoint.refined_by``)."""
+    factors) and how it was found (``SpecialPoint.refined_by``); ``located``: the point found
+    again at the study's smoothing on a finer mesh (its values then judged from there)."""
 
     values: np.ndarray
     method: str
+    located: SpecialPoint | None = None
 
 
 def refined_parameters(parameters: dict[str, float], smoothing: tuple[str, ...],
@@ -116,6 +120,8 @@ def _annotated(point: SpecialPoint, refined: list[ContinuationResult], width: fl
         return point
     if recomputed is not None:
         values, method = np.asarray(recomputed.values, dtype=float), recomputed.method
+        if recomputed.located is not None:
+            point = relocated(point, recomputed.located)
     else:
         values, method = np.array([_nearest(point, run) for run in refined]), "repetition"
     steps = np.diff(np.concatenate([[point.parameters[0]], values]))
@@ -131,6 +137,17 @@ def _annotated(point: SpecialPoint, refined: list[ContinuationResult], width: fl
         why = ""
     return replace(point, refined=values, artefact=artefact, note=joined_notes(point.note, why),
                    refined_by=method)
+
+
+def relocated(point: SpecialPoint, found: SpecialPoint) -> SpecialPoint:
+    """``point`` at the parameters and period of ``found`` (the same point on a finer mesh),
+    saying where it was."""
+    if np.allclose(found.parameters, point.parameters, rtol=0, atol=0):
+        return point
+    note = (f"located on a finer mesh, where AUTO's Floquet multipliers are more accurate "
+            f"(on the study's: {point.parameter_names[0]} = {point.parameters[0]:.6g})")
+    return replace(point, parameters=found.parameters.copy(), period=found.period,
+                   note=joined_notes(point.note, note))
 
 
 def _nearest(point: SpecialPoint, run: ContinuationResult) -> float:

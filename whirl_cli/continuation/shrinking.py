@@ -10,7 +10,11 @@ Two ways, tried in this order for each special point of a type AUTO detects:
    (AUTO's ``STOP``; at most twice the steps the original run took between the two labels,
    plus :data:`SPARE_STEPS`). Starting before the point lets the run pass through it wherever
    the smaller smoothing moved it along the family (restarting at the point itself lands on
-   either side of a fold that moved, and the run never meets it).
+   either side of a fold that moved, and the run never meets it). A point AUTO finds from the
+   Floquet multipliers (period doubling) is recomputed on :data:`MULTIPLIER_MESH` times the
+   mesh, at the study's width too, where it is located again (its multipliers on the study's
+   mesh can err by more than a shallow pair of period doublings dips below -1); a run
+   starts before the first of such points in a row and stops at the one it recomputes.
 2. **epsilon locus** (folds of cycles, one smoothing width): the fold continued in the
    principal parameter and the smoothing width (AUTO's two-parameter LPC locus,
    :func:`whirl_cli.continuation.loci.locus_constants`, on twice the mesh of the run that
@@ -33,6 +37,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..results import BranchKind, ContinuationResult, Origin, PointType, SpecialPoint
+from .branches import special_points
 from .engine import Engine, Numerics, RunSpec, read_run
 from .loci import locus_constants
 from .persistence import Recomputed
@@ -52,6 +57,12 @@ LOCUS_MESH_CAP = 4
 #: A user point on the locus is at a reduced width if within this fraction of it (AUTO locates
 #: user points to EPSS, set to a thousandth of the smallest width on the locus).
 WIDTH_MATCH = 1e-2
+#: Types AUTO finds from the Floquet multipliers, whose error on the study's mesh can exceed
+#: how far a multiplier passes -1 (a shallow period-doubling pair near a homoclinic orbit:
+#: found about 1e-2 m/s off the smoothed law's own in studies/freeplay/pitch_offset_cycles.yaml),
+#: and the multiple of the mesh of the run that found them they are recomputed on (on twice
+#: the mesh that study's pair still comes out doubled at epsilon / 4).
+MULTIPLIER_TYPES, MULTIPLIER_MESH = frozenset({PointType.PD}), 4
 #: How each point was recomputed (``SpecialPoint.refined_by``).
 RESTART, LOCUS, REPETITION = "restart", "epsilon locus", "repetition"
 
@@ -75,7 +86,8 @@ def recompute(engine: Engine, name: str, continuation: ContinuationResult,
             if p.point_type in checked and p.label and p.branch in runs}
     shared = _same_solution(todo, runs)
     todo = {k: p for k, p in todo.items() if k not in shared}
-    found = _close(_restarted(engine, name, todo, runs, widths, factors), todo, reach)
+    found = _close(_restarted(engine, name, todo, runs, widths, factors, numerics), todo,
+                   reach)
     folds = {k: p for k, p in todo.items() if k not in found and p.point_type == PointType.LPC}
     if len(widths) == 1 and folds:
         found |= _close(_by_locus(engine, name, folds, runs, widths, factors, bounds,
@@ -102,9 +114,10 @@ def _same_solution(points: dict[int, SpecialPoint], runs: dict[str, tuple[str, .
 def _close(found: dict[int, Recomputed], points: dict[int, SpecialPoint],
            reach: float) -> dict[int, Recomputed]:
     """``found`` without the points whose values stray: NaN, or a step of more than
-    ``reach`` from the point to its first value or between values."""
+    ``reach`` from the point (where it was located again, if it was) to its first value or
+    between values."""
     return {k: r for k, r in found.items() if np.all(np.abs(np.diff(np.concatenate(
-        [points[k].parameters[:1], r.values]))) <= reach)}
+        [(r.located or points[k]).parameters[:1], r.values]))) <= reach)}
 
 
 def _widths(engine: Engine, parameters: dict[str, float],
@@ -124,47 +137,102 @@ def _source(engine: Engine, runs: dict[str, tuple[str, ...]], point: SpecialPoin
 
 
 def _restart_spec(engine: Engine, name: str, k: int, j: int, point: SpecialPoint,
-                  source: str, widths: dict[str, float], factor: float) -> RunSpec | None:
+                  source: str, widths: dict[str, float], factor: float,
+                  mesh: int | None = None) -> tuple[RunSpec, int] | None:
     """The short run from the label before ``point`` in ``source`` at ``factor`` times the
-    smoothing, or None (no earlier label in that run)."""
+    smoothing (on ``mesh`` intervals if given) and which point of its type it stops at, or
+    None (no label to start from)."""
     spec = engine.specs[source]
-    run = read_run(engine, spec, engine.outcomes[source])
+    start = (_multiplier_start if mesh else _label_before)(
+        read_run(engine, spec, engine.outcomes[source]), point, source, spec.restart)
+    if start is None:
+        return None
+    restart, steps, count = start
+    constants = {key: value for key, value in spec.constants.items() if key not in ("PAR", "LAB")}
+    constants.update(PAR={w: v * factor for w, v in widths.items()},
+                     STOP=[f"{STOP_CODES[PointType(point.point_type)]}{count}"],
+                     NMX=2 * steps + SPARE_STEPS, **({"NTST": mesh} if mesh else {}))
+    return RunSpec(f"{name}/shrink_{k}_eps{j}", constants, spec.kind,
+                   Origin.at(point, f"smoothing x {factor:g}"),
+                   spec.parameter_names, restart=restart, data=None), count
+
+
+def _label_before(run, point: SpecialPoint, source: str,
+                  _start) -> tuple[tuple[str, int], int, int] | None:
+    """(restart, steps to ``point``, 1): from the label before ``point`` in its run ``run``
+    (AUTO's name ``source``), or None."""
     rows = np.flatnonzero(run.label == point.label)
     labelled = [r for r in np.flatnonzero(run.label) if rows.size and r < rows[0]]
     if not labelled:
         return None
-    start, steps = int(run.label[labelled[-1]]), int(rows[0] - labelled[-1])
-    constants = {key: value for key, value in spec.constants.items() if key not in ("PAR", "LAB")}
-    constants.update(PAR={w: v * factor for w, v in widths.items()},
-                     STOP=[f"{STOP_CODES[PointType(point.point_type)]}1"],
-                     NMX=2 * steps + SPARE_STEPS)
-    return RunSpec(f"{name}/shrink_{k}_eps{j}", constants, spec.kind,
-                   Origin.at(point, f"smoothing x {factor:g}"),
-                   spec.parameter_names, restart=(source, start), data=None)
+    return (source, int(run.label[labelled[-1]])), int(rows[0] - labelled[-1]), 1
+
+
+def _multiplier_start(run, point: SpecialPoint, source: str,
+                      start: tuple[str, int] | None) -> tuple[tuple[str, int], int, int] | None:
+    """(restart, steps to ``point``, which point of its type after the restart it is) for a
+    point found from the Floquet multipliers: from the label before the first of the points
+    of its type that lead up to it with no other special point between (a finer mesh may
+    move each of a close pair, but keeps their order), else from where ``run`` (AUTO's name
+    ``source``) itself started (``start``); None if another special point comes first."""
+    rows = np.flatnonzero(run.label == point.label)
+    if not rows.size:
+        return None
+    row, count, before = int(rows[0]), 1, None
+    for r in np.flatnonzero(run.label[:row])[::-1]:  # the labels before it, nearest first
+        kind = PointType(int(run.point_type[r]))
+        if kind == point.point_type:
+            count, before = count + 1, None
+        elif kind.is_special:
+            return None if before is None else ((source, int(run.label[before])),
+                                                row - before, count)
+        elif before is None:
+            before = int(r)
+    if before is not None:
+        return (source, int(run.label[before])), row - before, count
+    return None if start is None else (start, row, count)
 
 
 def _restarted(engine: Engine, name: str, points: dict[int, SpecialPoint],
                runs: dict[str, str], widths: dict[str, float],
-               factors: tuple[float, ...]) -> dict[int, Recomputed]:
-    """Path 1 (module docstring) for every point of a type AUTO can stop at, side by side."""
-    specs: list[tuple[int, RunSpec]] = []
+               factors: tuple[float, ...], numerics: Numerics) -> dict[int, Recomputed]:
+    """Path 1 (module docstring) for every point of a type AUTO can stop at, side by side;
+    a point AUTO finds from its Floquet multipliers on :data:`MULTIPLIER_MESH` times the
+    mesh, at the study's width too (its location there: ``Recomputed.located``)."""
+    specs: list[tuple[int, float, RunSpec, int]] = []
     for k, point in points.items():
         source = _source(engine, runs, point)
         if PointType(point.point_type) not in STOP_CODES or source is None:
             continue
-        made = [_restart_spec(engine, name, k, j, point, source, widths, f)
-                for j, f in enumerate(factors, 1)]
+        mesh = _multiplier_mesh(engine, source, point, numerics)
+        wanted = ((1.0,) if mesh else ()) + factors  # (run 0: the study's width)
+        made = [_restart_spec(engine, name, k, j, point, source, widths, f, mesh)
+                for j, f in enumerate(wanted, 0 if mesh else 1)]
         if all(made):
-            specs += [(k, spec) for spec in made]
+            specs += [(k, f, spec, count) for f, (spec, count) in zip(wanted, made, strict=True)]
     values: dict[int, list[float]] = {}
-    for (k, spec), outcome in zip(specs, engine.run_many([s for _, s in specs]), strict=True):
-        branch = read_run(engine, spec, outcome)
-        same = [r for r in range(1, len(branch))
-                if branch.point_type[r] == points[k].point_type]
-        values.setdefault(k, []).append(float(branch.parameters[same[0], 0]) if same
-                                        else float("nan"))
-    return {k: Recomputed(np.array(v), RESTART) for k, v in values.items()
-            if np.all(np.isfinite(v))}
+    located: dict[int, SpecialPoint | None] = {}
+    for (k, factor, spec, count), outcome in zip(
+            specs, engine.run_many([spec for _, _, spec, _ in specs]), strict=True):
+        same = [p for p in special_points(read_run(engine, spec, outcome), skip_first=True)
+                if p.point_type == points[k].point_type][count - 1:count]
+        if factor == 1.0:
+            located[k] = same[0] if same else None
+        else:
+            values.setdefault(k, []).append(float(same[0].parameters[0]) if same
+                                            else float("nan"))
+    return {k: Recomputed(np.array(v), RESTART, located.get(k)) for k, v in values.items()
+            if np.all(np.isfinite(v)) and (k not in located or located[k] is not None)}
+
+
+def _multiplier_mesh(engine: Engine, source: str, point: SpecialPoint,
+                     numerics: Numerics) -> int | None:
+    """The finer mesh (intervals) to recompute ``point`` on if AUTO finds its type from the
+    Floquet multipliers, else None."""
+    if point.point_type not in MULTIPLIER_TYPES:
+        return None
+    return min(MULTIPLIER_MESH * engine.specs[source].constants["NTST"],
+               LOCUS_MESH_CAP * numerics.mesh_intervals)
 
 
 def _by_locus(engine: Engine, name: str, folds: dict[int, SpecialPoint],
