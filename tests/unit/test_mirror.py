@@ -101,7 +101,7 @@ def test_a_mapped_familys_points_share_their_sources_shrinking_restarts(monkeypa
     points = (fold, other, mirrored_point(fold, image))
     asked = []
 
-    def restarted(_engine, _name, todo, _runs, _widths, factors):
+    def restarted(_engine, _name, todo, _runs, _widths, factors, _numerics):
         asked.extend(todo)
         return {k: Recomputed(p.parameters[0] + np.array([1e-4, 2e-4]), shrinking.RESTART)
                 for k, p in todo.items()}
