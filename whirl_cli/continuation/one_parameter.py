@@ -15,6 +15,7 @@ from .doubling import doubled_families
 from .engine import Engine, Numerics
 from .equilibria import equilibria, is_linear
 from .periodic import OrbitStart, orbit_families, periodic_families
+from .switching import switched_families
 
 
 def one_parameter(engine: Engine, name: str, parameter: str, start: float,
@@ -32,8 +33,10 @@ def one_parameter(engine: Engine, name: str, parameter: str, start: float,
     where every branch stores a labelled solution (orbit profiles); ``resting``: states (SI)
     at ``start`` near equilibria (e.g. where seeds came to rest), each starting a branch if
     it is on none (see :func:`.equilibria.equilibria`), as does (``spread``) every
-    equilibrium Newton's method finds there from a spread of starts; ``period_doubling``: the
-    families doubled at the PD points of the periodic ones (:mod:`.doubling`)."""
+    equilibrium Newton's method finds there from a spread of starts. The periodic families'
+    branch points of cycles start the families crossing them there (:mod:`.switching`);
+    ``period_doubling``: the families doubled at the PD points of the periodic ones
+    (:mod:`.doubling`)."""
     numerics = replace(numerics, orbits_at=tuple(orbits_at))
     branches, points = equilibria(engine, name, parameter, start, bounds, parameters, numerics,
                                   branch_points, start_state, tuple(resting), spread)
@@ -51,6 +54,13 @@ def one_parameter(engine: Engine, name: str, parameter: str, start: float,
         steady = [b for b in branches if not b.is_periodic]
         families, family_points = orbit_families(engine, name, parameter, bounds, numerics,
                                                  list(start_orbits), steady, points, parameters)
+        branches += families
+        points += family_points
+    if periodic or start_orbits:
+        steady = [b for b in branches if not b.is_periodic]
+        families, family_points = switched_families(
+            engine, name, parameter, bounds, numerics, [b for b in branches if b.is_periodic],
+            points, steady, parameters)
         branches += families
         points += family_points
     if period_doubling:
