@@ -4,7 +4,9 @@ crosses it there, continued fold by fold (:mod:`.periodic`) until it is back at 
 point of cycles of the family it left (its start, or another: at a pitchfork of a symmetric
 model's symmetric cycles the asymmetric family often joins two of them).
 
-A branch point a switched family reached is not switched at again (its family is that one).
+A branch point a switched family reached is not switched at again (its family is that one),
+nor one in its family's period blow-up (a period over BLOWUP_FACTOR times the family's
+shortest: a family snaking towards a homoclinic orbit has many, on families that snake too).
 Of a symmetric model, a family leaving a symmetric cycle (its orbit its own mirror image:
 a symmetry-breaking pitchfork) has a mirror image, the other side of the pitchfork: mapped
 (:mod:`.mirror`, branch ``<family>m``), not computed.
@@ -16,6 +18,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..analysis.global_bifurcations import BLOWUP_FACTOR
 from ..models import Model
 from ..results import Branch, BranchKind, Origin, PointType, SpecialPoint
 from .branches import head
@@ -69,9 +72,10 @@ def switched_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
         branch_points = [p for p in points if p.branch == family.name
                          and p.point_type == PointType.BPC]
         reached: set[int] = set()
+        shortest = float(np.nanmin(family.period)) if len(family) else np.inf
         for k, point in enumerate(branch_points, 1):
-            if k - 1 in reached:
-                continue
+            if k - 1 in reached or point.period > BLOWUP_FACTOR * shortest:
+                continue  # reached from another, or in the family's period blow-up
             side = _start(engine, name, parameter, bounds, numerics, family, point,
                           f"{family.name}_bp{k}", tuple(branch_points))
             continue_families(engine, [side], hopfs, width)
@@ -192,10 +196,13 @@ def _start(engine: Engine, name: str, parameter: str, bounds: tuple[float, float
     scale = np.asarray(engine.model.state_scale, dtype=float)
 
     def back(piece: Branch, row: int) -> str:
+        """The end at ``row`` of ``piece``: back at a branch point of the family, or a
+        piece that only retraces the family (a failed switch: no use going on)."""
         for other in branch_points:
             if at_branch_point(piece, row, other, family, width, scale):
                 return (f"back on {family.name} at its BPC at {parameter} = "
                         f"{other.parameters[0]:.6g}")
-        return ""
+        return f"retraces {family.name}" if len(piece) >= 3 and not _left(
+            piece, family, width, scale) else ""
 
     return FamilySide(switched, point.period, spec, [], stop=back)
