@@ -104,7 +104,7 @@ def switched_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
             prefix = f"{sources[family.name]}_bp"
             for branch in [b for b in kept if b.name.startswith(prefix)]:
                 image = mirrored_branch(branch, family.name + branch.name[len(prefix) - 3:],
-                                        branch.origin, branch.end)
+                                        replace(branch.origin, branch=family.name), branch.end)
                 kept.append(image)
                 found += [mirrored_point(p, image) for p in found if p.branch == branch.name]
     return kept, found
