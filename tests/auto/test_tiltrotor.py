@@ -287,7 +287,7 @@ def test_the_period_doubled_family_starts_where_a_multiplier_is_minus_one(gimbal
     eigenvalue at -1 (1e-2), and the doubled family (``period_doubling: true``) starts at its
     airspeed with twice its period (1e-3)."""
     gimbal_law = _only(gimbal_law)
-    (doubling,) = _points(gimbal_law, PointType.PD, "periodic_1")
+    (doubling,) = [p for p in _points(gimbal_law, PointType.PD) if p.branch == "periodic_1"]
     family = next(b for b in gimbal_law.branches if b.name == "periodic_1")
     orbit = next(o for o in family.orbits if o.index == doubling.index)
     ours = np.linalg.eigvals(_monodromy(float(orbit.parameters[0]), orbit.states[0] * FRAME,

@@ -93,7 +93,9 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
     special points (both directions, each locus once). Returns the continuation (slice branches
     named ``slice_<k>.<branch>`` and the locus branches) and the locus branches.
     ``slice_orbits``: per slice, orbits (e.g. settled seeds) whose periodic families that
-    slice's run continues too (their folds of cycles start loci as a Hopf family's do).
+    slice's run continues too (their folds of cycles start loci as a Hopf family's do; those
+    of the families branching off at branch points of cycles start none: they stay on the
+    slices).
     ``snaking_folds``: "all", or "outermost" (:func:`_outermost_folds`)."""
     first, second = pair
     wanted = {kind for kind, (locus, _) in LOCI.items() if locus in loci}
@@ -112,6 +114,7 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
     results = thread_map(run_slice, range(len(slices)), len(slices))
     for k, (value, result) in enumerate(zip(slices, results, strict=True)):
         runs = {b.name: b.runs for b in result.branches}
+        switched = {b.name for b in result.branches if b.origin.point == PointType.BPC}
         for branch in result.branches:
             branches.append(replace(branch, name=slice_branch(k, branch.name)))
         for point in result.special_points:
@@ -119,7 +122,8 @@ def two_parameter(engine: Engine, name: str, pair: tuple[str, str],
                             parameters=np.array([point.parameters[0], value]))
             points.append(named)
             width = bounds[first][1] - bounds[first][0]
-            if point.point_type in wanted and _starts_locus(point) and not any(
+            if point.point_type in wanted and point.branch not in switched and \
+                    _starts_locus(point) and not any(
                     point.point_type == other.point_type
                     and same_point(named, other, width, amplitudes)
                     for other, _ in starts):

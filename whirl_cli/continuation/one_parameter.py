@@ -15,6 +15,7 @@ from .doubling import doubled_families
 from .engine import Engine, Numerics
 from .equilibria import equilibria, is_linear
 from .periodic import OrbitStart, orbit_families, periodic_families
+from .switching import switched_families
 
 
 def one_parameter(engine: Engine, name: str, parameter: str, start: float,
@@ -24,7 +25,8 @@ def one_parameter(engine: Engine, name: str, parameter: str, start: float,
                   start_orbits: tuple[OrbitStart, ...] = (),
                   start_state: np.ndarray | None = None,
                   resting: tuple[np.ndarray, ...] = (), spread: bool = False,
-                  period_doubling: bool = False) -> ContinuationResult:
+                  period_doubling: bool = False, cycle_branching: bool = True
+                  ) -> ContinuationResult:
     """Equilibria of ``parameter`` over ``bounds`` from ``start`` (from the equilibrium found
     by Newton's method from ``start_state``, SI, default zero), with branch switching, and
     (``periodic``) the periodic families of every Hopf point, and those through each of
@@ -32,8 +34,11 @@ def one_parameter(engine: Engine, name: str, parameter: str, start: float,
     where every branch stores a labelled solution (orbit profiles); ``resting``: states (SI)
     at ``start`` near equilibria (e.g. where seeds came to rest), each starting a branch if
     it is on none (see :func:`.equilibria.equilibria`), as does (``spread``) every
-    equilibrium Newton's method finds there from a spread of starts; ``period_doubling``: the
-    families doubled at the PD points of the periodic ones (:mod:`.doubling`)."""
+    equilibrium Newton's method finds there from a spread of starts. The periodic families'
+    branch points of cycles start the families crossing them there (:mod:`.switching`;
+    not if ``cycle_branching`` is false);
+    ``period_doubling``: the families doubled at the PD points of the periodic ones
+    (:mod:`.doubling`)."""
     numerics = replace(numerics, orbits_at=tuple(orbits_at))
     branches, points = equilibria(engine, name, parameter, start, bounds, parameters, numerics,
                                   branch_points, start_state, tuple(resting), spread)
@@ -51,6 +56,13 @@ def one_parameter(engine: Engine, name: str, parameter: str, start: float,
         steady = [b for b in branches if not b.is_periodic]
         families, family_points = orbit_families(engine, name, parameter, bounds, numerics,
                                                  list(start_orbits), steady, points, parameters)
+        branches += families
+        points += family_points
+    if cycle_branching and (periodic or start_orbits):
+        steady = [b for b in branches if not b.is_periodic]
+        families, family_points = switched_families(
+            engine, name, parameter, bounds, numerics, [b for b in branches if b.is_periodic],
+            points, steady, parameters)
         branches += families
         points += family_points
     if period_doubling:

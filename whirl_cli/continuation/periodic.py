@@ -9,6 +9,7 @@ point's, or its start orbit's.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -90,7 +91,9 @@ class FamilySide:
 
     ``name``: its branch name; ``period``: its reference period (s), the Hopf period or the
     start orbit's; ``hopf``: the index of the Hopf point it starts from (None for an orbit
-    start); ``grows``: its first run grows it from the Hopf point to GROWN_AMPLITUDE."""
+    start); ``grows``: its first run grows it from the Hopf point to GROWN_AMPLITUDE;
+    ``stop(piece, row)``: why the family ends at that row of a piece of it, if it does there
+    ("" if not; judged at each fold it reaches)."""
 
     name: str
     period: float
@@ -100,6 +103,7 @@ class FamilySide:
     grows: bool = False
     retries: int = 0
     refinements: int = 0
+    stop: Callable[[Branch, int], str] | None = None
 
 
 def periodic_families(engine: Engine, name: str, parameter: str, bounds: tuple[float, float],
@@ -417,8 +421,9 @@ def _next_segment(family: FamilySide, model: Model, hopfs: list[SpecialPoint],
             return None
     elif last != PointType.LPC or \
             _first_return(piece, hopfs, width, scale, family.grows) is not None or \
-            hopf_at(piece, len(piece) - 1, hopfs, width, scale) is not None:
-        return None  # an end (range, amplitude, period, steps) or back at a Hopf point
+            hopf_at(piece, len(piece) - 1, hopfs, width, scale) is not None or \
+            family.stop is not None and family.stop(piece, len(piece) - 1):
+        return None  # an end (range, amplitude, period, steps), back at a Hopf point, its own
     if global_bifurcations.in_blowup(piece, family.period) and \
             global_bifurcations.blowup_turns(*_columns(family), family.period) \
             >= global_bifurcations.BRACKET_TURNS:
@@ -499,6 +504,8 @@ def _periodic_end(family: Branch, model: Model, hopfs: list[SpecialPoint],
                            returned == state.hopf), returned
     if family.point_type[-1] == PointType.MX:
         return "no convergence (MX)", None
+    if state.stop is not None and state.stop(family, len(family) - 1):
+        return state.stop(family, len(family) - 1), None
     if family.period[-1] >= 0.999 * PERIOD_CAP * state.period:
         return "period cap", None
     if min(abs(value - bounds[0]), abs(value - bounds[1])) < 1e-6 * width:

@@ -203,11 +203,12 @@ def continue_two_parameter(stage: Stage, spec) -> tuple[ContinuationResult, Boun
     added = itertools.count(1)
 
     def more_slices(values: list[float]) -> list[tuple]:
-        """The branches of extra slices at ``values`` (not stored: they only judge folds)."""
+        """The branches of extra slices at ``values`` (not stored: they only judge folds, by
+        the stable cycles of each fold's own family, so no family branching off is run)."""
         def run(named: tuple[str, float]) -> tuple:
             return one_parameter(engine, named[0], pair[0], spec.start, bounds[pair[0]],
                                  {**parameters, pair[1]: named[1]}, numerics,
-                                 periodic=True).branches
+                                 periodic=True, cycle_branching=False).branches
         named = [(f"{spec.name}.extra_{next(added)}", value) for value in values]
         return thread_map(run, named, len(named))
 
