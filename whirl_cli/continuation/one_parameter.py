@@ -58,16 +58,14 @@ def one_parameter(engine: Engine, name: str, parameter: str, start: float,
                                                  list(start_orbits), steady, points, parameters)
         branches += families
         points += family_points
-    if cycle_branching and (periodic or start_orbits):
+    # families branching off the cycles found so far: at branch points, then (of those too)
+    # at period doublings
+    for wanted, branching in ((cycle_branching and (periodic or start_orbits),
+                               switched_families), (period_doubling, doubled_families)):
+        if not wanted:
+            continue
         steady = [b for b in branches if not b.is_periodic]
-        families, family_points = switched_families(
-            engine, name, parameter, bounds, numerics, [b for b in branches if b.is_periodic],
-            points, steady, parameters)
-        branches += families
-        points += family_points
-    if period_doubling:
-        steady = [b for b in branches if not b.is_periodic]
-        families, family_points = doubled_families(
+        families, family_points = branching(
             engine, name, parameter, bounds, numerics, [b for b in branches if b.is_periodic],
             points, steady, parameters)
         branches += families
