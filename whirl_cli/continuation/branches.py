@@ -69,11 +69,24 @@ def special_points(branch: Branch, skip_first: bool = False) -> list[SpecialPoin
             parameter_units=branch.parameter_units,
             state=branch.state_max[index].copy(), period=float(branch.period[index]),
             stable=bool(branch.stable[index]), label=int(branch.label[index]),
-            **(_torus(branch, index) if kind == PointType.TR and branch.is_periodic else {})))
+            **_verdict(branch, index, kind)))
     return found
 
 
-#: How far from the unit circle (in modulus) the multiplier pair of a torus point may be.
+def _verdict(branch: Branch, index: int, kind: PointType) -> dict:
+    """What the Floquet multipliers say of a point of a periodic ``branch`` AUTO labelled
+    as a torus point or a branch point of cycles (fields of its :class:`SpecialPoint`)."""
+    if not branch.is_periodic:
+        return {}
+    if kind == PointType.TR:
+        return _torus(branch, index)
+    if kind == PointType.BPC:
+        return _branch_point_of_cycles(branch, index)
+    return {}
+
+
+#: How far from the unit circle (in modulus) the multiplier pair of a torus point may be, and
+#: the second multiplier of a branch point of cycles from +1.
 TORUS_TOLERANCE = 0.05
 
 
@@ -103,6 +116,20 @@ def _torus(branch: Branch, index: int) -> dict:
             "note": "no complex pair of Floquet multipliers on the unit circle: AUTO's torus "
                     "test function changed sign without a Neimark-Sacker pair (not a torus "
                     "bifurcation)"}
+
+
+def _branch_point_of_cycles(branch: Branch, index: int) -> dict:
+    """A BPC point's status rejected and a ``note`` if its multipliers (known) have a single
+    one within :data:`TORUS_TOLERANCE` of +1: at a branch point of cycles a second real
+    multiplier passes through +1 beside the cycle's trivial one."""
+    multipliers = branch.eigenvalues[index]
+    known = multipliers[np.isfinite(multipliers)]
+    if not known.size or np.sum(np.abs(known - 1.0) <= TORUS_TOLERANCE) >= 2:
+        return {}
+    return {"status": LocateStatus.REJECTED,
+            "note": "a single Floquet multiplier at +1 (the cycle's own): AUTO's branch-point "
+                    "test function changed sign without a second one passing +1 (no family "
+                    "of cycles crosses here)"}
 
 
 def typical_amplitudes(model: Model) -> np.ndarray:

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..analysis.global_bifurcations import BLOWUP_FACTOR
 from ..models import Model
-from ..results import Branch, BranchKind, Origin, PointType, SpecialPoint
+from ..results import Branch, BranchKind, LocateStatus, Origin, PointType, SpecialPoint
 from .branches import head
 from .engine import Engine, Numerics, RunSpec
 from .mirror import is_odd, mirrored_branch, mirrored_point
@@ -70,7 +70,8 @@ def switched_families(engine: Engine, name: str, parameter: str, bounds: tuple[f
         if family.name in sources:
             continue
         branch_points = [p for p in points if p.branch == family.name
-                         and p.point_type == PointType.BPC]
+                         and p.point_type == PointType.BPC
+                         and p.status != LocateStatus.REJECTED]
         reached: set[int] = set()
         shortest = float(np.nanmin(family.period)) if len(family) else np.inf
         for k, point in enumerate(branch_points, 1):
