@@ -132,6 +132,14 @@ def _branch_point_of_cycles(branch: Branch, index: int) -> dict:
                     "of cycles crosses here)"}
 
 
+def last_good_label(branch: Branch, before: int | None = None) -> int | None:
+    """The last row (before row ``before``, if given) of ``branch`` with a label that is no
+    MX point: where a run that failed can be restarted from; None if there is none."""
+    rows = [k for k in np.flatnonzero(branch.label[:before])
+            if branch.point_type[k] != PointType.MX]
+    return int(rows[-1]) if rows else None
+
+
 def typical_amplitudes(model: Model) -> np.ndarray:
     """(n,) :attr:`~whirl_cli.models.Model.typical_amplitudes` (rad for the classical
     model, where it is 1)."""

@@ -28,7 +28,7 @@ from ..results import (
     slice_branch,
 )
 from ..runtime import thread_map
-from .branches import head, join, same_point, special_points, typical_amplitudes
+from .branches import head, join, last_good_label, same_point, special_points, typical_amplitudes
 from .criticality import with_bautin_verdict
 from .engine import Engine, Numerics, RunSpec, read_run
 from .equilibria import equilibrium_constants
@@ -487,9 +487,8 @@ def _retry_from(engine: Engine, spec: RunSpec, curve: Branch
     other than the MX, or, for a locus of one run that AUTO labelled nowhere else (a locus of
     cycles ending in MX within its first chunk: only the MX is labelled), the point its run
     started from (its first row); None if neither."""
-    labelled = [r for r in np.flatnonzero(curve.label) if curve.point_type[r] != PointType.MX]
-    if labelled and labelled[-1] > 0:
-        row = int(labelled[-1])
+    row = last_good_label(curve)
+    if row:
         label = int(curve.label[row])
         return row, (engine.run_with_label(curve.runs, label), label)
     if len(curve.runs) == 1 and len(curve) > 1 and spec.restart is not None:

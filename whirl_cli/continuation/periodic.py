@@ -29,7 +29,7 @@ from ..results import (
     SpecialPoint,
 )
 from ..runtime import thread_map
-from .branches import amplitude, head, join, reverse, special_points
+from .branches import amplitude, head, join, last_good_label, reverse, special_points
 from .engine import Engine, Numerics, RunSpec, read_run
 from .equilibria import equilibrium_constants
 from .homoclinic import locate_homoclinics
@@ -458,11 +458,11 @@ def _retry(family: FamilySide, piece: Branch) -> RunSpec | None:
     twice the mesh intervals and half the largest step; the piece is cut back to that point.
     A retry that failed before its first label is dropped and the family restarts from the
     label before the one that retry started from."""
-    row = _last_good_label(piece, len(piece))
+    row = last_good_label(piece)
     if row is None and family.retries and len(family.pieces) > 1:
         family.pieces.pop()
         piece = family.pieces[-1]
-        row = _last_good_label(piece, len(piece) - 1)
+        row = last_good_label(piece, len(piece) - 1)
     if row is None or global_bifurcations.in_blowup(piece, family.period):
         return None
     family.pieces[-1] = head(piece, row + 1)
@@ -477,13 +477,6 @@ def _retry(family: FamilySide, piece: Branch) -> RunSpec | None:
                    f"{len(family.pieces)}r{family.retries}",
                    constants=_segment_constants(family),
                    restart=(piece.runs[-1], int(piece.label[row])), data=None)
-
-
-def _last_good_label(piece: Branch, before: int) -> int | None:
-    """The last row before ``before`` of ``piece`` with a label that is no MX point."""
-    rows = [k for k in np.flatnonzero(piece.label[:before])
-            if piece.point_type[k] != PointType.MX]
-    return int(rows[-1]) if rows else None
 
 
 def _periodic_end(family: Branch, model: Model, hopfs: list[SpecialPoint],
@@ -504,8 +497,9 @@ def _periodic_end(family: Branch, model: Model, hopfs: list[SpecialPoint],
                            returned == state.hopf), returned
     if family.point_type[-1] == PointType.MX:
         return "no convergence (MX)", None
-    if state.stop is not None and state.stop(family, len(family) - 1):
-        return state.stop(family, len(family) - 1), None
+    stopped = state.stop(family, len(family) - 1) if state.stop is not None else ""
+    if stopped:
+        return stopped, None
     if family.period[-1] >= 0.999 * PERIOD_CAP * state.period:
         return "period cap", None
     if min(abs(value - bounds[0]), abs(value - bounds[1])) < 1e-6 * width:
