@@ -283,10 +283,14 @@ def _place(label, renderer) -> None:
 def _curve_points(ax: Axes) -> np.ndarray:
     """The vertices of ``ax``'s drawn lines without markers (curves), in display coordinates."""
     points = [line.get_transform().transform(line.get_xydata()) for line in ax.lines
-              if line.get_visible() and line.get_marker() in ("None", "none", "", " ", None)
-              and len(line.get_xdata())]
+              if line.get_visible() and not _has_marker(line) and len(line.get_xdata())]
     xy = np.concatenate(points) if points else np.zeros((0, 2))
     return xy[np.isfinite(xy).all(axis=1)]
+
+
+def _has_marker(line) -> bool:
+    """True if the matplotlib ``line`` draws a marker at its points."""
+    return line.get_marker() not in ("None", "none", "", " ", None)
 
 
 def _put(label, place: tuple) -> None:
@@ -353,7 +357,7 @@ def _obstacles(ax: Axes, label, renderer) -> list:
     per_point = ax.figure.dpi / 72.0
     boxes = []
     for line in ax.lines:
-        if not line.get_visible() or line.get_marker() in ("None", "none", "", " ", None):
+        if not line.get_visible() or not _has_marker(line):
             continue
         half = 0.5 * (line.get_markersize() + line.get_markeredgewidth()) * per_point
         for x, y in line.get_transform().transform(line.get_xydata()):
@@ -377,23 +381,14 @@ def crowd(centres: np.ndarray, reach: np.ndarray) -> np.ndarray:
     n = len(centres)
     if n < CROWD:
         return np.zeros(0, dtype=int)
+    from scipy.sparse.csgraph import connected_components
+
     gaps = np.linalg.norm(centres[:, None, :] - centres[None, :, :], axis=2)
-    linked = gaps < reach[:, None] + reach[None, :]
-    group = -np.ones(n, dtype=int)
-    for start in range(n):
-        if group[start] >= 0:
-            continue
-        group[start] = start
-        todo = [start]
-        while todo:
-            k = todo.pop()
-            for m in np.flatnonzero(linked[k] & (group < 0)):
-                group[m] = start
-                todo.append(m)
-    labels, counts = np.unique(group, return_counts=True)
+    _, group = connected_components(gaps < reach[:, None] + reach[None, :], directed=False)
+    counts = np.bincount(group)
     if counts.max() < CROWD:
         return np.zeros(0, dtype=int)
-    return np.flatnonzero(group == labels[np.argmax(counts)])
+    return np.flatnonzero(group == np.argmax(counts))
 
 
 def crowded_box(ax: Axes) -> tuple[tuple[float, float], tuple[float, float]] | None:
@@ -405,8 +400,8 @@ def crowded_box(ax: Axes) -> tuple[tuple[float, float], tuple[float, float]] | N
     per_point = ax.figure.dpi / 72.0
     data, centres, reach = [], [], []
     for line in ax.lines:
-        if line.get_linestyle() not in ("None", "none", "") or line.get_marker() in (
-                "None", "none", "", " ", None) or not line.get_visible():
+        if line.get_linestyle() not in ("None", "none", "") or not _has_marker(line) or \
+                not line.get_visible():
             continue
         xy = line.get_xydata()
         xy = xy[np.isfinite(xy).all(axis=1)]
